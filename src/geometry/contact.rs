@@ -1,0 +1,87 @@
+//! The output of the narrow phase: a contact manifold between two shapes.
+//!
+//! Convention used by every shape-pair test: the `normal` is a unit vector pointing **from shape
+//! A towards shape B**, `depth >= 0` is how far they interpenetrate along it, and a pair at
+//! distance exactly zero (touching) *is* in contact with depth 0 — the same closed-set convention
+//! as [`Aabb::intersects`](crate::bounding::Aabb::intersects). Points are in world space, midway
+//! between the two surfaces.
+
+use glam::Vec3;
+
+/// Most points a manifold keeps: four span a face-face contact, enough for a box to rest flat.
+pub const MAX_MANIFOLD_POINTS: usize = 4;
+
+/// One point of contact.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct ContactPoint {
+    /// World-space point midway between the two surfaces.
+    pub point: Vec3,
+    /// Penetration along the manifold normal, `>= 0`.
+    pub depth: f32,
+}
+
+/// Up to [`MAX_MANIFOLD_POINTS`] contact points sharing one normal, stored inline (the narrow
+/// phase allocates nothing per pair).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactManifold {
+    /// Unit normal from A to B.
+    pub normal: Vec3,
+    points: [ContactPoint; MAX_MANIFOLD_POINTS],
+    len: u8,
+}
+
+impl ContactManifold {
+    /// An empty manifold with the given normal.
+    pub fn new(normal: Vec3) -> Self {
+        Self {
+            normal,
+            points: [ContactPoint::default(); MAX_MANIFOLD_POINTS],
+            len: 0,
+        }
+    }
+
+    /// A manifold of a single point.
+    pub fn single(normal: Vec3, point: Vec3, depth: f32) -> Self {
+        let mut m = Self::new(normal);
+        m.push(ContactPoint { point, depth });
+        m
+    }
+
+    /// Adds a point; returns `false` (and drops it) when the manifold is full.
+    pub fn push(&mut self, p: ContactPoint) -> bool {
+        if (self.len as usize) < MAX_MANIFOLD_POINTS {
+            self.points[self.len as usize] = p;
+            self.len += 1;
+            true
+        } else {
+            false
+        }
+    }
+
+    /// The points held.
+    pub fn points(&self) -> &[ContactPoint] {
+        &self.points[..self.len as usize]
+    }
+
+    /// Number of points held.
+    pub fn len(&self) -> usize {
+        self.len as usize
+    }
+
+    /// True when no point is held.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// The deepest penetration over the points (0 when empty).
+    pub fn max_depth(&self) -> f32 {
+        self.points().iter().fold(0.0, |d, p| d.max(p.depth))
+    }
+
+    /// The same contact seen from B: the normal flips, the points stay.
+    #[must_use]
+    pub fn flipped(mut self) -> Self {
+        self.normal = -self.normal;
+        self
+    }
+}

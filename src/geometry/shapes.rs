@@ -1,0 +1,147 @@
+//! Collision shapes in their local frames: the slides' closed-form shapes (sphere, plane)
+//! and the box that OBB tests and games both need.
+//!
+//! A shape never stores its pose: the pose comes with every query (see [`Isometry`]).
+
+use crate::bounding::Aabb;
+use crate::geometry::Isometry;
+use glam::Vec3;
+use std::fmt;
+
+/// A ball of `radius` centred on the local origin.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sphere {
+    /// Radius, `>= 0` (zero is a point).
+    pub radius: f32,
+}
+
+/// A box centred on the local origin, faces along the local axes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cuboid {
+    /// Half the size along local x, y, z; each `>= 0`.
+    pub half_extents: Vec3,
+}
+
+/// The solid half-space below a plane through the local origin: points `x` with `normal·x <= 0`.
+///
+/// Used for grounds and walls: the body is unbounded, so it is always static and never enters the
+/// broad phase's sort (its AABB is infinite).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HalfSpace {
+    /// Outward unit normal in the local frame: it points out of the solid.
+    pub normal: Vec3,
+}
+
+/// Every shape urto collides.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shape {
+    /// See [`Sphere`].
+    Sphere(Sphere),
+    /// See [`Cuboid`].
+    Cuboid(Cuboid),
+    /// See [`HalfSpace`].
+    HalfSpace(HalfSpace),
+}
+
+/// Why a shape cannot be simulated.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ShapeError {
+    /// A radius that is negative, NaN or infinite.
+    BadRadius(f32),
+    /// Half extents with a negative, NaN or infinite component.
+    BadHalfExtents(Vec3),
+    /// A plane normal that is zero, NaN or infinite.
+    BadNormal(Vec3),
+}
+
+impl fmt::Display for ShapeError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::BadRadius(r) => write!(f, "sphere radius must be finite and >= 0, got {r}"),
+            Self::BadHalfExtents(h) => {
+                write!(f, "box half extents must be finite and >= 0, got {h}")
+            }
+            Self::BadNormal(n) => write!(f, "plane normal must be finite and non-zero, got {n}"),
+        }
+    }
+}
+
+impl std::error::Error for ShapeError {}
+
+impl Shape {
+    /// A sphere of `radius`.
+    pub fn sphere(radius: f32) -> Self {
+        Self::Sphere(Sphere { radius })
+    }
+
+    /// A box of the given half extents.
+    pub fn cuboid(half_extents: Vec3) -> Self {
+        Self::Cuboid(Cuboid { half_extents })
+    }
+
+    /// The half-space below the plane of outward `normal` (normalised here; a zero normal is
+    /// kept as is and refused by [`Shape::validate`]).
+    pub fn half_space(normal: Vec3) -> Self {
+        Self::HalfSpace(HalfSpace {
+            normal: normal.try_normalize().unwrap_or(normal),
+        })
+    }
+
+    /// Checks that the shape's numbers describe a real shape.
+    pub fn validate(&self) -> Result<(), ShapeError> {
+        match self {
+            Self::Sphere(s) if !(s.radius.is_finite() && s.radius >= 0.0) => {
+                Err(ShapeError::BadRadius(s.radius))
+            }
+            Self::Cuboid(c)
+                if !(c.half_extents.is_finite() && c.half_extents.cmpge(Vec3::ZERO).all()) =>
+            {
+                Err(ShapeError::BadHalfExtents(c.half_extents))
+            }
+            Self::HalfSpace(h) if !(h.normal.is_finite() && h.normal.length_squared() > 0.5) => {
+                Err(ShapeError::BadNormal(h.normal))
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// True for shapes with an infinite extent (they are static scenery by construction).
+    pub fn is_unbounded(&self) -> bool {
+        matches!(self, Self::HalfSpace(_))
+    }
+
+    /// The world-space AABB of the shape placed at `pose` (infinite for unbounded shapes).
+    pub fn world_aabb(&self, pose: &Isometry) -> Aabb {
+        match self {
+            Self::Sphere(s) => Aabb::from_center_half_extents(pose.translation, Vec3::splat(s.radius)),
+            Self::Cuboid(c) => {
+                Aabb::from_center_half_extents(Vec3::ZERO, c.half_extents).transformed(pose)
+            }
+            Self::HalfSpace(_) => Aabb::new(Vec3::NEG_INFINITY, Vec3::INFINITY),
+        }
+    }
+
+    /// Radius of the smallest origin-centred ball holding the shape (infinite if unbounded).
+    pub fn bounding_radius(&self) -> f32 {
+        match self {
+            Self::Sphere(s) => s.radius,
+            Self::Cuboid(c) => c.half_extents.length(),
+            Self::HalfSpace(_) => f32::INFINITY,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn validation_refuses_nan_negative_and_zero_normals() {
+        assert!(Shape::sphere(0.0).validate().is_ok());
+        assert!(Shape::sphere(-1.0).validate().is_err());
+        assert!(Shape::sphere(f32::NAN).validate().is_err());
+        assert!(Shape::cuboid(Vec3::new(1.0, -0.1, 1.0)).validate().is_err());
+        assert!(Shape::half_space(Vec3::ZERO).validate().is_err());
+        assert!(Shape::half_space(Vec3::new(0.0, 0.0, 3.0)).validate().is_ok());
+    }
+}
