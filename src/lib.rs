@@ -1,4 +1,51 @@
-//! urto: collision detection and rigid-body dynamics for Bevy-style ECS games.
+//! # urto — collision detection and rigid-body dynamics for Bevy-style ECS games
+//!
+//! urto implements the lecture *Scene dinamiche e Collision detection* (F. Ganovelli): a fixed
+//! step with a choice of integrators, sweep-and-prune broad phase, bounding-volume hierarchies
+//! in the narrow phase, reflection/impulse response, and debug recordings for the rerun viewer.
+//!
+//! Two layers, data flowing one way:
+//! - the **algorithm core** — [`geometry`], [`bounding`], [`dynamics`], [`clock`] — plain Rust
+//!   and glam, no ECS: every algorithm is testable and benchmarkable alone;
+//! - the **ECS layer** — [`components`], [`schedule`], [`plugins`], [`debug`] — thin
+//!   `bevy_ecs` systems that gather components, call the core, and write back.
+//!
+//! ```
+//! use bevy_app::App;
+//! use urto::prelude::*;
+//!
+//! let mut app = App::new();
+//! app.add_plugins(UrtoPlugins::default()).insert_resource(Gravity::EARTH_Z_UP);
+//! app.world_mut().spawn((Collider::half_space(glam::Vec3::Z), Static));
+//! let ball = app
+//!     .world_mut()
+//!     .spawn((Collider::sphere(0.5), Position::new(0.0, 0.0, 2.0), Velocity::default()))
+//!     .id();
+//! urto::step(app.world_mut(), 120).unwrap();
+//! let z = app.world().get::<Position>(ball).unwrap().0.z;
+//! assert!(z > 0.4 && z < 2.0);
+//! ```
 
 pub mod bounding;
+pub mod clock;
+pub mod components;
+pub mod debug;
+pub mod dynamics;
 pub mod geometry;
+pub mod plugins;
+pub mod schedule;
+pub mod settings;
+pub mod stats;
+
+pub use plugins::{UrtoPlugins, step};
+pub use settings::{ContactSettings, Gravity, Integration, PhysicsTimestep, SettingsError};
+
+/// What a game needs in scope.
+pub mod prelude {
+    pub use crate::components::*;
+    pub use crate::dynamics::Integrator;
+    pub use crate::plugins::{CollisionEnded, CollisionStarted, UrtoPlugins};
+    pub use crate::schedule::{PhysicsSchedule, PhysicsSet, SubstepSchedule, SubstepSet};
+    pub use crate::settings::*;
+    pub use crate::stats::{PhysicsStats, Stage};
+}

@@ -126,7 +126,10 @@ impl Aabb {
     /// The box grown by `margin` on every side.
     #[must_use]
     pub fn expanded(&self, margin: f32) -> Aabb {
-        Aabb::new(self.min - Vec3::splat(margin), self.max + Vec3::splat(margin))
+        Aabb::new(
+            self.min - Vec3::splat(margin),
+            self.max + Vec3::splat(margin),
+        )
     }
 
     /// The box of this box's image under `pose` (Arvo 1990: project the rotated half extents).
@@ -155,7 +158,10 @@ mod tests {
     #[test]
     fn transformed_box_holds_every_transformed_corner() {
         let b = Aabb::new(Vec3::new(-1.0, -2.0, 0.5), Vec3::new(3.0, 1.0, 2.0));
-        let pose = Isometry::new(Vec3::new(5.0, -1.0, 2.0), Quat::from_euler(glam::EulerRot::XYZ, 0.3, -0.8, 1.9));
+        let pose = Isometry::new(
+            Vec3::new(5.0, -1.0, 2.0),
+            Quat::from_euler(glam::EulerRot::XYZ, 0.3, -0.8, 1.9),
+        );
         let t = b.transformed(&pose);
         for i in 0..8 {
             let corner = Vec3::new(
@@ -163,7 +169,10 @@ mod tests {
                 if i & 2 == 0 { b.min.y } else { b.max.y },
                 if i & 4 == 0 { b.min.z } else { b.max.z },
             );
-            assert!(t.expanded(1e-4).contains_point(pose.transform_point(corner)));
+            assert!(
+                t.expanded(1e-4)
+                    .contains_point(pose.transform_point(corner))
+            );
         }
     }
 

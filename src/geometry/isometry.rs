@@ -95,7 +95,10 @@ impl Mul for Isometry {
 
     /// Composition: `(a * b).transform_point(p) == a.transform_point(b.transform_point(p))`.
     fn mul(self, rhs: Isometry) -> Isometry {
-        Isometry::new(self.transform_point(rhs.translation), self.rotation * rhs.rotation)
+        Isometry::new(
+            self.transform_point(rhs.translation),
+            self.rotation * rhs.rotation,
+        )
     }
 }
 

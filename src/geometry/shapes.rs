@@ -113,7 +113,9 @@ impl Shape {
     /// The world-space AABB of the shape placed at `pose` (infinite for unbounded shapes).
     pub fn world_aabb(&self, pose: &Isometry) -> Aabb {
         match self {
-            Self::Sphere(s) => Aabb::from_center_half_extents(pose.translation, Vec3::splat(s.radius)),
+            Self::Sphere(s) => {
+                Aabb::from_center_half_extents(pose.translation, Vec3::splat(s.radius))
+            }
             Self::Cuboid(c) => {
                 Aabb::from_center_half_extents(Vec3::ZERO, c.half_extents).transformed(pose)
             }
@@ -142,6 +144,10 @@ mod tests {
         assert!(Shape::sphere(f32::NAN).validate().is_err());
         assert!(Shape::cuboid(Vec3::new(1.0, -0.1, 1.0)).validate().is_err());
         assert!(Shape::half_space(Vec3::ZERO).validate().is_err());
-        assert!(Shape::half_space(Vec3::new(0.0, 0.0, 3.0)).validate().is_ok());
+        assert!(
+            Shape::half_space(Vec3::new(0.0, 0.0, 3.0))
+                .validate()
+                .is_ok()
+        );
     }
 }

@@ -20,7 +20,11 @@ pub fn contact_sphere_sphere(
         return None;
     }
     let dist = dist2.sqrt();
-    let normal = if dist > 0.0 { d / dist } else { FALLBACK_NORMAL };
+    let normal = if dist > 0.0 {
+        d / dist
+    } else {
+        FALLBACK_NORMAL
+    };
     let on_a = ca + normal * a.radius;
     let on_b = cb - normal * b.radius;
     Some(ContactManifold::single(

@@ -1,0 +1,178 @@
+//! The state urto reads and writes, as ECS components (the slides' "Lo stato": position,
+//! velocity, then mass and force).
+//!
+//! Spawning a body is one line thanks to `#[require]`:
+//!
+//! ```
+//! # use bevy_ecs::prelude::*;
+//! # use urto::prelude::*;
+//! # let mut world = World::new();
+//! // A dynamic ball: Velocity, Mass (1 kg), Rotation and BoundingVolume come by default.
+//! world.spawn((Collider::sphere(0.5), Position::new(0.0, 0.0, 3.0), Velocity::default()));
+//! // Static scenery: never moves, collides as infinitely heavy.
+//! world.spawn((Collider::half_space(glam::Vec3::Z), Static));
+//! ```
+//!
+//! # Kinds of body
+//! - **dynamic**: has [`Velocity`] and a finite [`Mass`]; forces and contacts move it.
+//! - **kinematic**: has [`Velocity`] and [`Mass::INFINITE`]; it moves at its velocity, pushes
+//!   dynamic bodies and is never pushed back.
+//! - **static**: has the [`Static`] marker (or no [`Velocity`]); never moves, collides as
+//!   infinitely heavy. Unbounded shapes (half-spaces) are always static.
+//!
+//! Bodies whose numbers are unusable (NaN, zero or negative mass, a bad shape) are set aside with
+//! a [`Quarantined`] marker and a logged warning: they stop taking part, and nothing they hold can
+//! spread to their neighbours.
+
+use crate::bounding::Aabb;
+use crate::geometry::{Isometry, Shape};
+use bevy_ecs::prelude::*;
+use glam::{Quat, Vec3};
+
+/// Where a body is: the world position of its origin (centre of mass).
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct Position(pub Vec3);
+
+impl Position {
+    /// A position from coordinates.
+    pub const fn new(x: f32, y: f32, z: f32) -> Self {
+        Self(Vec3::new(x, y, z))
+    }
+}
+
+/// Orientation of a body's collider; identity when absent. Bodies do not spin by themselves
+/// (contacts act through the centre of mass); set it to place boxes and planes.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct Rotation(pub Quat);
+
+/// Linear velocity (m/s).
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+#[require(Position, Rotation, Mass)]
+pub struct Velocity(pub Vec3);
+
+impl Velocity {
+    /// A velocity from components.
+    pub const fn new(x: f32, y: f32, z: f32) -> Self {
+        Self(Vec3::new(x, y, z))
+    }
+}
+
+/// Mass in kg: finite and `> 0` for dynamic bodies, [`Mass::INFINITE`] for kinematic ones.
+/// Zero, negative or NaN mass quarantines the body.
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+pub struct Mass(pub f32);
+
+impl Default for Mass {
+    fn default() -> Self {
+        Self(1.0)
+    }
+}
+
+impl Mass {
+    /// A body no force or impulse can move.
+    pub const INFINITE: Self = Self(f32::INFINITY);
+
+    /// `1/m`, 0 for infinite mass.
+    pub fn inverse(self) -> f32 {
+        if self.0.is_infinite() {
+            0.0
+        } else {
+            1.0 / self.0
+        }
+    }
+
+    /// True for finite positive masses and for infinity.
+    pub fn is_valid(self) -> bool {
+        self.0 > 0.0 && !self.0.is_nan()
+    }
+}
+
+/// Force (N) applied during the next physics step, then cleared: game code adds to it, the step
+/// consumes it. Bodies without it cost the force stage nothing.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct Force(pub Vec3);
+
+/// Linear drag coefficient `b` (N·s/m): the force `-b v`.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct LinearDrag(pub f32);
+
+/// What the far end of a [`Spring`] holds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SpringTarget {
+    /// Another body.
+    Entity(Entity),
+    /// A fixed point in the world.
+    Point(Vec3),
+}
+
+/// A damped spring from this body to a target.
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+pub struct Spring {
+    /// The far end.
+    pub target: SpringTarget,
+    /// Length at which it exerts no force (m).
+    pub rest_length: f32,
+    /// Stiffness (N/m).
+    pub stiffness: f32,
+    /// Damping along the spring's axis (N·s/m).
+    pub damping: f32,
+}
+
+/// How much of the approach speed a contact gives back (0 = dead stop, 1 = perfect bounce).
+/// The pair uses the average of its two bodies' values; absent means
+/// [`ContactSettings::default_restitution`](crate::ContactSettings).
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+pub struct Restitution(pub f32);
+
+/// The shape a body collides with, in the body's frame.
+#[derive(Component, Clone, Debug, PartialEq)]
+#[require(Position, Rotation, BoundingVolume)]
+pub struct Collider {
+    /// The shape.
+    pub shape: Shape,
+}
+
+impl Collider {
+    /// A ball of `radius`.
+    pub fn sphere(radius: f32) -> Self {
+        Self {
+            shape: Shape::sphere(radius),
+        }
+    }
+
+    /// A box of the given half extents.
+    pub fn cuboid(hx: f32, hy: f32, hz: f32) -> Self {
+        Self {
+            shape: Shape::cuboid(Vec3::new(hx, hy, hz)),
+        }
+    }
+
+    /// The solid below a plane through the body's position with outward `normal` (a ground).
+    pub fn half_space(normal: Vec3) -> Self {
+        Self {
+            shape: Shape::half_space(normal),
+        }
+    }
+}
+
+/// The world-space AABB the broad phase reads, kept up to date by the physics step.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct BoundingVolume(pub Aabb);
+
+/// Marks scenery that never moves.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[require(Position, Rotation)]
+pub struct Static;
+
+/// Set aside: this entity's physical state was unusable, so physics ignores it until the marker
+/// is removed (after fixing the state).
+#[derive(Component, Clone, Debug, PartialEq, Eq)]
+pub struct Quarantined {
+    /// Why, in words.
+    pub reason: String,
+}
+
+/// The pose of a body as an [`Isometry`].
+pub fn pose(position: &Position, rotation: Option<&Rotation>) -> Isometry {
+    Isometry::new(position.0, rotation.map_or(Quat::IDENTITY, |r| r.0))
+}

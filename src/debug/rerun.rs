@@ -1,0 +1,443 @@
+//! Debug recording to rerun: the physics state of every (k-th) step, for viewing offline.
+//!
+//! The plugin is a consumer at the end of the step ([`PhysicsSet::Debug`]): it reads physics state
+//! and writes nothing back, so a slow recording can only slow the program, never change a result.
+//! It logs, on a `step` sequence timeline and a `sim_time` timeline:
+//!
+//! | entity path | what | archetype |
+//! |---|---|---|
+//! | `world/bodies/spheres`, `world/bodies/boxes` | moving bodies (orange dynamic, blue kinematic, red quarantined) | `Ellipsoids3D`, `Boxes3D` |
+//! | `world/static/...` | static scenery (grey), re-logged only when it changes | `Ellipsoids3D`, `Boxes3D` |
+//! | `world/bounding_volumes` | the world AABBs the broad phase reads (green wireframe) | `Boxes3D` |
+//! | `world/velocities` | velocity arrows (yellow) | `Arrows3D` |
+//! | `world/contacts` | contact points with their normals scaled by depth (magenta) | `Arrows3D` |
+//! | `broad_phase/pairs` | candidate pairs as segments between centres | `LineStrips3D` |
+//! | `timing/<stage>` | wall time of each stage in the step, ms | `Scalars` |
+//! | `counters/<name>` | the step's counters (pairs, contacts, refits, …) | `Scalars` |
+//! | `log` | quarantine warnings | `TextLog` |
+//!
+//! Conversion to rerun's types happens here and only here: the rest of urto never sees rerun.
+
+use crate::components::*;
+use crate::geometry::Shape;
+use crate::plugins::{BroadPhasePairs, Contacts};
+use crate::schedule::{PhysicsSchedule, PhysicsSet};
+use crate::stats::{PhysicsStats, Stage};
+use bevy_app::prelude::*;
+use bevy_ecs::prelude::*;
+use glam::{Quat, Vec3};
+use rerun::RecordingStream;
+use std::fmt;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Where the recording goes.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RecordingSink {
+    /// An `.rrd` file, created (truncated) when the plugin is made.
+    File(PathBuf),
+    /// A running viewer, by its gRPC proxy URL (`rerun+http://127.0.0.1:9876/proxy`).
+    Connect(String),
+}
+
+/// Which world axis is up in the viewer.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum UpAxis {
+    /// The slides' convention (gravity along -z).
+    #[default]
+    Z,
+    /// Bevy's convention (gravity along -y).
+    Y,
+}
+
+/// How and what to record.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RerunConfig {
+    /// The recording's application id, shown in the viewer.
+    pub app_id: String,
+    /// Where to send it.
+    pub sink: RecordingSink,
+    /// Log every k-th step only (1 = every step): long runs stay small.
+    pub every_k_steps: u64,
+    /// Which axis is up.
+    pub up: UpAxis,
+    /// Log bounding volumes (wireframes).
+    pub bounding_volumes: bool,
+    /// Log velocity arrows.
+    pub velocities: bool,
+    /// Log contacts and broad-phase pairs.
+    pub contacts: bool,
+    /// Half size of the square drawn for each half-space (they are infinite).
+    pub plane_half_size: f32,
+}
+
+impl RerunConfig {
+    /// Everything recorded to a file, every step.
+    pub fn file(path: impl Into<PathBuf>) -> Self {
+        Self {
+            app_id: "urto".into(),
+            sink: RecordingSink::File(path.into()),
+            every_k_steps: 1,
+            up: UpAxis::Z,
+            bounding_volumes: true,
+            velocities: true,
+            contacts: true,
+            plane_half_size: 10.0,
+        }
+    }
+}
+
+/// Why the recording could not start.
+#[derive(Debug)]
+pub enum RerunError {
+    /// The sink could not be opened (unwritable path, bad URL, …).
+    Sink(String),
+    /// A setting is out of range.
+    Config(String),
+}
+
+impl fmt::Display for RerunError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Sink(e) => write!(f, "cannot open the rerun recording: {e}"),
+            Self::Config(e) => write!(f, "bad rerun recording settings: {e}"),
+        }
+    }
+}
+
+impl std::error::Error for RerunError {}
+
+/// Records the simulation to rerun. Made with [`RerunDebugPlugin::new`], which opens the sink
+/// and fails there (not later) on an unwritable path.
+#[derive(Clone)]
+pub struct RerunDebugPlugin {
+    recording: RecordingStream,
+    config: RerunConfig,
+}
+
+impl fmt::Debug for RerunDebugPlugin {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("RerunDebugPlugin")
+            .field("config", &self.config)
+            .finish()
+    }
+}
+
+impl RerunDebugPlugin {
+    /// Opens the sink the config names.
+    pub fn new(config: RerunConfig) -> Result<Self, RerunError> {
+        if config.every_k_steps == 0 {
+            return Err(RerunError::Config("every_k_steps must be >= 1".into()));
+        }
+        let builder = rerun::RecordingStreamBuilder::new(config.app_id.as_str());
+        let recording = match &config.sink {
+            RecordingSink::File(path) => builder.save(path),
+            RecordingSink::Connect(url) => builder.connect_grpc_opts(url.as_str()),
+        }
+        .map_err(|e| RerunError::Sink(e.to_string()))?;
+        Ok(Self::from_stream(recording, config))
+    }
+
+    /// Everything recorded to an `.rrd` file.
+    pub fn to_file(path: impl Into<PathBuf>) -> Result<Self, RerunError> {
+        Self::new(RerunConfig::file(path))
+    }
+
+    /// Records into a stream made by the caller (e.g. rerun's in-memory sink in tests); the
+    /// config's sink is ignored.
+    pub fn from_stream(recording: RecordingStream, config: RerunConfig) -> Self {
+        Self { recording, config }
+    }
+}
+
+/// The open recording, as a resource (game code may log its own entities to it).
+#[derive(Resource, Clone)]
+pub struct RerunRecording {
+    /// The stream.
+    pub stream: RecordingStream,
+    /// The settings it was opened with.
+    pub config: RerunConfig,
+}
+
+impl Plugin for RerunDebugPlugin {
+    fn build(&self, app: &mut App) {
+        let rec = &self.recording;
+        // Wall-clock timestamps would make two recordings of the same run differ.
+        rec.set_log_time_enabled(false);
+        let coordinates = match self.config.up {
+            UpAxis::Z => rerun::ViewCoordinates::RIGHT_HAND_Z_UP(),
+            UpAxis::Y => rerun::ViewCoordinates::RIGHT_HAND_Y_UP(),
+        };
+        report(rec.log_static("world", &coordinates));
+        app.init_resource::<DebugClock>()
+            .insert_resource(RerunRecording {
+                stream: self.recording.clone(),
+                config: self.config.clone(),
+            })
+            .add_systems(
+                PhysicsSchedule,
+                (
+                    start_debug_clock,
+                    record_statics,
+                    record_bodies,
+                    record_pairs,
+                    record_stats,
+                )
+                    .chain()
+                    .run_if(is_recorded_step)
+                    .in_set(PhysicsSet::Debug),
+            );
+    }
+
+    fn cleanup(&self, _app: &mut App) {
+        report(self.recording.flush_blocking());
+    }
+}
+
+impl Drop for RerunRecording {
+    fn drop(&mut self) {
+        report(self.stream.flush_blocking());
+    }
+}
+
+const DYNAMIC: [u8; 3] = [230, 126, 34];
+const KINEMATIC: [u8; 3] = [52, 152, 219];
+const STATIC: [u8; 3] = [149, 165, 166];
+const QUARANTINED: [u8; 3] = [231, 76, 60];
+const BV: [u8; 3] = [46, 204, 113];
+const VELOCITY: [u8; 3] = [241, 196, 15];
+const CONTACT: [u8; 3] = [217, 70, 239];
+const PAIR: [u8; 3] = [120, 120, 120];
+
+fn report<E: fmt::Display>(r: Result<(), E>) {
+    if let Err(e) = r {
+        log::warn!("urto: rerun logging failed: {e}");
+    }
+}
+
+fn is_recorded_step(rec: Res<RerunRecording>, stats: Res<PhysicsStats>) -> bool {
+    stats.step % rec.config.every_k_steps == 0
+}
+
+fn set_time(rec: &RecordingStream, stats: &PhysicsStats) {
+    rec.set_time_sequence("step", stats.step as i64);
+    rec.set_duration_secs("sim_time", stats.sim_time);
+}
+
+fn arr(v: Vec3) -> [f32; 3] {
+    v.to_array()
+}
+
+fn quat(q: Quat) -> rerun::Quaternion {
+    rerun::Quaternion::from_xyzw(q.to_array())
+}
+
+/// Spheres and boxes of one group of bodies, ready to log.
+#[derive(Default)]
+struct ShapeBatch {
+    sphere_centers: Vec<[f32; 3]>,
+    sphere_radii: Vec<f32>,
+    sphere_colors: Vec<rerun::Color>,
+    box_centers: Vec<[f32; 3]>,
+    box_half_sizes: Vec<[f32; 3]>,
+    box_rotations: Vec<rerun::Quaternion>,
+    box_colors: Vec<rerun::Color>,
+}
+
+impl ShapeBatch {
+    fn push(&mut self, shape: &Shape, p: Vec3, r: Quat, color: [u8; 3], plane_half_size: f32) {
+        let color = rerun::Color::from_rgb(color[0], color[1], color[2]);
+        match shape {
+            Shape::Sphere(s) => {
+                self.sphere_centers.push(arr(p));
+                self.sphere_radii.push(s.radius);
+                self.sphere_colors.push(color);
+            }
+            Shape::Cuboid(c) => self.push_box(p, c.half_extents, r, color),
+            Shape::HalfSpace(h) => {
+                // A thin square slab just below the plane, facing along the normal.
+                let normal = r * h.normal;
+                let facing = Quat::from_rotation_arc(Vec3::Z, normal);
+                let half = Vec3::new(plane_half_size, plane_half_size, 0.005);
+                self.push_box(p - normal * 0.005, half, facing, color);
+            }
+        }
+    }
+
+    fn push_box(&mut self, p: Vec3, half: Vec3, r: Quat, color: rerun::Color) {
+        self.box_centers.push(arr(p));
+        self.box_half_sizes.push(arr(half));
+        self.box_rotations.push(quat(r));
+        self.box_colors.push(color);
+    }
+
+    fn log(self, rec: &RecordingStream, path: &str) {
+        let spheres =
+            rerun::Ellipsoids3D::from_centers_and_radii(self.sphere_centers, self.sphere_radii)
+                .with_colors(self.sphere_colors)
+                .with_fill_mode(rerun::FillMode::Solid);
+        report(rec.log(format!("{path}/spheres"), &spheres));
+        let boxes =
+            rerun::Boxes3D::from_centers_and_half_sizes(self.box_centers, self.box_half_sizes)
+                .with_quaternions(self.box_rotations)
+                .with_colors(self.box_colors)
+                .with_fill_mode(rerun::FillMode::Solid);
+        report(rec.log(format!("{path}/boxes"), &boxes));
+    }
+}
+
+type StaticChanged = (
+    With<Static>,
+    Or<(
+        Added<Collider>,
+        Changed<Position>,
+        Changed<Rotation>,
+        Changed<Collider>,
+    )>,
+);
+
+/// Static scenery, re-logged only on the steps where some of it was added, moved or removed.
+fn record_statics(
+    rec: Res<RerunRecording>,
+    stats: Res<PhysicsStats>,
+    changed: Query<(), StaticChanged>,
+    removed: RemovedComponents<Static>,
+    statics: Query<(&Collider, &Position, &Rotation), With<Static>>,
+) {
+    if changed.is_empty() && removed.is_empty() {
+        return;
+    }
+    set_time(&rec.stream, &stats);
+    let mut batch = ShapeBatch::default();
+    for (c, p, r) in &statics {
+        batch.push(&c.shape, p.0, r.0, STATIC, rec.config.plane_half_size);
+    }
+    batch.log(&rec.stream, "world/static");
+}
+
+type BodyView<'a> = (
+    &'a Collider,
+    &'a Position,
+    &'a Rotation,
+    &'a BoundingVolume,
+    Option<&'a Velocity>,
+    Option<&'a Mass>,
+    Option<&'a Quarantined>,
+);
+
+/// Moving bodies, their bounding volumes and velocities.
+fn record_bodies(
+    rec: Res<RerunRecording>,
+    stats: Res<PhysicsStats>,
+    bodies: Query<BodyView, Without<Static>>,
+    mut log_lines: Query<(Entity, &Quarantined), Added<Quarantined>>,
+) {
+    let stream = &rec.stream;
+    set_time(stream, &stats);
+    let mut batch = ShapeBatch::default();
+    let (mut bv_centers, mut bv_half) = (Vec::new(), Vec::new());
+    let (mut origins, mut vectors) = (Vec::new(), Vec::new());
+    for (c, p, r, bv, v, m, q) in &bodies {
+        let color = match (q, m) {
+            (Some(_), _) => QUARANTINED,
+            (None, Some(m)) if m.inverse() == 0.0 => KINEMATIC,
+            _ => DYNAMIC,
+        };
+        batch.push(&c.shape, p.0, r.0, color, rec.config.plane_half_size);
+        if bv.0.is_finite() {
+            bv_centers.push(arr(bv.0.center()));
+            bv_half.push(arr(bv.0.half_extents()));
+        }
+        if let Some(v) = v.filter(|v| v.0 != Vec3::ZERO) {
+            origins.push(arr(p.0));
+            vectors.push(arr(v.0 * 0.1));
+        }
+    }
+    batch.log(stream, "world/bodies");
+    if rec.config.bounding_volumes {
+        let boxes = rerun::Boxes3D::from_centers_and_half_sizes(bv_centers, bv_half)
+            .with_colors([rerun::Color::from_rgb(BV[0], BV[1], BV[2])]);
+        report(stream.log("world/bounding_volumes", &boxes));
+    }
+    if rec.config.velocities {
+        let arrows = rerun::Arrows3D::from_vectors(vectors)
+            .with_origins(origins)
+            .with_colors([rerun::Color::from_rgb(
+                VELOCITY[0],
+                VELOCITY[1],
+                VELOCITY[2],
+            )]);
+        report(stream.log("world/velocities", &arrows));
+    }
+    for (e, q) in log_lines.iter_mut() {
+        let line = rerun::TextLog::new(format!("quarantined {e}: {}", q.reason))
+            .with_level(rerun::TextLogLevel::WARN);
+        report(stream.log("log", &line));
+    }
+}
+
+/// Contacts (arrows along the normal, scaled by depth) and broad-phase pairs (segments).
+fn record_pairs(
+    rec: Res<RerunRecording>,
+    contacts: Option<Res<Contacts>>,
+    pairs: Option<Res<BroadPhasePairs>>,
+    positions: Query<&Position>,
+) {
+    if !rec.config.contacts {
+        return;
+    }
+    let stream = &rec.stream;
+    if let Some(contacts) = contacts {
+        let (mut origins, mut vectors) = (Vec::new(), Vec::new());
+        for c in &contacts.pairs {
+            for p in c.manifold.points() {
+                origins.push(arr(p.point));
+                vectors.push(arr(c.manifold.normal * (0.1 + p.depth)));
+            }
+        }
+        let arrows = rerun::Arrows3D::from_vectors(vectors)
+            .with_origins(origins)
+            .with_colors([rerun::Color::from_rgb(CONTACT[0], CONTACT[1], CONTACT[2])]);
+        report(stream.log("world/contacts", &arrows));
+    }
+    if let Some(pairs) = pairs {
+        let strips: Vec<[[f32; 3]; 2]> = pairs
+            .pairs
+            .iter()
+            .filter_map(|&(a, b)| {
+                Some([arr(positions.get(a).ok()?.0), arr(positions.get(b).ok()?.0)])
+            })
+            .collect();
+        let lines = rerun::LineStrips3D::new(strips)
+            .with_colors([rerun::Color::from_rgb(PAIR[0], PAIR[1], PAIR[2])]);
+        report(stream.log("broad_phase/pairs", &lines));
+    }
+}
+
+/// When this step's recording began: the Debug stage times itself without writing to the
+/// physics statistics (it stays a pure consumer).
+#[derive(Resource, Default)]
+struct DebugClock(Option<Instant>);
+
+fn start_debug_clock(mut clock: ResMut<DebugClock>) {
+    clock.0 = Some(Instant::now());
+}
+
+/// Per-stage wall time (ms) and the step's counters as time series.
+fn record_stats(rec: Res<RerunRecording>, stats: Res<PhysicsStats>, clock: Res<DebugClock>) {
+    let stream = &rec.stream;
+    for stage in Stage::ALL {
+        let t = match (stage, clock.0) {
+            (Stage::Debug, Some(start)) => start.elapsed(),
+            _ => stats.stage_time(stage),
+        };
+        let ms = t.as_secs_f64() * 1e3;
+        report(stream.log(
+            format!("timing/{}", stage.name()),
+            &rerun::Scalars::single(ms),
+        ));
+    }
+    for (name, value) in stats.counters() {
+        report(stream.log(format!("counters/{name}"), &rerun::Scalars::single(*value)));
+    }
+}

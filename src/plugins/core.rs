@@ -1,0 +1,150 @@
+//! The core plugin: schedules, settings, statistics, and the two ways a step is driven —
+//! Bevy's fixed-timestep loop in an `App`, or [`step`] on a standalone world.
+
+use crate::schedule::{PhysicsSchedule, PhysicsSet, SubstepSchedule, SubstepSet};
+use crate::settings::{ContactSettings, Integration, PhysicsTimestep};
+use crate::stats::PhysicsStats;
+use bevy_app::prelude::*;
+use bevy_ecs::prelude::*;
+use bevy_ecs::schedule::SingleThreadedExecutor;
+use bevy_time::{Fixed, Time, Virtual};
+use std::fmt;
+use std::time::Duration;
+
+/// Builds the schedules and inserts the settings every other stage reads.
+#[derive(Debug, Clone, Default)]
+pub struct PhysicsCorePlugin {
+    /// The fixed step; `None` keeps a [`PhysicsTimestep`] already in the world, else the default.
+    pub timestep: Option<PhysicsTimestep>,
+}
+
+impl Plugin for PhysicsCorePlugin {
+    fn build(&self, app: &mut App) {
+        match self.timestep {
+            Some(ts) => {
+                app.insert_resource(ts);
+            }
+            None => {
+                app.init_resource::<PhysicsTimestep>();
+            }
+        }
+        app.init_resource::<Integration>()
+            .init_resource::<ContactSettings>()
+            .init_resource::<PhysicsStats>();
+
+        // Single-threaded executors: the step is a strict chain, and one thread keeps runs
+        // bit-for-bit reproducible whatever the machine's thread count.
+        let mut physics = Schedule::new(PhysicsSchedule);
+        physics.set_executor(SingleThreadedExecutor::new());
+        physics.configure_sets(
+            (
+                PhysicsSet::Prepare,
+                PhysicsSet::Forces,
+                PhysicsSet::Substeps,
+                PhysicsSet::Debug,
+            )
+                .chain(),
+        );
+        physics.add_systems((
+            begin_step.in_set(PhysicsSet::Prepare).before(PrepareStart),
+            run_substeps.in_set(PhysicsSet::Substeps),
+        ));
+        physics.configure_sets(PrepareStart.in_set(PhysicsSet::Prepare));
+        app.add_schedule(physics);
+
+        let mut substep = Schedule::new(SubstepSchedule);
+        substep.set_executor(SingleThreadedExecutor::new());
+        substep.configure_sets(
+            (
+                SubstepSet::Integrate,
+                SubstepSet::BroadPhase,
+                SubstepSet::NarrowPhase,
+                SubstepSet::Response,
+            )
+                .chain(),
+        );
+        app.add_schedule(substep);
+
+        app.add_systems(FixedPostUpdate, run_physics_in_fixed_update);
+    }
+
+    fn finish(&self, app: &mut App) {
+        // In an App, Bevy's fixed clock is the accumulator: give it our dt and cap the catch-up.
+        let ts = *app.world().resource::<PhysicsTimestep>();
+        if let Some(mut fixed) = app.world_mut().get_resource_mut::<Time<Fixed>>() {
+            fixed.set_timestep(Duration::from_secs_f32(ts.dt()));
+        }
+        if let Some(mut virt) = app.world_mut().get_resource_mut::<Time<Virtual>>() {
+            virt.set_max_delta(Duration::from_secs_f32(ts.dt()) * ts.max_steps_per_frame());
+        }
+    }
+}
+
+/// Anchor for Prepare's systems: they run after the step's bookkeeping.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct PrepareStart;
+
+fn begin_step(mut stats: ResMut<PhysicsStats>) {
+    stats.begin_step();
+}
+
+/// Runs the substep schedule `substeps` times and advances the step counters.
+fn run_substeps(world: &mut World) {
+    let ts = *world.resource::<PhysicsTimestep>();
+    let _ = world.try_schedule_scope(SubstepSchedule, |world, schedule| {
+        for _ in 0..ts.substeps() {
+            schedule.run(world);
+            world.resource_mut::<PhysicsStats>().sim_time += ts.substep_dt() as f64;
+        }
+    });
+    world.resource_mut::<PhysicsStats>().step += 1;
+}
+
+/// In an `App`: one physics step per fixed tick, with dt taken from Bevy's fixed clock.
+fn run_physics_in_fixed_update(world: &mut World) {
+    let fixed_dt = world.resource::<Time>().delta_secs();
+    let mut ts = world.resource_mut::<PhysicsTimestep>();
+    if (ts.dt() - fixed_dt).abs() > f32::EPSILON * ts.dt()
+        && let Err(e) = ts.set_dt(fixed_dt)
+    {
+        log::warn!("urto: skipping a physics step: {e}");
+        return;
+    }
+    world.run_schedule(PhysicsSchedule);
+}
+
+/// Why [`step`] could not run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StepError {
+    /// The world has no physics schedule: add [`UrtoPlugins`](crate::UrtoPlugins) to the app
+    /// whose world is stepped.
+    NoPhysicsSchedule,
+}
+
+impl fmt::Display for StepError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("the world has no PhysicsSchedule: add UrtoPlugins to its App first")
+    }
+}
+
+impl std::error::Error for StepError {}
+
+/// Steps a world `n` times, outside any `App` loop (tests, examples, servers, offline runs).
+///
+/// ```
+/// # use bevy_app::App;
+/// # use urto::prelude::*;
+/// let mut app = App::new();
+/// app.add_plugins(UrtoPlugins::default());
+/// app.world_mut().spawn((Collider::sphere(0.5), Position::new(0.0, 0.0, 2.0), Velocity::default()));
+/// urto::step(app.world_mut(), 60).unwrap();
+/// ```
+pub fn step(world: &mut World, n: u32) -> Result<(), StepError> {
+    for _ in 0..n {
+        world
+            .try_run_schedule(PhysicsSchedule)
+            .map_err(|_| StepError::NoPhysicsSchedule)?;
+        crate::plugins::response::update_collision_messages(world);
+    }
+    Ok(())
+}

@@ -1,0 +1,113 @@
+//! The Forces stage: gathers the step's forces, one system per kind of force, each running only
+//! when the world has that kind (no `Gravity` resource: no gravity system; no `Force`
+//! component anywhere: no force system). What they gather is evaluated by the integrator at every
+//! intermediate state it needs.
+
+use crate::components::*;
+use crate::schedule::{PhysicsSchedule, PhysicsSet};
+use crate::settings::Gravity;
+use crate::stats::{PhysicsStats, Stage};
+use bevy_app::prelude::*;
+use bevy_ecs::prelude::*;
+use glam::Vec3;
+
+/// Gathers gravity, user forces, drag and springs.
+#[derive(Debug, Clone, Default)]
+pub struct ForcesPlugin;
+
+/// The forces gathered for the current step, keyed by entity (the integrator maps them to its
+/// body arrays).
+#[derive(Resource, Debug, Default, Clone)]
+pub struct GatheredForces {
+    /// Gravity, when the world has it.
+    pub gravity: Option<Vec3>,
+    /// User forces consumed from [`Force`] components this step.
+    pub forces: Vec<(Entity, Vec3)>,
+    /// Drag coefficients.
+    pub drag: Vec<(Entity, f32)>,
+    /// Springs, by the entity that carries them.
+    pub springs: Vec<(Entity, Spring)>,
+}
+
+impl GatheredForces {
+    /// True when nothing but (possibly) gravity acts.
+    pub fn only_gravity(&self) -> bool {
+        self.forces.is_empty() && self.drag.is_empty() && self.springs.is_empty()
+    }
+}
+
+impl Plugin for ForcesPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<GatheredForces>().add_systems(
+            PhysicsSchedule,
+            (
+                clear_gathered_forces,
+                gather_gravity.run_if(resource_exists::<Gravity>),
+                gather_user_forces.run_if(any_with_component::<Force>),
+                gather_drag.run_if(any_with_component::<LinearDrag>),
+                gather_springs.run_if(any_with_component::<Spring>),
+            )
+                .chain()
+                .in_set(PhysicsSet::Forces),
+        );
+    }
+}
+
+fn clear_gathered_forces(mut gathered: ResMut<GatheredForces>) {
+    let g = &mut *gathered;
+    g.gravity = None;
+    g.forces.clear();
+    g.drag.clear();
+    g.springs.clear();
+}
+
+fn gather_gravity(
+    gravity: Res<Gravity>,
+    mut gathered: ResMut<GatheredForces>,
+    mut stats: ResMut<PhysicsStats>,
+) {
+    stats.time(Stage::Forces, "forces/gravity", || {
+        gathered.gravity = Some(gravity.acceleration());
+    });
+}
+
+/// Consumes every [`Force`]: it acts for this step, then reads zero until game code adds more.
+fn gather_user_forces(
+    mut bodies: Query<(Entity, &mut Force), Without<Quarantined>>,
+    mut gathered: ResMut<GatheredForces>,
+    mut stats: ResMut<PhysicsStats>,
+) {
+    stats.time(Stage::Forces, "forces/user", || {
+        for (entity, mut force) in &mut bodies {
+            if force.0 != Vec3::ZERO {
+                gathered.forces.push((entity, force.0));
+                force.0 = Vec3::ZERO;
+            }
+        }
+    });
+}
+
+fn gather_drag(
+    bodies: Query<(Entity, &LinearDrag), Without<Quarantined>>,
+    mut gathered: ResMut<GatheredForces>,
+    mut stats: ResMut<PhysicsStats>,
+) {
+    stats.time(Stage::Forces, "forces/drag", || {
+        gathered.drag.extend(
+            bodies
+                .iter()
+                .filter(|(_, d)| d.0 != 0.0)
+                .map(|(e, d)| (e, d.0)),
+        );
+    });
+}
+
+fn gather_springs(
+    bodies: Query<(Entity, &Spring), Without<Quarantined>>,
+    mut gathered: ResMut<GatheredForces>,
+    mut stats: ResMut<PhysicsStats>,
+) {
+    stats.time(Stage::Forces, "forces/springs", || {
+        gathered.springs.extend(bodies.iter().map(|(e, s)| (e, *s)));
+    });
+}

@@ -1,0 +1,66 @@
+//! The ECS layer: one plugin per stage of the step, gathered in [`UrtoPlugins`].
+//!
+//! Each plugin is a thin adapter: its systems gather components into plain arrays, call the
+//! algorithm core, and write the results back. Any stage can be disabled or replaced:
+//!
+//! ```
+//! # use bevy_app::{App, PluginGroup};
+//! # use urto::prelude::*;
+//! # use urto::plugins::ResponsePlugin;
+//! let mut app = App::new();
+//! // Detect contacts, but let game code respond to them.
+//! app.add_plugins(UrtoPlugins::default().build().disable::<ResponsePlugin>());
+//! ```
+
+pub mod broad_phase;
+pub mod core;
+pub mod forces;
+pub mod integration;
+pub mod narrow_phase;
+pub mod response;
+pub mod validation;
+
+pub use broad_phase::{BroadPhasePairs, BroadPhasePlugin};
+pub use core::{PhysicsCorePlugin, StepError, step};
+pub use forces::{ForcesPlugin, GatheredForces};
+pub use integration::IntegrationPlugin;
+pub use narrow_phase::{ContactPair, Contacts, NarrowPhasePlugin};
+pub use response::{CollisionEnded, CollisionStarted, ResponsePlugin};
+pub use validation::ValidationPlugin;
+
+use crate::settings::PhysicsTimestep;
+use bevy_app::{PluginGroup, PluginGroupBuilder};
+
+/// Every stage of urto in schedule order; `app.add_plugins(UrtoPlugins::default())`.
+///
+/// The rerun recording is not in the group because it needs a destination that can fail to
+/// open: add [`RerunDebugPlugin`](crate::debug::RerunDebugPlugin) separately.
+#[derive(Debug, Clone, Default)]
+pub struct UrtoPlugins {
+    /// The fixed step (default 60 Hz, one substep).
+    pub timestep: Option<PhysicsTimestep>,
+}
+
+impl UrtoPlugins {
+    /// The group with a given fixed step.
+    pub fn with_timestep(timestep: PhysicsTimestep) -> Self {
+        Self {
+            timestep: Some(timestep),
+        }
+    }
+}
+
+impl PluginGroup for UrtoPlugins {
+    fn build(self) -> PluginGroupBuilder {
+        PluginGroupBuilder::start::<Self>()
+            .add(PhysicsCorePlugin {
+                timestep: self.timestep,
+            })
+            .add(ValidationPlugin)
+            .add(ForcesPlugin)
+            .add(IntegrationPlugin)
+            .add(BroadPhasePlugin)
+            .add(NarrowPhasePlugin)
+            .add(ResponsePlugin)
+    }
+}

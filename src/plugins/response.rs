@@ -1,0 +1,191 @@
+//! The Response stage: impulses and position correction for the contacts, and the collision
+//! started / ended messages game code listens to.
+
+use crate::components::*;
+use crate::dynamics::response::{ContactConstraint, correct_positions, solve_velocities};
+use crate::plugins::narrow_phase::Contacts;
+use crate::schedule::{SubstepSchedule, SubstepSet};
+use crate::settings::ContactSettings;
+use crate::stats::{PhysicsStats, Stage};
+use bevy_app::prelude::*;
+use bevy_ecs::entity::EntityHashMap;
+use bevy_ecs::message::Messages;
+use bevy_ecs::prelude::*;
+use glam::Vec3;
+use std::time::Instant;
+
+/// Resolves contacts and reports collisions.
+#[derive(Debug, Clone, Default)]
+pub struct ResponsePlugin;
+
+/// Two bodies started touching this step (`a < b`).
+#[derive(Message, Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CollisionStarted {
+    /// One body.
+    pub a: Entity,
+    /// The other.
+    pub b: Entity,
+}
+
+/// Two bodies stopped touching this step (`a < b`).
+#[derive(Message, Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CollisionEnded {
+    /// One body.
+    pub a: Entity,
+    /// The other.
+    pub b: Entity,
+}
+
+impl Plugin for ResponsePlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<ResponseBuffers>()
+            .init_resource::<TouchingPairs>()
+            .add_message::<CollisionStarted>()
+            .add_message::<CollisionEnded>()
+            .add_systems(
+                SubstepSchedule,
+                (resolve_contacts, report_collisions)
+                    .chain()
+                    .run_if(any_with_component::<Collider>)
+                    .in_set(SubstepSet::Response),
+            );
+    }
+}
+
+/// Solver arrays reused from step to step. Index 0 is the shared immovable body (all statics).
+#[derive(Resource, Default)]
+struct ResponseBuffers {
+    index: EntityHashMap<usize>,
+    entities: Vec<Entity>,
+    positions: Vec<Vec3>,
+    velocities: Vec<Vec3>,
+    inverse_mass: Vec<f32>,
+    constraints: Vec<ContactConstraint>,
+    displacement: Vec<Vec3>,
+}
+
+type Movable<'a> = (&'a mut Position, &'a mut Velocity, &'a Mass);
+type MovableFilter = (Without<Static>, Without<Quarantined>);
+
+fn resolve_contacts(
+    contacts: Res<Contacts>,
+    mut bodies: Query<Movable, MovableFilter>,
+    restitution: Query<&Restitution>,
+    settings: Res<ContactSettings>,
+    mut buffers: ResMut<ResponseBuffers>,
+    mut stats: ResMut<PhysicsStats>,
+) {
+    if contacts.pairs.is_empty() {
+        return;
+    }
+    let start = Instant::now();
+    let b = &mut *buffers;
+    b.clear();
+    let e_of = |e: Entity| {
+        restitution
+            .get(e)
+            .map_or(settings.default_restitution, |r| r.0)
+    };
+    for c in &contacts.pairs {
+        let ia = b.slot(c.a, &bodies);
+        let ib = b.slot(c.b, &bodies);
+        let e = 0.5 * (e_of(c.a) + e_of(c.b));
+        let m = &c.manifold;
+        b.constraints
+            .push(ContactConstraint::new(ia, ib, m.normal, m.max_depth(), e));
+    }
+    solve_velocities(
+        &mut b.constraints,
+        &mut b.velocities,
+        &b.inverse_mass,
+        &settings.solver,
+    );
+    correct_positions(
+        &b.constraints,
+        &mut b.positions,
+        &b.inverse_mass,
+        &settings.solver,
+        &mut b.displacement,
+    );
+    for i in 1..b.entities.len() {
+        if b.inverse_mass[i] > 0.0
+            && let Ok((mut p, mut v, _)) = bodies.get_mut(b.entities[i])
+        {
+            p.set_if_neq(Position(b.positions[i]));
+            v.set_if_neq(Velocity(b.velocities[i]));
+        }
+    }
+    stats.add_time(Stage::Response, start.elapsed());
+    stats.count_run("response");
+}
+
+impl ResponseBuffers {
+    fn clear(&mut self) {
+        self.index.clear();
+        self.constraints.clear();
+        self.entities.clear();
+        self.positions.clear();
+        self.velocities.clear();
+        self.inverse_mass.clear();
+        // Slot 0: every static body (immovable, at rest).
+        self.entities.push(Entity::PLACEHOLDER);
+        self.positions.push(Vec3::ZERO);
+        self.velocities.push(Vec3::ZERO);
+        self.inverse_mass.push(0.0);
+    }
+
+    /// The solver index of `e`, adding it on first sight; statics share slot 0.
+    fn slot(&mut self, e: Entity, bodies: &Query<Movable, MovableFilter>) -> usize {
+        if let Some(&i) = self.index.get(&e) {
+            return i;
+        }
+        let Ok((p, v, m)) = bodies.get(e) else {
+            return 0;
+        };
+        let i = self.entities.len();
+        self.index.insert(e, i);
+        self.entities.push(e);
+        self.positions.push(p.0);
+        self.velocities.push(v.0);
+        self.inverse_mass.push(m.inverse());
+        i
+    }
+}
+
+/// The sorted set of touching pairs at the end of the previous substep.
+#[derive(Resource, Default)]
+struct TouchingPairs(Vec<(Entity, Entity)>);
+
+fn report_collisions(
+    contacts: Res<Contacts>,
+    mut touching: ResMut<TouchingPairs>,
+    mut started: MessageWriter<CollisionStarted>,
+    mut ended: MessageWriter<CollisionEnded>,
+) {
+    let mut now: Vec<(Entity, Entity)> = contacts
+        .pairs
+        .iter()
+        .map(|c| (c.a.min(c.b), c.a.max(c.b)))
+        .collect();
+    now.sort_unstable();
+    now.dedup();
+    let before = &touching.0;
+    for &(a, b) in now.iter().filter(|p| before.binary_search(p).is_err()) {
+        started.write(CollisionStarted { a, b });
+    }
+    for &(a, b) in before.iter().filter(|p| now.binary_search(p).is_err()) {
+        ended.write(CollisionEnded { a, b });
+    }
+    touching.0 = now;
+}
+
+/// Advances the collision message buffers once per standalone step (an `App` does this itself
+/// every frame), so unread messages live two steps, as Bevy's messages live two frames.
+pub(crate) fn update_collision_messages(world: &mut World) {
+    if let Some(mut m) = world.get_resource_mut::<Messages<CollisionStarted>>() {
+        m.update();
+    }
+    if let Some(mut m) = world.get_resource_mut::<Messages<CollisionEnded>>() {
+        m.update();
+    }
+}

@@ -1,0 +1,96 @@
+//! The Prepare stage: bad input is set aside before it can spread.
+//!
+//! A body whose state is unusable — a NaN or infinite position, velocity, force or rotation, a
+//! zero, negative or NaN mass, a shape with impossible numbers — gets a
+//! [`Quarantined`] marker and a logged warning. Every other stage filters quarantined
+//! entities out, so their NaN never reaches a neighbour through a contact or a spring. Only
+//! added or changed components are checked, so a scene at rest costs nothing here.
+
+use crate::components::*;
+use crate::plugins::core::PrepareStart;
+use crate::schedule::PhysicsSchedule;
+use crate::stats::{PhysicsStats, Stage};
+use bevy_app::prelude::*;
+use bevy_ecs::prelude::*;
+use glam::Vec3;
+
+/// Quarantines bodies with unusable state.
+#[derive(Debug, Clone, Default)]
+pub struct ValidationPlugin;
+
+impl Plugin for ValidationPlugin {
+    fn build(&self, app: &mut App) {
+        app.add_systems(
+            PhysicsSchedule,
+            quarantine_invalid_bodies.in_set(PrepareStart),
+        );
+    }
+}
+
+type BodyData<'a> = (
+    Entity,
+    &'a Position,
+    Option<&'a Velocity>,
+    Option<&'a Mass>,
+    Option<&'a Rotation>,
+    Option<&'a Collider>,
+    Option<&'a Force>,
+);
+
+type ChangedBody = (
+    Without<Quarantined>,
+    Or<(
+        Changed<Position>,
+        Changed<Velocity>,
+        Changed<Mass>,
+        Changed<Rotation>,
+        Changed<Collider>,
+        Changed<Force>,
+    )>,
+);
+
+fn quarantine_invalid_bodies(
+    bodies: Query<BodyData, ChangedBody>,
+    mut stats: ResMut<PhysicsStats>,
+    mut commands: Commands,
+) {
+    stats.time(Stage::Prepare, "prepare/validate", || {
+        for (entity, p, v, m, r, c, f) in &bodies {
+            if let Some(reason) = why_invalid(p, v, m, r, c, f) {
+                quarantine(&mut commands, entity, reason);
+            }
+        }
+    });
+}
+
+/// Marks `entity` as quarantined and says why in the log.
+pub(crate) fn quarantine(commands: &mut Commands, entity: Entity, reason: String) {
+    log::warn!("urto: quarantined {entity}: {reason}");
+    commands.entity(entity).insert(Quarantined { reason });
+}
+
+fn why_invalid(
+    p: &Position,
+    v: Option<&Velocity>,
+    m: Option<&Mass>,
+    r: Option<&Rotation>,
+    c: Option<&Collider>,
+    f: Option<&Force>,
+) -> Option<String> {
+    let finite = |name: &str, x: Vec3| (!x.is_finite()).then(|| format!("{name} is {x}"));
+    finite("position", p.0)
+        .or_else(|| v.and_then(|v| finite("velocity", v.0)))
+        .or_else(|| f.and_then(|f| finite("force", f.0)))
+        .or_else(|| {
+            m.filter(|m| !m.is_valid())
+                .map(|m| format!("mass must be > 0 (or Mass::INFINITE), got {}", m.0))
+        })
+        .or_else(|| {
+            r.filter(|r| !(r.0.is_finite() && (r.0.length() - 1.0).abs() < 1e-3))
+                .map(|r| format!("rotation must be a unit quaternion, got {}", r.0))
+        })
+        .or_else(|| {
+            c.and_then(|c| c.shape.validate().err())
+                .map(|e| e.to_string())
+        })
+}

@@ -1,0 +1,172 @@
+//! The knobs of a simulation, as resources. Each has a validated constructor: bad numbers are a
+//! [`SettingsError`] at the call, never a panic or a silent NaN later.
+
+use crate::dynamics::Integrator;
+use crate::dynamics::response::SolverSettings;
+use bevy_ecs::prelude::*;
+use glam::Vec3;
+use std::fmt;
+
+/// Largest accepted step: beyond a second per step a game simulation has stopped meaning much.
+pub const MAX_DT: f32 = 1.0;
+/// Most substeps accepted per step.
+pub const MAX_SUBSTEPS: u32 = 1024;
+
+/// Why a setting was refused.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SettingsError {
+    /// `dt` not finite, `<= 0`, or above [`MAX_DT`].
+    BadTimestep(f32),
+    /// Zero substeps or more than [`MAX_SUBSTEPS`].
+    BadSubsteps(u32),
+    /// A catch-up cap of zero steps.
+    BadCatchUp(u32),
+    /// A non-finite gravity vector.
+    BadGravity(Vec3),
+    /// A coefficient outside its range.
+    BadCoefficient(&'static str, f32),
+}
+
+impl fmt::Display for SettingsError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::BadTimestep(dt) => {
+                write!(
+                    f,
+                    "time step must be finite, > 0 and <= {MAX_DT} s, got {dt}"
+                )
+            }
+            Self::BadSubsteps(n) => write!(f, "substeps must be 1..={MAX_SUBSTEPS}, got {n}"),
+            Self::BadCatchUp(n) => write!(f, "catch-up cap must be >= 1 step, got {n}"),
+            Self::BadGravity(g) => write!(f, "gravity must be finite, got {g}"),
+            Self::BadCoefficient(name, v) => write!(f, "{name} out of range: {v}"),
+        }
+    }
+}
+
+impl std::error::Error for SettingsError {}
+
+/// The fixed step: `dt` seconds split into `substeps` equal substeps, and at most
+/// `max_steps_per_frame` steps run per frame in an `App` ("the frame rate is sacred").
+#[derive(Resource, Clone, Copy, Debug, PartialEq)]
+pub struct PhysicsTimestep {
+    dt: f32,
+    substeps: u32,
+    max_steps_per_frame: u32,
+}
+
+impl Default for PhysicsTimestep {
+    /// 60 Hz, one substep, at most 4 steps per frame.
+    fn default() -> Self {
+        Self {
+            dt: 1.0 / 60.0,
+            substeps: 1,
+            max_steps_per_frame: 4,
+        }
+    }
+}
+
+impl PhysicsTimestep {
+    /// A step of `dt` seconds with `substeps` substeps.
+    pub fn new(dt: f32, substeps: u32) -> Result<Self, SettingsError> {
+        check_dt(dt)?;
+        if substeps == 0 || substeps > MAX_SUBSTEPS {
+            return Err(SettingsError::BadSubsteps(substeps));
+        }
+        Ok(Self {
+            dt,
+            substeps,
+            ..Default::default()
+        })
+    }
+
+    /// The same step with another catch-up cap.
+    pub fn with_max_steps_per_frame(mut self, steps: u32) -> Result<Self, SettingsError> {
+        if steps == 0 {
+            return Err(SettingsError::BadCatchUp(steps));
+        }
+        self.max_steps_per_frame = steps;
+        Ok(self)
+    }
+
+    /// Seconds per step.
+    pub fn dt(&self) -> f32 {
+        self.dt
+    }
+
+    /// Substeps per step.
+    pub fn substeps(&self) -> u32 {
+        self.substeps
+    }
+
+    /// Seconds per substep.
+    pub fn substep_dt(&self) -> f32 {
+        self.dt / self.substeps as f32
+    }
+
+    /// Most steps one frame may run.
+    pub fn max_steps_per_frame(&self) -> u32 {
+        self.max_steps_per_frame
+    }
+
+    /// Changes `dt` (e.g. to follow Bevy's fixed clock), refusing bad values.
+    pub fn set_dt(&mut self, dt: f32) -> Result<(), SettingsError> {
+        check_dt(dt)?;
+        self.dt = dt;
+        Ok(())
+    }
+}
+
+fn check_dt(dt: f32) -> Result<(), SettingsError> {
+    if dt.is_finite() && dt > 0.0 && dt <= MAX_DT {
+        Ok(())
+    } else {
+        Err(SettingsError::BadTimestep(dt))
+    }
+}
+
+/// Uniform gravitational acceleration (m/s²). Without this resource there is no gravity and the
+/// gravity system does not run. The slides' value, z up: `(0, 0, -9.8)`.
+#[derive(Resource, Clone, Copy, Debug, PartialEq)]
+pub struct Gravity(Vec3);
+
+impl Gravity {
+    /// The slides' gravity, z up.
+    pub const EARTH_Z_UP: Self = Self(Vec3::new(0.0, 0.0, -9.8));
+
+    /// Gravity along any direction.
+    pub fn new(acceleration: Vec3) -> Result<Self, SettingsError> {
+        if acceleration.is_finite() {
+            Ok(Self(acceleration))
+        } else {
+            Err(SettingsError::BadGravity(acceleration))
+        }
+    }
+
+    /// The acceleration.
+    pub fn acceleration(&self) -> Vec3 {
+        self.0
+    }
+}
+
+/// Which integrator advances the state (default: symplectic Euler).
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Integration(pub Integrator);
+
+/// Contact response settings.
+#[derive(Resource, Clone, Copy, Debug, PartialEq)]
+pub struct ContactSettings {
+    /// Restitution of bodies without a [`Restitution`](crate::components::Restitution).
+    pub default_restitution: f32,
+    /// The contact solver's tunables.
+    pub solver: SolverSettings,
+}
+
+impl Default for ContactSettings {
+    fn default() -> Self {
+        Self {
+            default_restitution: 0.5,
+            solver: SolverSettings::default(),
+        }
+    }
+}

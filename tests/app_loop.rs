@@ -1,0 +1,58 @@
+//! urto inside a real `bevy_app::App`, driven by Bevy's fixed-timestep loop.
+
+use bevy_app::App;
+use bevy_time::{TimePlugin, TimeUpdateStrategy};
+use glam::Vec3;
+use std::time::Duration;
+use urto::prelude::*;
+
+fn app(frame: Duration) -> App {
+    let mut app = App::new();
+    app.add_plugins(TimePlugin)
+        .add_plugins(UrtoPlugins::with_timestep(
+            PhysicsTimestep::new(1.0 / 50.0, 1)
+                .unwrap()
+                .with_max_steps_per_frame(3)
+                .unwrap(),
+        ));
+    app.insert_resource(TimeUpdateStrategy::ManualDuration(frame))
+        .insert_resource(Gravity::EARTH_Z_UP);
+    app.finish();
+    app.cleanup();
+    app
+}
+
+#[test]
+fn app_update_steps_physics_by_elapsed_time() {
+    let mut app = app(Duration::from_millis(10));
+    app.world_mut()
+        .spawn((Collider::half_space(Vec3::Z), Static));
+    let ball = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(0.0, 0.0, 3.0),
+            Velocity::default(),
+        ))
+        .id();
+    for _ in 0..101 {
+        app.update();
+    }
+    // 100 frames of 10 ms after the first = 1 s = 50 steps of 20 ms.
+    let stats = app.world().resource::<PhysicsStats>();
+    assert_eq!(stats.step, 50);
+    let z = app.world().get::<Position>(ball).unwrap().0.z;
+    assert!(
+        z > 0.0 && z < 2.0,
+        "after 1 s of gravity the ball must have fallen: {z}"
+    );
+}
+
+#[test]
+fn a_slow_frame_runs_at_most_the_catch_up_cap() {
+    let mut app = app(Duration::from_secs(1));
+    app.world_mut().spawn(Velocity::default());
+    app.update(); // the first frame has no elapsed time
+    app.update();
+    assert_eq!(app.world().resource::<PhysicsStats>().step, 3);
+}

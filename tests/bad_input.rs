@@ -1,0 +1,145 @@
+//! Bad input is reported and set aside; it never panics and never poisons a neighbour.
+
+mod common;
+
+use glam::Vec3;
+use urto::prelude::*;
+
+fn quarantined(app: &bevy_app::App, e: bevy_ecs::entity::Entity) -> bool {
+    app.world().get::<Quarantined>(e).is_some()
+}
+
+#[test]
+fn nan_and_infinite_state_is_quarantined_and_neighbours_stay_finite() {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    app.world_mut()
+        .spawn((Collider::half_space(Vec3::Z), Static));
+    let good = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(0.0, 0.0, 0.6),
+            Velocity::default(),
+        ))
+        .id();
+    let bad = [
+        app.world_mut()
+            .spawn((
+                Collider::sphere(0.5),
+                Position::new(f32::NAN, 0.0, 0.6),
+                Velocity::default(),
+            ))
+            .id(),
+        app.world_mut()
+            .spawn((
+                Collider::sphere(0.5),
+                Position::new(0.2, 0.0, 0.6),
+                Velocity::new(f32::INFINITY, 0.0, 0.0),
+            ))
+            .id(),
+        app.world_mut()
+            .spawn((
+                Collider::sphere(0.5),
+                Position::new(0.1, 0.0, 0.6),
+                Velocity::default(),
+                Force(Vec3::NAN),
+            ))
+            .id(),
+    ];
+    urto::step(app.world_mut(), 30).unwrap();
+    for e in bad {
+        assert!(quarantined(&app, e));
+    }
+    assert!(!quarantined(&app, good));
+    let p = app.world().get::<Position>(good).unwrap().0;
+    assert!(
+        p.is_finite() && p.z > 0.3,
+        "the good ball was disturbed: {p}"
+    );
+}
+
+#[test]
+fn zero_negative_and_nan_masses_are_quarantined() {
+    let mut app = common::app();
+    let masses = [0.0, -1.0, f32::NAN];
+    let bad: Vec<_> = masses
+        .iter()
+        .map(|&m| app.world_mut().spawn((Velocity::default(), Mass(m))).id())
+        .collect();
+    let infinite = app
+        .world_mut()
+        .spawn((Velocity::new(1.0, 0.0, 0.0), Mass::INFINITE))
+        .id();
+    urto::step(app.world_mut(), 1).unwrap();
+    for (e, m) in bad.iter().zip(masses) {
+        let q = app.world().get::<Quarantined>(*e).expect("quarantined");
+        assert!(q.reason.contains("mass"), "mass {m}: {}", q.reason);
+    }
+    assert!(
+        !quarantined(&app, infinite),
+        "infinite mass is a kinematic body, not an error"
+    );
+}
+
+#[test]
+fn bad_shapes_and_rotations_are_quarantined() {
+    let mut app = common::app();
+    let e1 = app.world_mut().spawn(Collider::sphere(-1.0)).id();
+    let e2 = app
+        .world_mut()
+        .spawn(Collider::cuboid(1.0, f32::NAN, 1.0))
+        .id();
+    let e3 = app.world_mut().spawn(Collider::half_space(Vec3::ZERO)).id();
+    let e4 = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(1.0),
+            Rotation(glam::Quat::from_xyzw(0.0, 0.0, 0.0, 0.0)),
+        ))
+        .id();
+    urto::step(app.world_mut(), 1).unwrap();
+    for e in [e1, e2, e3, e4] {
+        assert!(quarantined(&app, e));
+    }
+}
+
+#[test]
+fn an_overflowing_body_is_caught_before_it_spreads() {
+    let mut app = common::app();
+    let huge = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.5),
+            Velocity::new(f32::MAX, 0.0, 0.0),
+            Position::new(f32::MAX * 0.99, 0.0, 0.0),
+        ))
+        .id();
+    let neighbour = app
+        .world_mut()
+        .spawn((Collider::sphere(0.5), Velocity::default()))
+        .id();
+    urto::step(app.world_mut(), 3).unwrap();
+    assert!(quarantined(&app, huge));
+    assert_eq!(
+        app.world().get::<Position>(neighbour).unwrap().0,
+        Vec3::ZERO
+    );
+}
+
+#[test]
+fn bad_settings_are_errors() {
+    for dt in [0.0, -0.01, f32::NAN, f32::INFINITY, 10.0] {
+        assert!(PhysicsTimestep::new(dt, 1).is_err(), "dt = {dt}");
+    }
+    assert!(PhysicsTimestep::new(0.01, 0).is_err());
+    assert!(
+        PhysicsTimestep::new(0.01, 1)
+            .unwrap()
+            .with_max_steps_per_frame(0)
+            .is_err()
+    );
+    assert!(Gravity::new(Vec3::new(0.0, f32::NAN, 0.0)).is_err());
+    let e = PhysicsTimestep::new(-1.0, 1).unwrap_err();
+    assert!(e.to_string().contains("time step"), "{e}");
+}

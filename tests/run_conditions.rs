@@ -1,0 +1,113 @@
+//! "Simulate only the effects a scene calls for": an effect absent from the scene never runs.
+
+mod common;
+
+use glam::Vec3;
+use urto::prelude::*;
+
+fn runs(app: &bevy_app::App, effect: &str) -> u64 {
+    app.world().resource::<PhysicsStats>().runs(effect)
+}
+
+#[test]
+fn an_empty_world_runs_no_effect() {
+    let mut app = common::app();
+    urto::step(app.world_mut(), 10).unwrap();
+    for effect in [
+        "forces/gravity",
+        "forces/user",
+        "forces/drag",
+        "forces/springs",
+        "integrate",
+        "broad_phase",
+        "narrow_phase",
+        "response",
+    ] {
+        assert_eq!(runs(&app, effect), 0, "{effect} ran in an empty world");
+    }
+}
+
+#[test]
+fn bodies_without_colliders_pay_nothing_for_collision_and_without_gravity_do_not_fall() {
+    let mut app = common::app();
+    let body = app
+        .world_mut()
+        .spawn((Position::new(0.0, 0.0, 5.0), Velocity::new(1.0, 0.0, 0.0)))
+        .id();
+    urto::step(app.world_mut(), 60).unwrap();
+    assert_eq!(runs(&app, "integrate"), 60);
+    assert_eq!(runs(&app, "forces/gravity"), 0);
+    assert_eq!(runs(&app, "broad_phase"), 0);
+    assert_eq!(runs(&app, "narrow_phase"), 0);
+    let p = app.world().get::<Position>(body).unwrap().0;
+    assert!((p - Vec3::new(1.0, 0.0, 5.0)).length() < 1e-4, "{p}");
+}
+
+#[test]
+fn each_force_runs_only_when_present() {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    let a = app.world_mut().spawn(Velocity::default()).id();
+    urto::step(app.world_mut(), 5).unwrap();
+    assert_eq!(runs(&app, "forces/gravity"), 5);
+    assert_eq!(runs(&app, "forces/user"), 0);
+    assert_eq!(runs(&app, "forces/springs"), 0);
+    assert_eq!(runs(&app, "forces/drag"), 0);
+
+    app.world_mut()
+        .entity_mut(a)
+        .insert((Force(Vec3::X), LinearDrag(0.1)));
+    urto::step(app.world_mut(), 3).unwrap();
+    assert_eq!(runs(&app, "forces/user"), 3);
+    assert_eq!(runs(&app, "forces/drag"), 3);
+    assert_eq!(runs(&app, "forces/springs"), 0);
+    // The force was consumed by the first of those steps.
+    assert_eq!(app.world().get::<Force>(a).unwrap().0, Vec3::ZERO);
+}
+
+#[test]
+fn a_force_acts_for_one_step_then_is_cleared() {
+    let mut app = common::app();
+    let m = 2.0;
+    let body = app
+        .world_mut()
+        .spawn((
+            Velocity::default(),
+            Mass(m),
+            Force(Vec3::new(6.0, 0.0, 0.0)),
+        ))
+        .id();
+    urto::step(app.world_mut(), 10).unwrap();
+    let v = app.world().get::<Velocity>(body).unwrap().0;
+    // One step of a = F/m = 3 m/s² for dt = 1/60 s.
+    assert!((v.x - 3.0 / 60.0).abs() < 1e-6, "{v}");
+}
+
+#[test]
+fn springs_pull_towards_their_rest_length() {
+    let mut app = common::app();
+    let anchor = app
+        .world_mut()
+        .spawn((Position::new(0.0, 0.0, 0.0), Static))
+        .id();
+    let bob = app
+        .world_mut()
+        .spawn((
+            Position::new(2.0, 0.0, 0.0),
+            Velocity::default(),
+            Spring {
+                target: SpringTarget::Entity(anchor),
+                rest_length: 1.0,
+                stiffness: 50.0,
+                damping: 5.0,
+            },
+        ))
+        .id();
+    urto::step(app.world_mut(), 600).unwrap();
+    assert_eq!(runs(&app, "forces/springs"), 600);
+    let x = app.world().get::<Position>(bob).unwrap().0.x;
+    assert!(
+        (x - 1.0).abs() < 1e-2,
+        "damped spring should settle at rest length: {x}"
+    );
+}
