@@ -129,7 +129,9 @@ impl RerunDebugPlugin {
         if config.every_k_steps == 0 {
             return Err(RerunError::Config("every_k_steps must be >= 1".into()));
         }
-        let builder = rerun::RecordingStreamBuilder::new(config.app_id.as_str());
+        let app_id = rerun::ApplicationId::try_new(config.app_id.clone())
+            .map_err(|e| RerunError::Config(e.to_string()))?;
+        let builder = rerun::RecordingStreamBuilder::new(app_id);
         let recording = match &config.sink {
             RecordingSink::File(path) => builder.save(path),
             RecordingSink::Connect(url) => builder.connect_grpc_opts(url.as_str()),
