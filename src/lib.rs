@@ -27,6 +27,7 @@
 //! ```
 
 pub mod bounding;
+pub mod broad_phase;
 pub mod clock;
 pub mod components;
 pub mod debug;

@@ -218,7 +218,7 @@ fn report<E: fmt::Display>(r: Result<(), E>) {
 }
 
 fn is_recorded_step(rec: Res<RerunRecording>, stats: Res<PhysicsStats>) -> bool {
-    stats.step % rec.config.every_k_steps == 0
+    stats.step.is_multiple_of(rec.config.every_k_steps)
 }
 
 fn set_time(rec: &RecordingStream, stats: &PhysicsStats) {

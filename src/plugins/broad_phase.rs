@@ -65,11 +65,10 @@ fn refit_bounding_volumes(
 }
 
 /// All moving–moving and moving–static pairs whose AABBs overlap (brute force, O(n²)).
+type ColliderBox<'a> = (Entity, &'a BoundingVolume, Has<Velocity>, Has<Static>);
+
 fn find_candidate_pairs(
-    colliders: Query<
-        (Entity, &BoundingVolume, Has<Velocity>, Has<Static>),
-        (With<Collider>, Without<Quarantined>),
-    >,
+    colliders: Query<ColliderBox, (With<Collider>, Without<Quarantined>)>,
     mut out: ResMut<BroadPhasePairs>,
     mut stats: ResMut<PhysicsStats>,
 ) {

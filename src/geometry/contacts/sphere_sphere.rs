@@ -6,7 +6,9 @@ use glam::Vec3;
 
 /// Contact between a sphere centred at `ca` and one centred at `cb`.
 ///
-/// Coincident centres give [`FALLBACK_NORMAL`] and depth `ra + rb`.
+/// Coincident centres give depth `ra + rb` and the normal [`FALLBACK_NORMAL`] when A is at least
+/// as big as B (the smaller ball is pushed up), its opposite otherwise, so that swapping the pair
+/// always flips the normal unless the two balls are identical.
 pub fn contact_sphere_sphere(
     ca: Vec3,
     a: &Sphere,
@@ -22,8 +24,10 @@ pub fn contact_sphere_sphere(
     let dist = dist2.sqrt();
     let normal = if dist > 0.0 {
         d / dist
-    } else {
+    } else if a.radius >= b.radius {
         FALLBACK_NORMAL
+    } else {
+        -FALLBACK_NORMAL
     };
     let on_a = ca + normal * a.radius;
     let on_b = cb - normal * b.radius;
@@ -57,6 +61,9 @@ mod tests {
         let m = contact_sphere_sphere(Vec3::ONE, &s, Vec3::ONE, &s).unwrap();
         assert_eq!(m.normal, FALLBACK_NORMAL);
         assert_eq!(m.max_depth(), 1.0);
+        let small = Sphere { radius: 0.25 };
+        let m = contact_sphere_sphere(Vec3::ONE, &small, Vec3::ONE, &s).unwrap();
+        assert_eq!((m.normal, m.max_depth()), (-FALLBACK_NORMAL, 0.75));
         let points = Sphere { radius: 0.0 };
         let m = contact_sphere_sphere(Vec3::ONE, &points, Vec3::ONE, &points).unwrap();
         assert!(m.normal.is_finite() && m.max_depth() == 0.0);

@@ -1,0 +1,715 @@
+//! The uniform grid over the static scene: the slides' "CD e CR tra un oggetto e la scena
+//! statica". The scene does not move, so space is indexed once: each cell lists the static
+//! objects whose AABB touches it, and a moving object is tested only against the objects listed
+//! in the cells its own AABB touches (Ericson 2005, *Real-Time Collision Detection*, §7.1).
+//!
+//! Choices beyond the slides:
+//! - **Hashed cells, no bounds.** Cells live in a hash table keyed by their integer coordinates
+//!   (Teschner et al. 2003, "Optimized Spatial Hashing for Collision Detection of Deformable
+//!   Objects"), so the grid covers all of space and only occupied cells cost memory. The hasher
+//!   is fixed ([`CellHashBuilder`]) and only used for look-ups: no output depends on a table's
+//!   iteration order.
+//! - **Automatic, per-axis cell size** from the objects' sizes ([`suggest_cell_size`]),
+//!   overridable through [`StaticGridConfig`].
+//! - **Oversize list.** An object touching more than
+//!   [`max_cells_per_object`](StaticGridConfig::max_cells_per_object) cells (a ground slab,
+//!   terrain) is kept in a list that every query tests, so one object cannot fill memory.
+//! - **Dense slots.** Objects carry caller-chosen `u32` ids; inside, each has a slot in flat
+//!   arrays. What a query reads for every candidate (box, id, stamp) sits together in one
+//!   32-byte-aligned [`SlotObject`] that never straddles a cache line; the placement, read
+//!   only by edits, is kept apart.
+//!   Removed slots are recycled, so removing or moving an object touches only its cells.
+//!
+//! Queries live in `grid_query.rs`.
+
+use super::cell_hasher::CellHashBuilder;
+use super::cell_list::CellList;
+use super::cell_size::{DEFAULT_CELL_SIZE, suggest_cell_size};
+use super::cells::{CellCoord, CellRange};
+use super::config::{StaticGridConfig, check_cell_budget, check_cell_size};
+use super::error::{GridError, check_aabb};
+use crate::bounding::Aabb;
+use glam::Vec3;
+use std::collections::HashMap;
+use std::mem::size_of;
+
+/// Where a slot's object is indexed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Placement {
+    /// The slot is free (its object was removed); it is on the free list.
+    Vacant,
+    /// The object is listed in every cell of this range.
+    Cells(CellRange),
+    /// The object is at this position of the oversize list.
+    Oversize { position: u32 },
+}
+
+/// What a query reads for each candidate, packed into (and aligned to) 32 bytes so that one
+/// candidate costs one cache line.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(32))]
+pub(super) struct SlotObject {
+    pub(super) aabb: Aabb,
+    /// The caller's id.
+    pub(super) id: u32,
+    /// The last query generation that met this object (see `grid_query.rs`).
+    pub(super) stamp: u32,
+}
+
+/// A uniform hashed grid over static objects; see the module docs.
+///
+/// Queries ([`StaticGrid::query`]) return each object whose AABB intersects the query AABB,
+/// once, in ascending id order.
+#[derive(Clone, Debug)]
+pub struct StaticGrid {
+    pub(super) cell_size: Vec3,
+    /// `1 / cell_size`: cells are found by multiplying, which is as monotone as dividing.
+    pub(super) inv_cell_size: Vec3,
+    pub(super) max_cells_per_object: u32,
+    /// Occupied cells only: slots of the objects touching each (short lists inline, see
+    /// [`CellList`]). A cell whose list empties is removed.
+    pub(super) cells: HashMap<CellCoord, CellList, CellHashBuilder>,
+    pub(super) slot_of_id: HashMap<u32, u32, CellHashBuilder>,
+    /// Per slot: what queries read, and where the object is indexed.
+    pub(super) objects: Vec<SlotObject>,
+    pub(super) placements: Vec<Placement>,
+    /// Vacant slots, reused last-in first-out.
+    pub(super) free_slots: Vec<u32>,
+    /// Slots of the oversize objects.
+    pub(super) oversize: Vec<u32>,
+    /// Objects listed in cells (live objects minus oversize ones).
+    pub(super) gridded_count: usize,
+    /// A range holding every occupied cell (it grows with insertions and is reset only when no
+    /// object is left in cells), so queries skip the part of their range that cannot hold
+    /// anything.
+    pub(super) occupied: Option<CellRange>,
+    /// Stamp of the current query; see `grid_query.rs`.
+    pub(super) generation: u32,
+}
+
+impl StaticGrid {
+    /// An empty grid. Without a cell size in `config`, cells are [`DEFAULT_CELL_SIZE`]: prefer
+    /// [`StaticGrid::build`] when the objects are known, so the size fits them.
+    pub fn new(config: StaticGridConfig) -> Result<Self, GridError> {
+        let cell_size = check_cell_size(config.cell_size.unwrap_or(DEFAULT_CELL_SIZE))?;
+        let max_cells_per_object = check_cell_budget(config.max_cells_per_object)?;
+        Ok(Self {
+            cell_size,
+            inv_cell_size: cell_size.recip(),
+            max_cells_per_object,
+            cells: HashMap::with_hasher(CellHashBuilder),
+            slot_of_id: HashMap::with_hasher(CellHashBuilder),
+            objects: Vec::new(),
+            placements: Vec::new(),
+            free_slots: Vec::new(),
+            oversize: Vec::new(),
+            gridded_count: 0,
+            occupied: None,
+            generation: 0,
+        })
+    }
+
+    /// A grid holding `objects`, with the cell size chosen from them ([`suggest_cell_size`]).
+    pub fn build(objects: &[(u32, Aabb)]) -> Result<Self, GridError> {
+        Self::build_with(objects, StaticGridConfig::default())
+    }
+
+    /// A grid holding `objects`; the cell size is `config`'s, or chosen from the objects.
+    pub fn build_with(
+        objects: &[(u32, Aabb)],
+        config: StaticGridConfig,
+    ) -> Result<Self, GridError> {
+        check_batch(objects)?;
+        let cell_size = config
+            .cell_size
+            .unwrap_or_else(|| suggest_cell_size(objects.iter().map(|(_, aabb)| aabb)));
+        let mut grid = Self::new(StaticGridConfig {
+            cell_size: Some(cell_size),
+            ..config
+        })?;
+        grid.insert_checked_batch(objects);
+        Ok(grid)
+    }
+
+    /// Indexes object `id` with box `aabb`.
+    ///
+    /// Errors: a non-finite or inverted box, or an id already in the grid.
+    pub fn insert(&mut self, id: u32, aabb: Aabb) -> Result<(), GridError> {
+        check_aabb(&aabb, Some(id))?;
+        if self.slot_of_id.contains_key(&id) {
+            return Err(GridError::DuplicateId(id));
+        }
+        self.insert_checked(id, aabb);
+        Ok(())
+    }
+
+    /// Indexes a batch of objects: all of them, or (on the first bad box or repeated id) none.
+    pub fn insert_bulk(&mut self, objects: &[(u32, Aabb)]) -> Result<(), GridError> {
+        check_batch(objects)?;
+        if let Some(&(id, _)) = objects
+            .iter()
+            .find(|(id, _)| self.slot_of_id.contains_key(id))
+        {
+            return Err(GridError::DuplicateId(id));
+        }
+        self.insert_checked_batch(objects);
+        Ok(())
+    }
+
+    /// Removes object `id` from its cells (or the oversize list) and returns its box.
+    pub fn remove(&mut self, id: u32) -> Result<Aabb, GridError> {
+        let slot = self
+            .slot_of_id
+            .remove(&id)
+            .ok_or(GridError::UnknownId(id))?;
+        self.unplace(slot);
+        self.placements[slot as usize] = Placement::Vacant;
+        self.free_slots.push(slot);
+        Ok(self.objects[slot as usize].aabb)
+    }
+
+    /// Gives object `id` a new box. Only the cells the object leaves or enters are touched; a
+    /// box that stays in the same cells touches none.
+    pub fn update(&mut self, id: u32, aabb: Aabb) -> Result<(), GridError> {
+        check_aabb(&aabb, Some(id))?;
+        let slot = *self.slot_of_id.get(&id).ok_or(GridError::UnknownId(id))?;
+        let old = self.placements[slot as usize];
+        self.objects[slot as usize].aabb = aabb;
+        let same_place = match (old, self.cell_range_if_gridded(&aabb)) {
+            (Placement::Cells(before), Some(after)) => before == after,
+            (Placement::Oversize { .. }, None) => true,
+            _ => false,
+        };
+        if !same_place {
+            self.unplace(slot);
+            self.place(slot);
+        }
+        Ok(())
+    }
+
+    /// Number of objects.
+    pub fn len(&self) -> usize {
+        self.slot_of_id.len()
+    }
+
+    /// True when the grid holds no object.
+    pub fn is_empty(&self) -> bool {
+        self.slot_of_id.is_empty()
+    }
+
+    /// True when object `id` is in the grid.
+    pub fn contains(&self, id: u32) -> bool {
+        self.slot_of_id.contains_key(&id)
+    }
+
+    /// The box of object `id`.
+    pub fn aabb(&self, id: u32) -> Option<Aabb> {
+        self.slot_of_id
+            .get(&id)
+            .map(|&slot| self.objects[slot as usize].aabb)
+    }
+
+    /// True when object `id` is on the oversize list (tested by every query), `None` for an
+    /// unknown id.
+    pub fn is_oversize(&self, id: u32) -> Option<bool> {
+        let slot = *self.slot_of_id.get(&id)?;
+        Some(matches!(
+            self.placements[slot as usize],
+            Placement::Oversize { .. }
+        ))
+    }
+
+    /// Size of a cell along x, y, z.
+    pub fn cell_size(&self) -> Vec3 {
+        self.cell_size
+    }
+
+    /// The per-object cell budget beyond which objects go to the oversize list.
+    pub fn max_cells_per_object(&self) -> u32 {
+        self.max_cells_per_object
+    }
+
+    /// Number of objects on the oversize list.
+    pub fn oversize_count(&self) -> usize {
+        self.oversize.len()
+    }
+
+    /// Number of cells listing at least one object.
+    pub fn occupied_cell_count(&self) -> usize {
+        self.cells.len()
+    }
+
+    /// An estimate of the heap and inline bytes the grid holds: the capacity of every buffer,
+    /// hash tables counted as capacity × (entry + 1 control byte), allocator overhead excluded.
+    /// Walks every occupied cell, so it costs O(cells): a diagnostic, not for every frame.
+    pub fn memory_bytes(&self) -> usize {
+        let lists: usize = self.cells.values().map(CellList::heap_bytes).sum();
+        size_of::<Self>()
+            + table_bytes::<CellCoord, CellList>(self.cells.capacity())
+            + lists
+            + table_bytes::<u32, u32>(self.slot_of_id.capacity())
+            + self.objects.capacity() * size_of::<SlotObject>()
+            + self.placements.capacity() * size_of::<Placement>()
+            + self.free_slots.capacity() * size_of::<u32>()
+            + self.oversize.capacity() * size_of::<u32>()
+    }
+
+    /// The cells `aabb` would be listed in, `None` when it would go to the oversize list.
+    fn cell_range_if_gridded(&self, aabb: &Aabb) -> Option<CellRange> {
+        let range = CellRange::of_aabb(aabb, self.inv_cell_size);
+        (range.cell_count() <= u128::from(self.max_cells_per_object)).then_some(range)
+    }
+
+    /// Inserts a batch already checked for bad boxes and repeated ids.
+    fn insert_checked_batch(&mut self, objects: &[(u32, Aabb)]) {
+        let additional = objects.len().saturating_sub(self.free_slots.len());
+        self.slot_of_id.reserve(objects.len());
+        self.objects.reserve(additional);
+        self.placements.reserve(additional);
+        for &(id, aabb) in objects {
+            self.insert_checked(id, aabb);
+        }
+    }
+
+    /// Inserts an object already checked for a bad box and a repeated id.
+    fn insert_checked(&mut self, id: u32, aabb: Aabb) {
+        // Stamp 0 is never a query's generation (they skip 0), so the object is unseen.
+        let object = SlotObject { aabb, id, stamp: 0 };
+        let slot = match self.free_slots.pop() {
+            Some(slot) => {
+                self.objects[slot as usize] = object;
+                slot
+            }
+            None => {
+                // Ids are distinct `u32`s and vacant slots are reused first, so there are
+                // never more than 2³² slots and the index fits a `u32`.
+                let slot = self.objects.len() as u32;
+                self.objects.push(object);
+                self.placements.push(Placement::Vacant);
+                slot
+            }
+        };
+        self.slot_of_id.insert(id, slot);
+        self.place(slot);
+    }
+
+    /// Lists the slot's object in its cells, or on the oversize list.
+    fn place(&mut self, slot: u32) {
+        let aabb = self.objects[slot as usize].aabb;
+        self.placements[slot as usize] = match self.cell_range_if_gridded(&aabb) {
+            Some(range) => {
+                for cell in range.iter() {
+                    self.cells.entry(cell).or_default().push(slot);
+                }
+                self.gridded_count += 1;
+                self.occupied = Some(self.occupied.map_or(range, |o| o.union(&range)));
+                Placement::Cells(range)
+            }
+            None => {
+                // The oversize list holds at most one entry per slot: its length fits a `u32`.
+                let position = self.oversize.len() as u32;
+                self.oversize.push(slot);
+                Placement::Oversize { position }
+            }
+        };
+    }
+
+    /// Takes the slot's object out of its cells or the oversize list (its placement is left
+    /// stale: the caller sets it).
+    fn unplace(&mut self, slot: u32) {
+        match self.placements[slot as usize] {
+            Placement::Vacant => {}
+            Placement::Cells(range) => {
+                for cell in range.iter() {
+                    self.remove_from_cell(cell, slot);
+                }
+                self.gridded_count -= 1;
+                if self.gridded_count == 0 {
+                    self.occupied = None;
+                }
+            }
+            Placement::Oversize { position } => {
+                self.oversize.swap_remove(position as usize);
+                if let Some(&moved) = self.oversize.get(position as usize) {
+                    self.placements[moved as usize] = Placement::Oversize { position };
+                }
+            }
+        }
+    }
+
+    /// Removes `slot` from one cell's list, and the cell itself when it empties. Linear in the
+    /// cell's population, which the cell-size rule keeps small.
+    fn remove_from_cell(&mut self, cell: CellCoord, slot: u32) {
+        let Some(list) = self.cells.get_mut(&cell) else {
+            return;
+        };
+        list.remove(slot);
+        if list.is_empty() {
+            self.cells.remove(&cell);
+        }
+    }
+}
+
+/// Accepts a batch whose boxes are all indexable and whose ids are distinct.
+fn check_batch(objects: &[(u32, Aabb)]) -> Result<(), GridError> {
+    for (id, aabb) in objects {
+        check_aabb(aabb, Some(*id))?;
+    }
+    let mut ids: Vec<u32> = objects.iter().map(|&(id, _)| id).collect();
+    ids.sort_unstable();
+    match ids.windows(2).find(|pair| pair[0] == pair[1]) {
+        Some(pair) => Err(GridError::DuplicateId(pair[0])),
+        None => Ok(()),
+    }
+}
+
+/// Bytes of a hash table of `capacity` entries: the entries plus one control byte each.
+fn table_bytes<K, V>(capacity: usize) -> usize {
+    capacity * (size_of::<(K, V)>() + 1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::broad_phase::grid::stats::GridQueryStats;
+
+    fn unit_box(min: Vec3) -> Aabb {
+        Aabb::new(min, min + Vec3::ONE)
+    }
+
+    fn cubes(size: f32) -> StaticGrid {
+        StaticGrid::new(StaticGridConfig::with_cell_size(size)).unwrap()
+    }
+
+    fn query_ids(grid: &mut StaticGrid, query: Aabb) -> Vec<u32> {
+        let mut out = Vec::new();
+        grid.query(&query, &mut out).unwrap();
+        out
+    }
+
+    #[test]
+    fn bad_boxes_and_ids_are_refused_and_leave_the_grid_unchanged() {
+        let mut grid = cubes(1.0);
+        grid.insert(1, unit_box(Vec3::ZERO)).unwrap();
+        let nan = Aabb::new(Vec3::new(f32::NAN, 0.0, 0.0), Vec3::ONE);
+        let inverted = Aabb::new(Vec3::ONE, Vec3::ZERO);
+        assert_eq!(
+            grid.insert(2, nan),
+            Err(GridError::NonFiniteAabb { id: Some(2) })
+        );
+        assert_eq!(
+            grid.insert(2, Aabb::EMPTY),
+            Err(GridError::NonFiniteAabb { id: Some(2) })
+        );
+        assert_eq!(
+            grid.insert(2, inverted),
+            Err(GridError::InvertedAabb { id: Some(2) })
+        );
+        assert_eq!(
+            grid.insert(1, unit_box(Vec3::ONE)),
+            Err(GridError::DuplicateId(1))
+        );
+        assert_eq!(grid.remove(7), Err(GridError::UnknownId(7)));
+        assert_eq!(
+            grid.update(7, unit_box(Vec3::ZERO)),
+            Err(GridError::UnknownId(7))
+        );
+        assert_eq!(
+            grid.update(1, nan),
+            Err(GridError::NonFiniteAabb { id: Some(1) })
+        );
+        let mut out = vec![99];
+        assert_eq!(
+            grid.query(&nan, &mut out),
+            Err(GridError::NonFiniteAabb { id: None })
+        );
+        assert_eq!(
+            grid.query(&inverted, &mut out),
+            Err(GridError::InvertedAabb { id: None })
+        );
+        assert_eq!(out, vec![99]);
+        assert_eq!(grid.len(), 1);
+        assert_eq!(grid.aabb(1), Some(unit_box(Vec3::ZERO)));
+    }
+
+    #[test]
+    fn a_bulk_insert_with_one_bad_object_inserts_nothing() {
+        let mut grid = cubes(1.0);
+        grid.insert(5, unit_box(Vec3::ZERO)).unwrap();
+        let repeated = [
+            (1, unit_box(Vec3::ZERO)),
+            (2, unit_box(Vec3::ONE)),
+            (1, unit_box(Vec3::ONE)),
+        ];
+        assert_eq!(grid.insert_bulk(&repeated), Err(GridError::DuplicateId(1)));
+        let clash = [(1, unit_box(Vec3::ZERO)), (5, unit_box(Vec3::ONE))];
+        assert_eq!(grid.insert_bulk(&clash), Err(GridError::DuplicateId(5)));
+        let bad = [(1, unit_box(Vec3::ZERO)), (2, Aabb::EMPTY)];
+        assert_eq!(
+            grid.insert_bulk(&bad),
+            Err(GridError::NonFiniteAabb { id: Some(2) })
+        );
+        assert_eq!(grid.len(), 1);
+        assert_eq!(
+            StaticGrid::build(&repeated).err(),
+            Some(GridError::DuplicateId(1))
+        );
+    }
+
+    #[test]
+    fn bad_configurations_are_refused() {
+        let zero = StaticGridConfig::with_cell_size(0.0);
+        assert_eq!(
+            StaticGrid::new(zero).err(),
+            Some(GridError::InvalidCellSize(Vec3::ZERO))
+        );
+        let greedy = StaticGridConfig {
+            max_cells_per_object: u32::MAX,
+            ..StaticGridConfig::default()
+        };
+        assert_eq!(
+            StaticGrid::new(greedy).err(),
+            Some(GridError::InvalidCellBudget(u32::MAX))
+        );
+    }
+
+    #[test]
+    fn build_picks_the_cell_size_from_the_objects_unless_told() {
+        let objects: Vec<(u32, Aabb)> = (0..20)
+            .map(|i| (i, Aabb::new(Vec3::ZERO, Vec3::new(2.0, 2.0, 6.0))))
+            .collect();
+        assert_eq!(
+            StaticGrid::build(&objects).unwrap().cell_size(),
+            Vec3::new(2.0, 2.0, 6.0)
+        );
+        let told = StaticGrid::build_with(&objects, StaticGridConfig::with_cell_size(0.5)).unwrap();
+        assert_eq!(told.cell_size(), Vec3::splat(0.5));
+        assert_eq!(
+            StaticGrid::new(StaticGridConfig::default())
+                .unwrap()
+                .cell_size(),
+            DEFAULT_CELL_SIZE
+        );
+    }
+
+    #[test]
+    fn an_object_is_listed_in_exactly_the_cells_it_touches() {
+        let mut grid = cubes(1.0);
+        // [-0.5, 1.0] touches cells -1, 0 and 1 on x (its max face lies on the 0|1 boundary).
+        grid.insert(
+            3,
+            Aabb::new(Vec3::new(-0.5, 0.2, 0.2), Vec3::new(1.0, 0.8, 0.8)),
+        )
+        .unwrap();
+        assert_eq!(grid.occupied_cell_count(), 3);
+        let mut out = Vec::new();
+        for x in -1..=1 {
+            grid.objects_in_cell(CellCoord::new(x, 0, 0), &mut out);
+            assert_eq!(out, vec![3]);
+        }
+        grid.objects_in_cell(CellCoord::new(2, 0, 0), &mut out);
+        assert!(out.is_empty());
+    }
+
+    #[test]
+    fn removal_empties_cells_and_reinsertion_reuses_the_slot() {
+        let mut grid = cubes(1.0);
+        grid.insert(1, unit_box(Vec3::ZERO)).unwrap();
+        grid.insert(2, unit_box(Vec3::splat(5.0))).unwrap();
+        let cells_with_both = grid.occupied_cell_count();
+        assert_eq!(grid.remove(1), Ok(unit_box(Vec3::ZERO)));
+        assert!(grid.occupied_cell_count() < cells_with_both);
+        assert!(query_ids(&mut grid, unit_box(Vec3::ZERO)).is_empty());
+        grid.insert(7, unit_box(Vec3::ZERO)).unwrap();
+        assert_eq!(grid.objects.len(), 2, "the freed slot is reused");
+        assert_eq!(grid.occupied_cell_count(), cells_with_both);
+        assert_eq!(
+            query_ids(&mut grid, Aabb::new(Vec3::ZERO, Vec3::splat(5.0))),
+            vec![2, 7]
+        );
+    }
+
+    #[test]
+    fn an_update_within_the_same_cells_touches_no_cell() {
+        let mut grid = cubes(10.0);
+        grid.insert(1, unit_box(Vec3::splat(1.0))).unwrap();
+        let cells = grid.cells.clone();
+        grid.update(1, unit_box(Vec3::splat(2.0))).unwrap();
+        assert_eq!(grid.cells, cells);
+        assert!(query_ids(&mut grid, unit_box(Vec3::splat(1.0))).contains(&1));
+        assert!(query_ids(&mut grid, Aabb::new(Vec3::splat(0.5), Vec3::splat(1.5))).is_empty());
+        grid.update(1, unit_box(Vec3::splat(25.0))).unwrap();
+        assert_eq!(query_ids(&mut grid, unit_box(Vec3::splat(25.5))), vec![1]);
+        assert_eq!(grid.occupied_cell_count(), 1);
+    }
+
+    #[test]
+    fn huge_objects_go_to_the_oversize_list_and_are_always_tested() {
+        let mut grid = cubes(1.0);
+        let ground = Aabb::new(
+            Vec3::new(-1.0e5, -1.0e5, -1.0),
+            Vec3::new(1.0e5, 1.0e5, 0.0),
+        );
+        grid.insert(0, ground).unwrap();
+        grid.insert(1, unit_box(Vec3::ZERO)).unwrap();
+        assert_eq!(grid.is_oversize(0), Some(true));
+        assert_eq!(grid.is_oversize(1), Some(false));
+        assert_eq!(grid.is_oversize(2), None);
+        assert_eq!(grid.occupied_cell_count(), 8);
+        let mut out = Vec::new();
+        grid.oversize_ids(&mut out);
+        assert_eq!(out, vec![0]);
+        assert_eq!(
+            query_ids(&mut grid, unit_box(Vec3::new(50.0, 50.0, -0.5))),
+            vec![0]
+        );
+        assert!(query_ids(&mut grid, unit_box(Vec3::new(50.0, 50.0, 0.5))).is_empty());
+        // Shrinking it brings it back into the cells; removing it empties the list.
+        grid.update(0, unit_box(Vec3::splat(3.0))).unwrap();
+        assert_eq!(grid.oversize_count(), 0);
+        grid.update(0, ground).unwrap();
+        grid.insert(2, ground).unwrap();
+        grid.remove(0).unwrap();
+        grid.oversize_ids(&mut out);
+        assert_eq!(out, vec![2]);
+        assert_eq!(grid.is_oversize(2), Some(true));
+    }
+
+    #[test]
+    fn a_zero_budget_turns_the_grid_into_a_scan() {
+        let config = StaticGridConfig {
+            max_cells_per_object: 0,
+            ..StaticGridConfig::with_cell_size(1.0)
+        };
+        let mut grid = StaticGrid::new(config).unwrap();
+        grid.insert_bulk(&[(4, unit_box(Vec3::ZERO)), (9, unit_box(Vec3::splat(3.0)))])
+            .unwrap();
+        assert_eq!(grid.occupied_cell_count(), 0);
+        assert_eq!(
+            query_ids(&mut grid, Aabb::new(Vec3::ZERO, Vec3::splat(3.0))),
+            vec![4, 9]
+        );
+    }
+
+    #[test]
+    fn a_world_sized_query_scans_objects_instead_of_cells() {
+        let mut grid = cubes(0.001);
+        grid.insert(1, unit_box(Vec3::ZERO).expanded(-0.4995))
+            .unwrap();
+        grid.insert(2, unit_box(Vec3::splat(100.0)).expanded(-0.4995))
+            .unwrap();
+        let world = Aabb::new(Vec3::splat(-1.0e30), Vec3::splat(1.0e30));
+        let mut out = Vec::new();
+        let stats = grid.query(&world, &mut out).unwrap();
+        assert_eq!(out, vec![1, 2]);
+        assert_eq!(stats.object_scans, 1);
+        assert_eq!(stats.cells_visited, 0);
+        assert_eq!(stats.exact_tests, 2);
+        let candidates = grid.query_candidates(&world, &mut out).unwrap();
+        assert_eq!(out, vec![1, 2]);
+        assert_eq!(candidates.exact_tests, 0);
+    }
+
+    #[test]
+    fn a_query_far_from_every_object_visits_no_cell() {
+        let mut grid = cubes(1.0);
+        grid.insert(1, unit_box(Vec3::ZERO)).unwrap();
+        let mut out = Vec::new();
+        let stats = grid
+            .query(&unit_box(Vec3::splat(-500.0)), &mut out)
+            .unwrap();
+        assert!(out.is_empty());
+        assert_eq!(stats, GridQueryStats::default());
+    }
+
+    #[test]
+    fn stats_count_cells_entries_and_distinct_tests() {
+        let mut grid = cubes(1.0);
+        // Object 1 spans 2 × 1 × 1 cells, object 2 one of them.
+        grid.insert(1, Aabb::new(Vec3::splat(0.1), Vec3::new(1.9, 0.9, 0.9)))
+            .unwrap();
+        grid.insert(2, Aabb::new(Vec3::splat(0.2), Vec3::splat(0.3)))
+            .unwrap();
+        let mut out = Vec::new();
+        let query = Aabb::new(Vec3::new(0.5, 0.5, 0.5), Vec3::new(1.5, 0.6, 0.6));
+        let stats = grid.query(&query, &mut out).unwrap();
+        assert_eq!(out, vec![1]);
+        assert_eq!(stats.cells_visited, 2);
+        assert_eq!(stats.candidates_listed, 3);
+        assert_eq!(stats.exact_tests, 2);
+        let candidates = grid.query_candidates(&query, &mut out).unwrap();
+        assert_eq!(out, vec![1, 2]);
+        assert_eq!(candidates.exact_tests, 0);
+    }
+
+    #[test]
+    fn the_generation_counter_wraps_without_false_duplicates() {
+        let mut grid = cubes(1.0);
+        grid.insert(1, Aabb::new(Vec3::ZERO, Vec3::splat(1.5)))
+            .unwrap();
+        // Enough other objects that an 8-cell query visits cells instead of scanning.
+        for id in 2..12 {
+            grid.insert(id, unit_box(Vec3::new(0.0, 0.0, id as f32 * 2.0)))
+                .unwrap();
+        }
+        let query = Aabb::new(Vec3::splat(0.5), Vec3::splat(1.2));
+        grid.generation = u32::MAX - 1;
+        for _ in 0..4 {
+            let mut out = Vec::new();
+            let stats = grid.query(&query, &mut out).unwrap();
+            assert_eq!(out, vec![1]);
+            assert_eq!(
+                (
+                    stats.cells_visited,
+                    stats.candidates_listed,
+                    stats.exact_tests
+                ),
+                (8, 8, 1)
+            );
+        }
+        assert_eq!(
+            grid.generation, 3,
+            "wrapped past zero to 1, then two more queries"
+        );
+    }
+
+    #[test]
+    fn cell_bounds_cover_the_cells_a_box_touches() {
+        let grid = StaticGrid::new(StaticGridConfig::with_cell_size_per_axis(Vec3::new(
+            2.0, 3.0, 0.5,
+        )))
+        .unwrap();
+        let aabb = Aabb::new(Vec3::new(-3.0, 1.0, 0.1), Vec3::new(1.0, 4.0, 0.2));
+        let range = grid.cells_touching(&aabb).unwrap();
+        assert_eq!(range.cell_count(), 3 * 2);
+        let covered = grid.range_bounds(&range);
+        assert!(covered.contains(&aabb));
+        for cell in range.iter() {
+            assert!(grid.cell_bounds(cell).intersects(&aabb));
+        }
+        assert!(grid.cells_touching(&Aabb::EMPTY).is_err());
+    }
+
+    #[test]
+    fn memory_grows_with_objects_and_stays_bounded_for_huge_ones() {
+        let objects: Vec<(u32, Aabb)> = (0..100)
+            .map(|i| (i, unit_box(Vec3::new(i as f32 * 3.0, 0.0, 0.0))))
+            .collect();
+        let empty = cubes(1.0).memory_bytes();
+        let mut with_small = cubes(1.0);
+        with_small.insert_bulk(&objects).unwrap();
+        let hundred = with_small.memory_bytes();
+        // At least the objects' records plus one 4-byte entry in each of their 8 cells.
+        assert!(hundred > empty + 100 * size_of::<SlotObject>() + 800 * size_of::<u32>());
+        let mut with_huge = with_small.clone();
+        with_small
+            .insert(1000, unit_box(Vec3::splat(-50.0)))
+            .unwrap();
+        with_huge
+            .insert(1000, Aabb::new(Vec3::splat(-1.0e6), Vec3::splat(1.0e6)))
+            .unwrap();
+        // A box over ~10¹⁸ cells costs about what a unit box does: one oversize-list entry.
+        assert!(with_huge.memory_bytes() <= with_small.memory_bytes() + 64);
+        assert_eq!(with_huge.occupied_cell_count(), 800);
+    }
+}
