@@ -171,6 +171,7 @@ impl Plugin for RerunDebugPlugin {
             UpAxis::Y => rerun::ViewCoordinates::RIGHT_HAND_Y_UP(),
         };
         report(rec.log_static("world", &coordinates));
+        report(default_layout().send(rec, Default::default()));
         app.init_resource::<DebugClock>()
             .insert_resource(RerunRecording {
                 stream: self.recording.clone(),
@@ -200,6 +201,22 @@ impl Drop for RerunRecording {
     fn drop(&mut self) {
         report(self.stream.flush_blocking());
     }
+}
+
+/// The layout the viewer opens on: the 3D scene large on the left; on the right the wall time
+/// of each stage in one plot and the step's counters in another (instead of one plot each).
+fn default_layout() -> rerun::blueprint::Blueprint {
+    use rerun::blueprint::components::PanelState;
+    use rerun::blueprint::*;
+    let scene = Spatial3DView::new("scene").with_origin("/");
+    let timing = TimeSeriesView::new("time per stage (ms)").with_origin("/timing");
+    let counters = TimeSeriesView::new("counters").with_origin("/counters");
+    let log = TextLogView::new("log").with_origin("/log");
+    let side = Vertical::new([timing.into(), counters.into(), log.into()])
+        .with_row_shares([0.4, 0.4, 0.2]);
+    Blueprint::new(Horizontal::new([scene.into(), side.into()]).with_column_shares([0.62, 0.38]))
+        .with_blueprint_panel(BlueprintPanel::new().with_state(PanelState::Collapsed))
+        .with_selection_panel(SelectionPanel::new().with_state(PanelState::Collapsed))
 }
 
 const DYNAMIC: [u8; 3] = [230, 126, 34];

@@ -3,8 +3,22 @@
 mod contact;
 pub mod contacts;
 mod isometry;
+pub mod mesh_io;
+pub(crate) mod predicates;
+mod primitives_mesh;
 mod shapes;
+pub mod tri_tri;
+mod triangle;
+mod trimesh;
+mod weld;
 
 pub use contact::{ContactManifold, ContactPoint, MAX_MANIFOLD_POINTS};
 pub use isometry::Isometry;
+pub use primitives_mesh::MAX_PROCEDURAL_VERTICES;
 pub use shapes::{Cuboid, HalfSpace, Shape, ShapeError, Sphere};
+pub use tri_tri::{TriTriIntersection, tri_tri_intersect, tri_tri_intersection};
+pub use triangle::{
+    Triangle, contact_triangle_halfspace, contact_triangle_sphere, intersects_triangle_aabb,
+    intersects_triangle_cuboid, triangle_box_overlap,
+};
+pub use trimesh::{MeshError, MeshReport, TriMesh};
