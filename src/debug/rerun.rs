@@ -395,12 +395,13 @@ fn record_bodies(
     }
 }
 
-/// Contacts (arrows along the normal, scaled by depth) and broad-phase pairs (segments).
+/// Contacts (arrows along the normal, scaled by depth) and broad-phase pairs (segments between
+/// the centres of bounded bodies).
 fn record_pairs(
     rec: Res<RerunRecording>,
     contacts: Option<Res<Contacts>>,
     pairs: Option<Res<BroadPhasePairs>>,
-    positions: Query<&Position>,
+    bodies: Query<(&Position, &BoundingVolume)>,
 ) {
     if !rec.config.contacts {
         return;
@@ -424,7 +425,9 @@ fn record_pairs(
             .pairs
             .iter()
             .filter_map(|&(a, b)| {
-                Some([arr(positions.get(a).ok()?.0), arr(positions.get(b).ok()?.0)])
+                // Pairs with unbounded scenery (every body vs the ground) would only be clutter.
+                let ((pa, ba), (pb, bb)) = (bodies.get(a).ok()?, bodies.get(b).ok()?);
+                (ba.0.is_finite() && bb.0.is_finite()).then(|| [arr(pa.0), arr(pb.0)])
             })
             .collect();
         let lines = rerun::LineStrips3D::new(strips)
