@@ -28,6 +28,7 @@
 
 pub mod bounding;
 pub mod broad_phase;
+pub mod bvh;
 pub mod clock;
 pub mod components;
 pub mod debug;

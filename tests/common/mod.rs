@@ -1,8 +1,80 @@
-//! Shared set-up for the integration tests (included with `mod common;`).
+//! Shared support for the integration tests (and the BVH bench and example, which include it
+//! by path): apps with urto's plugins, a seeded generator, test meshes, and a reference
+//! triangle–triangle test. Each test uses a different subset.
 #![allow(dead_code)]
 
+pub mod meshes;
+pub mod rng;
+pub mod tri_tri_sat;
+
 use bevy_app::App;
+use glam::Vec3;
+use urto::geometry::Isometry;
 use urto::prelude::*;
+
+/// A triangle mesh as two arrays, the shape every BVH function takes.
+#[derive(Clone, Debug)]
+pub struct Mesh {
+    pub vertices: Vec<Vec3>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl Mesh {
+    pub fn corners(&self, t: u32) -> [Vec3; 3] {
+        self.triangles[t as usize].map(|i| self.vertices[i as usize])
+    }
+
+    /// The vertices carried by `pose`.
+    pub fn transformed_vertices(&self, pose: &Isometry) -> Vec<Vec3> {
+        self.vertices
+            .iter()
+            .map(|v| pose.transform_point(*v))
+            .collect()
+    }
+
+    /// Radius of the ball about the origin holding the mesh.
+    pub fn radius(&self) -> f32 {
+        self.vertices.iter().fold(0.0, |r, v| r.max(v.length()))
+    }
+
+    /// The mesh moved so its vertices' bounding box is centred on the origin.
+    pub fn centred(mut self) -> Self {
+        let b = urto::bounding::Aabb::from_points(self.vertices.iter().copied());
+        let c = b.center();
+        for v in &mut self.vertices {
+            *v -= c;
+        }
+        self
+    }
+}
+
+/// The leaf test used by the BVH and by brute force alike: triangle `ta` of A (in A's frame)
+/// against triangle `tb` of B, whose vertices were carried into A's frame beforehand.
+pub fn leaf_test<'a>(
+    a: &'a Mesh,
+    b: &'a Mesh,
+    b_vertices_in_a: &'a [Vec3],
+) -> impl FnMut(u32, u32) -> bool + 'a {
+    move |ta, tb| {
+        let ta = a.corners(ta);
+        let tb = b.triangles[tb as usize].map(|i| b_vertices_in_a[i as usize]);
+        tri_tri_sat::triangles_intersect(&ta, &tb)
+    }
+}
+
+/// Every intersecting pair, by testing all of them, sorted.
+pub fn brute_force_pairs(a: &Mesh, b: &Mesh, b_vertices_in_a: &[Vec3]) -> Vec<[u32; 2]> {
+    let mut test = leaf_test(a, b, b_vertices_in_a);
+    let mut out = Vec::new();
+    for ta in 0..a.triangles.len() as u32 {
+        for tb in 0..b.triangles.len() as u32 {
+            if test(ta, tb) {
+                out.push([ta, tb]);
+            }
+        }
+    }
+    out
+}
 
 /// An app with every urto stage and the given step.
 pub fn app_with(dt: f32, substeps: u32) -> App {

@@ -1,0 +1,165 @@
+//! Criterion benchmarks of the hierarchies: build (per BV kind × build rule) and pair queries
+//! (per BV kind × build rule × traversal order, early-out and enumerate-all) on two tori of
+//! about 1k, 20k and 200k triangles each, with parry3d's `TriMesh` build and
+//! `intersection_test` on the same meshes and placements as the rival.
+//!
+//! Sizes: `URTO_BVH_BENCH_SIZES`, a comma-separated subset of `1k,20k,200k` (default: all).
+//! A quick smoke run: `URTO_BVH_BENCH_SIZES=1k cargo bench --bench bvh -- --quick`
+//! (criterion's `--quick`; a filter such as `query_early/obb` narrows further). The full set is
+//! several hundred benchmarks: expect tens of minutes with the default criterion settings.
+
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+use common::Mesh;
+use common::meshes::torus;
+use common::rng::Rng;
+use common::tri_tri_sat::triangles_intersect;
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use std::hint::black_box;
+use urto::bounding::{Aabb, BoundingSphere, Bv, Kdop14, Kdop18, Kdop26, Obb};
+use urto::bvh::{BuildOptions, BuildRule, Bvh, QueryScratch, TraversalOrder};
+use urto::geometry::Isometry;
+
+/// Placements per query benchmark iteration (the same seeded set for every contender).
+const PLACEMENTS: usize = 16;
+
+const RULES: [BuildRule; 2] = [BuildRule::Median, BuildRule::BinnedSah];
+const ORDERS: [TraversalOrder; 3] = [
+    TraversalOrder::DepthFirst,
+    TraversalOrder::BreadthFirst,
+    TraversalOrder::Priority,
+];
+
+/// A benchmark scene: two tori of about `n` triangles and placements of B near A.
+struct Scene {
+    label: &'static str,
+    a: Mesh,
+    b: Mesh,
+    poses: Vec<Isometry>,
+}
+
+fn scene(label: &'static str, n: usize) -> Scene {
+    let nv = ((n as f32 / 2.0 / 2.5).sqrt()).max(3.0) as u32;
+    let nu = (n as u32 / 2 / nv).max(3);
+    let a = torus(1.0, 0.3, nu, nv);
+    let b = torus(0.8, 0.25, nu, nv);
+    let mut rng = Rng::new(2024);
+    let reach = a.radius() + b.radius();
+    let poses = (0..PLACEMENTS).map(|_| rng.placement(reach)).collect();
+    Scene { label, a, b, poses }
+}
+
+fn scenes() -> Vec<Scene> {
+    let wanted = std::env::var("URTO_BVH_BENCH_SIZES").unwrap_or_else(|_| "1k,20k,200k".into());
+    [("1k", 1_000), ("20k", 20_000), ("200k", 200_000)]
+        .into_iter()
+        .filter(|(label, _)| wanted.split(',').any(|w| w.trim() == *label))
+        .map(|(label, n)| scene(label, n))
+        .collect()
+}
+
+/// The leaf test: B's triangle carried into A's frame, then a separating-axis test.
+fn leaf_test<'a>(a: &'a Mesh, b: &'a Mesh, pose: &Isometry) -> impl FnMut(u32, u32) -> bool + 'a {
+    let r = pose.rotation_matrix();
+    let t = pose.translation;
+    move |ta, tb| {
+        let ta = a.corners(ta);
+        let tb = b.corners(tb).map(|v| r * v + t);
+        triangles_intersect(&ta, &tb)
+    }
+}
+
+fn bench_kind<B: Bv>(c: &mut Criterion, kind: &str, s: &Scene) {
+    for rule in RULES {
+        let options = BuildOptions::with_rule(rule);
+        c.bench_function(&format!("build/{kind}/{rule:?}/{}", s.label), |bench| {
+            bench.iter(|| {
+                Bvh::<B>::build(black_box(&s.a.vertices), &s.a.triangles, &options).unwrap()
+            })
+        });
+        let ta = Bvh::<B>::build(&s.a.vertices, &s.a.triangles, &options).unwrap();
+        let tb = Bvh::<B>::build(&s.b.vertices, &s.b.triangles, &options).unwrap();
+        let mut scratch = QueryScratch::new();
+        let mut out = Vec::new();
+        for order in ORDERS {
+            let id = BenchmarkId::new(format!("query_early/{kind}/{rule:?}/{order:?}"), s.label);
+            c.bench_with_input(id, &s.poses, |bench, poses| {
+                bench.iter(|| {
+                    poses
+                        .iter()
+                        .filter(|pose| {
+                            let test = leaf_test(&s.a, &s.b, pose);
+                            ta.first_intersecting_pair(&tb, pose, order, &mut scratch, test)
+                                .0
+                                .is_some()
+                        })
+                        .count()
+                })
+            });
+            let id = BenchmarkId::new(format!("query_all/{kind}/{rule:?}/{order:?}"), s.label);
+            c.bench_with_input(id, &s.poses, |bench, poses| {
+                bench.iter(|| {
+                    let mut pairs = 0;
+                    for pose in poses {
+                        let test = leaf_test(&s.a, &s.b, pose);
+                        ta.intersecting_pairs(&tb, pose, order, &mut scratch, test, &mut out);
+                        pairs += out.len();
+                    }
+                    pairs
+                })
+            });
+        }
+    }
+}
+
+fn bench_parry(c: &mut Criterion, s: &Scene) {
+    use parry3d::math::{Pose, Vector};
+    use parry3d::query::intersection_test;
+    use parry3d::shape::TriMesh;
+    let vertices = |m: &Mesh| -> Vec<Vector> {
+        m.vertices
+            .iter()
+            .map(|p| Vector::new(p.x, p.y, p.z))
+            .collect()
+    };
+    let (va, vb) = (vertices(&s.a), vertices(&s.b));
+    c.bench_function(&format!("build/parry/{}", s.label), |bench| {
+        bench.iter(|| TriMesh::new(black_box(va.clone()), s.a.triangles.clone()).unwrap())
+    });
+    let ma = TriMesh::new(va, s.a.triangles.clone()).unwrap();
+    let mb = TriMesh::new(vb, s.b.triangles.clone()).unwrap();
+    let poses: Vec<Pose> = s
+        .poses
+        .iter()
+        .map(|p| Pose::from_parts(p.translation, p.rotation))
+        .collect();
+    let id = BenchmarkId::new("query_early/parry", s.label);
+    c.bench_with_input(id, &poses, |bench, poses| {
+        bench.iter(|| {
+            poses
+                .iter()
+                .filter(|p| {
+                    intersection_test(&Pose::IDENTITY, &ma, p, &mb)
+                        .unwrap()
+                        .intersecting
+                })
+                .count()
+        })
+    });
+}
+
+fn benches(c: &mut Criterion) {
+    for s in scenes() {
+        bench_parry(c, &s);
+        bench_kind::<BoundingSphere>(c, "sphere", &s);
+        bench_kind::<Aabb>(c, "aabb", &s);
+        bench_kind::<Obb>(c, "obb", &s);
+        bench_kind::<Kdop14>(c, "kdop14", &s);
+        bench_kind::<Kdop18>(c, "kdop18", &s);
+        bench_kind::<Kdop26>(c, "kdop26", &s);
+    }
+}
+
+criterion_group!(bvh, benches);
+criterion_main!(bvh);

@@ -1,0 +1,103 @@
+//! Pair changes for the broad phases that recompute all pairs each commit: keep the previous
+//! sorted list and diff it against the new one in one merge pass.
+
+use super::Pair;
+use std::cmp::Ordering;
+use std::mem::size_of;
+
+/// The current sorted pair list, the next one being built, and their difference.
+#[derive(Debug, Default)]
+pub struct PairHistory {
+    current: Vec<Pair>,
+    next: Vec<Pair>,
+    added: Vec<Pair>,
+    removed: Vec<Pair>,
+}
+
+impl PairHistory {
+    /// The buffer to fill with this commit's pairs (cleared, any order).
+    pub fn begin(&mut self) -> &mut Vec<Pair> {
+        self.next.clear();
+        &mut self.next
+    }
+
+    /// Sorts the filled buffer, makes it current and diffs it against the previous list.
+    pub fn finish(&mut self) {
+        self.next.sort_unstable();
+        self.added.clear();
+        self.removed.clear();
+        diff_sorted(
+            &self.current,
+            &self.next,
+            &mut self.added,
+            &mut self.removed,
+        );
+        std::mem::swap(&mut self.current, &mut self.next);
+    }
+
+    /// The pairs of the last commit, sorted.
+    pub fn current(&self) -> &[Pair] {
+        &self.current
+    }
+
+    /// Pairs in the last commit and not the one before, sorted.
+    pub fn added(&self) -> &[Pair] {
+        &self.added
+    }
+
+    /// Pairs in the commit before the last and not the last, sorted.
+    pub fn removed(&self) -> &[Pair] {
+        &self.removed
+    }
+
+    /// Heap bytes held.
+    pub fn memory_bytes(&self) -> usize {
+        (self.current.capacity()
+            + self.next.capacity()
+            + self.added.capacity()
+            + self.removed.capacity())
+            * size_of::<Pair>()
+    }
+}
+
+/// Appends `new \ old` to `added` and `old \ new` to `removed` (both inputs sorted, no repeats).
+pub fn diff_sorted(old: &[Pair], new: &[Pair], added: &mut Vec<Pair>, removed: &mut Vec<Pair>) {
+    let (mut i, mut j) = (0, 0);
+    while i < old.len() && j < new.len() {
+        match old[i].cmp(&new[j]) {
+            Ordering::Less => {
+                removed.push(old[i]);
+                i += 1;
+            }
+            Ordering::Greater => {
+                added.push(new[j]);
+                j += 1;
+            }
+            Ordering::Equal => {
+                i += 1;
+                j += 1;
+            }
+        }
+    }
+    removed.extend_from_slice(&old[i..]);
+    added.extend_from_slice(&new[j..]);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn diff_finds_both_sides() {
+        let p = |a, b| Pair { a, b };
+        let (mut added, mut removed) = (Vec::new(), Vec::new());
+        diff_sorted(
+            &[p(0, 1), p(0, 3), p(2, 5)],
+            &[p(0, 2), p(0, 3), p(4, 5)],
+            &mut added,
+            &mut removed,
+        );
+        assert_eq!(added, [p(0, 2), p(4, 5)]);
+        assert_eq!(removed, [p(0, 1), p(2, 5)]);
+    }
+}
