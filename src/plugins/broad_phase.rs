@@ -1,8 +1,20 @@
-//! The BroadPhase stage: refits the world-space [`BoundingVolume`] of moved colliders and lists
-//! the candidate pairs whose volumes overlap.
+//! The BroadPhase stage: refits the world-space [`BoundingVolume`] of moved colliders, keeps the
+//! broad-phase structures in step with the world, and lists the candidate pairs.
+//!
+//! - Moving bodies are in an incremental sweep and prune (the slides' §8), fed only the bodies
+//!   whose volume changed, so bodies at rest cost nothing.
+//! - Bounded static scenery is in a hashed uniform grid (the slides' "object vs static scene"):
+//!   indexed once, queried with each moving body's volume; statics never enter the sort.
+//! - Unbounded scenery (grounds, walls) is paired with every moving body.
+//!
+//! The moving-body algorithm is replaceable: any [`BroadPhase`] works, e.g.
+//! `BroadPhasePlugin { moving: || Box::new(SortAndSweep::new()), ..default() }`.
 
-use crate::bounding::Aabb;
+use crate::broad_phase::{
+    AxisTests, BodyKind, BroadPhase, IncrementalSap, ProxyId, StaticGrid, StaticGridConfig,
+};
 use crate::components::*;
+use crate::plugins::proxy_table::{Proxy, ProxyTable};
 use crate::plugins::validation::quarantine;
 use crate::schedule::{SubstepSchedule, SubstepSet};
 use crate::stats::{PhysicsStats, Stage};
@@ -10,26 +22,90 @@ use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
 use std::time::Instant;
 
-/// Keeps bounding volumes fresh and finds candidate pairs.
-#[derive(Debug, Clone, Default)]
-pub struct BroadPhasePlugin;
+/// Makes a fresh moving-body broad phase.
+pub type BroadPhaseFactory = fn() -> Box<dyn BroadPhase + Send + Sync>;
+
+/// Keeps bounding volumes and the broad-phase structures fresh and finds candidate pairs.
+#[derive(Debug, Clone)]
+pub struct BroadPhasePlugin {
+    /// The moving-body algorithm (default: incremental sweep and prune).
+    pub moving: BroadPhaseFactory,
+    /// The static grid's settings (default: cell size chosen from the statics' sizes).
+    pub grid: StaticGridConfig,
+}
+
+impl Default for BroadPhasePlugin {
+    fn default() -> Self {
+        Self {
+            moving: || Box::new(IncrementalSap::<AxisTests>::new()),
+            grid: StaticGridConfig::default(),
+        }
+    }
+}
 
 /// Candidate pairs of this substep; the first entity of a pair is always a moving body.
 #[derive(Resource, Debug, Default, Clone)]
 pub struct BroadPhasePairs {
-    /// The pairs, in a deterministic order.
+    /// The pairs, in a deterministic order: moving–moving, then moving–static, then
+    /// moving–unbounded.
     pub pairs: Vec<(Entity, Entity)>,
+}
+
+/// The broad-phase structures and the entity ↔ id table.
+#[derive(Resource)]
+pub struct BroadPhaseIndex {
+    moving: Box<dyn BroadPhase + Send + Sync>,
+    grid: StaticGrid,
+    grid_config: StaticGridConfig,
+    proxies: ProxyTable,
+    static_batch: Vec<(ProxyId, crate::bounding::Aabb)>,
+    moving_batch: Vec<(ProxyId, crate::bounding::Aabb, BodyKind)>,
+    hits: Vec<u32>,
+}
+
+impl BroadPhaseIndex {
+    fn new(plugin: &BroadPhasePlugin) -> Self {
+        Self {
+            moving: (plugin.moving)(),
+            grid: StaticGrid::new(plugin.grid).unwrap_or_else(|e| {
+                log::error!("urto: bad static grid settings ({e}); using the defaults");
+                // The default configuration is valid by construction, so this cannot fail.
+                StaticGrid::new(StaticGridConfig::default()).expect("default grid config")
+            }),
+            grid_config: plugin.grid,
+            proxies: ProxyTable::default(),
+            static_batch: Vec::new(),
+            moving_batch: Vec::new(),
+            hits: Vec::new(),
+        }
+    }
+
+    /// The static grid (read-only: for debug drawing and queries by game code).
+    pub fn grid(&self) -> &StaticGrid {
+        &self.grid
+    }
+
+    /// The moving-body broad phase.
+    pub fn moving(&self) -> &(dyn BroadPhase + Send + Sync) {
+        self.moving.as_ref()
+    }
 }
 
 impl Plugin for BroadPhasePlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<BroadPhasePairs>().add_systems(
-            SubstepSchedule,
-            (refit_bounding_volumes, find_candidate_pairs)
-                .chain()
-                .run_if(any_with_component::<Collider>)
-                .in_set(SubstepSet::BroadPhase),
-        );
+        app.init_resource::<BroadPhasePairs>()
+            .insert_resource(BroadPhaseIndex::new(self))
+            .add_systems(
+                SubstepSchedule,
+                (
+                    refit_bounding_volumes,
+                    sync_broad_phase,
+                    find_candidate_pairs,
+                )
+                    .chain()
+                    .run_if(any_with_component::<Collider>)
+                    .in_set(SubstepSet::BroadPhase),
+            );
     }
 }
 
@@ -64,33 +140,179 @@ fn refit_bounding_volumes(
     stats.add_time(Stage::BroadPhase, start.elapsed());
 }
 
-/// All moving–moving and moving–static pairs whose AABBs overlap (brute force, O(n²)).
-type ColliderBox<'a> = (Entity, &'a BoundingVolume, Has<Velocity>, Has<Static>);
+/// What the broad phase needs to know of a collider.
+type Indexed<'a> = (
+    Entity,
+    &'a Collider,
+    &'a BoundingVolume,
+    Has<Static>,
+    Has<Velocity>,
+);
+type IndexedRow<'a> = (Entity, &'a Collider, &'a BoundingVolume, bool, bool);
+type IndexChanged = (
+    Without<Quarantined>,
+    Or<(Added<Collider>, Changed<BoundingVolume>)>,
+);
 
+/// Brings the structures in step with the world: registers new colliders (in bulk), moves
+/// changed ones, drops removed, despawned and quarantined ones, then commits.
+#[allow(clippy::too_many_arguments)]
+fn sync_broad_phase(
+    mut index: ResMut<BroadPhaseIndex>,
+    changed: Query<Indexed, IndexChanged>,
+    all: Query<Indexed, Without<Quarantined>>,
+    newly_quarantined: Query<Entity, Added<Quarantined>>,
+    mut removed: RemovedComponents<Collider>,
+    mut released: RemovedComponents<Quarantined>,
+    mut stats: ResMut<PhysicsStats>,
+    mut commands: Commands,
+) {
+    let start = Instant::now();
+    let index = &mut *index;
+    for e in removed.read().chain(newly_quarantined.iter()) {
+        index.forget(e);
+    }
+    let back: Vec<Entity> = released.read().collect();
+    for row in back
+        .iter()
+        .filter_map(|e| all.get(*e).ok())
+        .chain(changed.iter())
+    {
+        index.upsert(row);
+    }
+    index.flush_batches(&mut commands);
+    index.moving.commit();
+    index.proxies.end_step();
+    let steps = index.moving.stats();
+    stats.set_counter("broad_phase/sap_swaps", steps.endpoint_swaps as f64);
+    stats.set_counter("broad_phase/moving_bodies", index.moving.len() as f64);
+    stats.set_counter("broad_phase/static_bodies", index.grid.len() as f64);
+    stats.add_time(Stage::BroadPhase, start.elapsed());
+}
+
+impl BroadPhaseIndex {
+    /// Removes `e` from whichever structure holds it.
+    fn forget(&mut self, e: Entity) {
+        match self.proxies.unregister(e) {
+            Some(Proxy::Moving(id)) => {
+                let _ = self.moving.remove(id);
+            }
+            Some(Proxy::Static(id)) => {
+                let _ = self.grid.remove(id);
+            }
+            Some(Proxy::Unbounded) | None => {}
+        }
+    }
+
+    /// Registers a new collider or moves a known one (re-registering it if its kind changed).
+    fn upsert(&mut self, (e, collider, bv, is_static, has_velocity): IndexedRow) {
+        let bounded = !collider.shape.is_unbounded();
+        let moving = has_velocity && !is_static;
+        let wanted = |p: Proxy| match p {
+            Proxy::Moving(_) => bounded && moving,
+            Proxy::Static(_) => bounded && !moving,
+            Proxy::Unbounded => !bounded,
+        };
+        match self.proxies.get(e) {
+            Some(Proxy::Moving(id)) if wanted(Proxy::Moving(id)) => {
+                let _ = self.moving.update(id, bv.0);
+            }
+            Some(Proxy::Static(id)) if wanted(Proxy::Static(id)) => {
+                let _ = self.grid.update(id, bv.0);
+            }
+            Some(Proxy::Unbounded) if !bounded => {}
+            known => {
+                if known.is_some() {
+                    self.forget(e);
+                }
+                match self.proxies.register(e, bounded, moving) {
+                    Proxy::Moving(id) => self.moving_batch.push((id, bv.0, BodyKind::Dynamic)),
+                    Proxy::Static(id) => self.static_batch.push((id, bv.0)),
+                    Proxy::Unbounded => {}
+                }
+            }
+        }
+    }
+
+    /// Inserts the step's new bodies in bulk; the first statics also choose the grid's cell size.
+    fn flush_batches(&mut self, commands: &mut Commands) {
+        if !self.moving_batch.is_empty() {
+            if let Err(err) = self.moving.insert_bulk(&self.moving_batch) {
+                // One bad body must not keep the others out: fall back to one by one.
+                log::warn!("urto: broad phase bulk insert failed ({err}); inserting one by one");
+                for &(id, aabb, kind) in &self.moving_batch {
+                    if let Err(err) = self.moving.insert(id, aabb, kind) {
+                        let e = self.proxies.entity(id);
+                        self.proxies.unregister(e);
+                        quarantine(commands, e, format!("broad phase refused it: {err}"));
+                    }
+                }
+            }
+            self.moving_batch.clear();
+        }
+        if !self.static_batch.is_empty() {
+            let result = if self.grid.is_empty() && self.grid_config.cell_size.is_none() {
+                StaticGrid::build_with(&self.static_batch, self.grid_config).map(|g| self.grid = g)
+            } else {
+                self.grid.insert_bulk(&self.static_batch)
+            };
+            if let Err(err) = result {
+                log::warn!("urto: static grid bulk insert failed ({err}); inserting one by one");
+                for &(id, aabb) in &self.static_batch {
+                    if let Err(err) = self.grid.insert(id, aabb) {
+                        let e = self.proxies.entity(id);
+                        self.proxies.unregister(e);
+                        quarantine(commands, e, format!("static grid refused it: {err}"));
+                    }
+                }
+            }
+            self.static_batch.clear();
+        }
+    }
+}
+
+/// Moving–moving pairs from the sweep and prune, then each moving body against the statics its
+/// volume's grid cells list, then against every unbounded collider.
 fn find_candidate_pairs(
-    colliders: Query<ColliderBox, (With<Collider>, Without<Quarantined>)>,
+    mut index: ResMut<BroadPhaseIndex>,
     mut out: ResMut<BroadPhasePairs>,
     mut stats: ResMut<PhysicsStats>,
 ) {
     let start = Instant::now();
-    let mut moving: Vec<(Entity, Aabb)> = Vec::new();
-    let mut fixed: Vec<(Entity, Aabb)> = Vec::new();
-    for (e, bv, has_velocity, is_static) in &colliders {
-        if has_velocity && !is_static {
-            moving.push((e, bv.0));
-        } else {
-            fixed.push((e, bv.0));
-        }
-    }
+    let index = &mut *index;
     out.pairs.clear();
-    for (i, (a, box_a)) in moving.iter().enumerate() {
-        for (b, box_b) in moving[i + 1..].iter().chain(fixed.iter()) {
-            if box_a.intersects(box_b) {
-                out.pairs.push((*a, *b));
+    let proxies = &index.proxies;
+    out.pairs.extend(
+        index
+            .moving
+            .pairs()
+            .iter()
+            .map(|p| (proxies.entity(p.a), proxies.entity(p.b))),
+    );
+    let moving_pairs = out.pairs.len();
+    let mut cells = 0usize;
+    if !index.grid.is_empty() || !proxies.unbounded().is_empty() {
+        for id in proxies.moving_ids() {
+            let (Some(aabb), e) = (index.moving.aabb(id), proxies.entity(id)) else {
+                continue;
+            };
+            if !index.grid.is_empty()
+                && let Ok(q) = index.grid.query(&aabb, &mut index.hits)
+            {
+                cells += q.cells_visited;
+                out.pairs
+                    .extend(index.hits.iter().map(|&s| (e, proxies.entity(s))));
             }
+            out.pairs
+                .extend(proxies.unbounded().iter().map(|&u| (e, u)));
         }
     }
-    stats.set_counter("broad_phase/pairs", out.pairs.len() as f64);
+    stats.set_counter("broad_phase/pairs", moving_pairs as f64);
+    stats.set_counter(
+        "broad_phase/static_pairs",
+        (out.pairs.len() - moving_pairs) as f64,
+    );
+    stats.set_counter("broad_phase/grid_cells_visited", cells as f64);
     stats.add_time(Stage::BroadPhase, start.elapsed());
     stats.count_run("broad_phase");
 }

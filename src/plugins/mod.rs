@@ -17,10 +17,11 @@ pub mod core;
 pub mod forces;
 pub mod integration;
 pub mod narrow_phase;
+mod proxy_table;
 pub mod response;
 pub mod validation;
 
-pub use broad_phase::{BroadPhasePairs, BroadPhasePlugin};
+pub use broad_phase::{BroadPhaseIndex, BroadPhasePairs, BroadPhasePlugin};
 pub use core::{PhysicsCorePlugin, StepError, step};
 pub use forces::{ForcesPlugin, GatheredForces};
 pub use integration::IntegrationPlugin;
@@ -59,7 +60,7 @@ impl PluginGroup for UrtoPlugins {
             .add(ValidationPlugin)
             .add(ForcesPlugin)
             .add(IntegrationPlugin)
-            .add(BroadPhasePlugin)
+            .add(BroadPhasePlugin::default())
             .add(NarrowPhasePlugin)
             .add(ResponsePlugin)
     }

@@ -1,0 +1,271 @@
+//! Collisions through the whole plugin: the broad phase finds exactly the overlapping pairs,
+//! impulses conserve momentum (and energy when elastic), restitution returns the right fraction,
+//! and game code hears when collisions start and end.
+
+mod common;
+
+use bevy_ecs::message::Messages;
+use bevy_ecs::prelude::*;
+use common::rng::Rng;
+use glam::Vec3;
+use std::collections::BTreeSet;
+use urto::plugins::BroadPhasePairs;
+use urto::prelude::*;
+
+fn ball(app: &mut bevy_app::App, at: Vec3, v: Vec3, m: f32, e: f32) -> Entity {
+    app.world_mut()
+        .spawn((
+            Collider::sphere(0.5),
+            Position(at),
+            Velocity(v),
+            Mass(m),
+            Restitution(e),
+        ))
+        .id()
+}
+
+fn velocity(app: &bevy_app::App, e: Entity) -> Vec3 {
+    app.world().get::<Velocity>(e).unwrap().0
+}
+
+#[test]
+fn a_head_on_elastic_collision_conserves_momentum_and_energy() {
+    let mut app = common::app();
+    let (ma, mb) = (1.0, 3.0);
+    let a = ball(
+        &mut app,
+        Vec3::new(-2.0, 0.0, 0.0),
+        Vec3::new(4.0, 0.3, 0.0),
+        ma,
+        1.0,
+    );
+    let b = ball(
+        &mut app,
+        Vec3::new(2.0, 0.0, 0.1),
+        Vec3::new(-2.0, 0.0, 0.0),
+        mb,
+        1.0,
+    );
+    let momentum = |app: &bevy_app::App| velocity(app, a) * ma + velocity(app, b) * mb;
+    let energy = |app: &bevy_app::App| {
+        0.5 * (ma * velocity(app, a).length_squared() + mb * velocity(app, b).length_squared())
+    };
+    let (p0, e0) = (momentum(&app), energy(&app));
+    urto::step(app.world_mut(), 120).unwrap();
+    assert!((momentum(&app) - p0).length() < 1e-4 * p0.length().max(1.0));
+    assert!(
+        (energy(&app) / e0 - 1.0).abs() < 1e-4,
+        "{} vs {e0}",
+        energy(&app)
+    );
+    assert!(velocity(&app, a).x < 0.0, "the light ball bounced back");
+}
+
+#[test]
+fn restitution_returns_its_fraction_of_the_closing_speed() {
+    for e in [0.0, 0.25, 0.5, 0.9] {
+        let mut app = common::app();
+        let a = ball(
+            &mut app,
+            Vec3::new(-1.0, 0.0, 0.0),
+            Vec3::new(3.0, 0.0, 0.0),
+            2.0,
+            e,
+        );
+        let b = ball(
+            &mut app,
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(-1.0, 0.0, 0.0),
+            1.0,
+            e,
+        );
+        urto::step(app.world_mut(), 60).unwrap();
+        let separating = velocity(&app, b).x - velocity(&app, a).x;
+        assert!((separating - e * 4.0).abs() < 1e-4, "e = {e}: {separating}");
+    }
+}
+
+#[test]
+fn many_colliding_balls_conserve_total_momentum() {
+    let mut app = common::app();
+    let mut rng = Rng::new(11);
+    let balls: Vec<(Entity, f32)> = (0..60)
+        .map(|_| {
+            let m = rng.range(0.5, 4.0);
+            let e = ball(
+                &mut app,
+                rng.in_ball(4.0),
+                rng.in_ball(3.0),
+                m,
+                rng.range(0.2, 1.0),
+            );
+            (e, m)
+        })
+        .collect();
+    let total = |app: &bevy_app::App| {
+        balls
+            .iter()
+            .map(|(e, m)| velocity(app, *e) * *m)
+            .sum::<Vec3>()
+    };
+    let p0 = total(&app);
+    let mut contacts = 0.0;
+    for _ in 0..120 {
+        urto::step(app.world_mut(), 1).unwrap();
+        contacts += app
+            .world()
+            .resource::<PhysicsStats>()
+            .counter("narrow_phase/contacts")
+            .unwrap_or(0.0);
+    }
+    assert!(
+        contacts > 20.0,
+        "the scene must actually collide ({contacts} contacts)"
+    );
+    assert!(
+        (total(&app) - p0).length() < 1e-3,
+        "{} vs {p0}",
+        total(&app)
+    );
+}
+
+#[test]
+fn a_ball_dropped_on_the_ground_rebounds_with_restitution() {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    app.world_mut()
+        .spawn((Collider::half_space(Vec3::Z), Static, Restitution(0.6)));
+    let b = ball(&mut app, Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, 1.0, 0.6);
+    let mut before = 0.0f32;
+    for _ in 0..120 {
+        let v = velocity(&app, b).z;
+        urto::step(app.world_mut(), 1).unwrap();
+        let after = velocity(&app, b).z;
+        if v < 0.0 && after > 0.0 {
+            // Integration runs before response: the ball hit the ground at v - g dt.
+            before = v - 9.8 / 60.0;
+            assert!((after / -before - 0.6).abs() < 1e-3, "{after} / {before}");
+            break;
+        }
+    }
+    assert!(before < -5.0, "the ball must have hit the ground fast");
+}
+
+#[test]
+fn collision_messages_report_each_touch_once() {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    let ground = app
+        .world_mut()
+        .spawn((Collider::half_space(Vec3::Z), Static, Restitution(0.8)))
+        .id();
+    let b = ball(&mut app, Vec3::new(0.0, 0.0, 2.0), Vec3::ZERO, 1.0, 0.8);
+    let (mut started, mut ended) = (0, 0);
+    let mut cursor_s = app
+        .world()
+        .resource::<Messages<CollisionStarted>>()
+        .get_cursor();
+    let mut cursor_e = app
+        .world()
+        .resource::<Messages<CollisionEnded>>()
+        .get_cursor();
+    for _ in 0..150 {
+        urto::step(app.world_mut(), 1).unwrap();
+        let w = app.world();
+        for m in cursor_s.read(w.resource::<Messages<CollisionStarted>>()) {
+            assert_eq!((m.a.min(m.b), m.a.max(m.b)), (ground.min(b), ground.max(b)));
+            started += 1;
+            assert_eq!(started, ended + 1, "a start must follow an end");
+        }
+        for _ in cursor_e.read(w.resource::<Messages<CollisionEnded>>()) {
+            ended += 1;
+            assert_eq!(ended, started, "an end must follow a start");
+        }
+    }
+    assert!(started >= 2, "the ball bounced at least twice: {started}");
+}
+
+/// Every pair the broad phase reports overlaps, and every overlapping pair with a moving body
+/// is reported — while bodies move, spawn, despawn and get quarantined.
+#[test]
+fn broad_phase_pairs_equal_brute_force_under_churn() {
+    let mut app = common::app();
+    let mut rng = Rng::new(5);
+    app.world_mut()
+        .spawn((Collider::half_space(Vec3::Z), Static));
+    for _ in 0..40 {
+        let h = Vec3::new(
+            rng.range(0.2, 2.0),
+            rng.range(0.2, 2.0),
+            rng.range(0.2, 1.0),
+        );
+        app.world_mut().spawn((
+            Collider::cuboid(h.x, h.y, h.z),
+            Position(rng.in_ball(15.0)),
+            Static,
+        ));
+    }
+    let mut moving: Vec<Entity> = Vec::new();
+    for step in 0..200 {
+        if step % 3 == 0 {
+            let shape = if rng.range(0.0, 1.0) < 0.5 {
+                Collider::sphere(rng.range(0.2, 1.0))
+            } else {
+                Collider::cuboid(
+                    rng.range(0.2, 1.0),
+                    rng.range(0.2, 1.0),
+                    rng.range(0.2, 1.0),
+                )
+            };
+            let e = app
+                .world_mut()
+                .spawn((
+                    shape,
+                    Position(rng.in_ball(12.0)),
+                    Velocity(rng.in_ball(6.0)),
+                ))
+                .id();
+            moving.push(e);
+        }
+        if step % 7 == 0 && moving.len() > 4 {
+            let victim = moving.remove(rng.below(moving.len()));
+            app.world_mut().despawn(victim);
+        }
+        if step == 50 {
+            app.world_mut().get_mut::<Position>(moving[1]).unwrap().0.x = f32::NAN;
+        }
+        urto::step(app.world_mut(), 1).unwrap();
+        assert_eq!(
+            reported_pairs(&mut app),
+            brute_force_pairs(&mut app),
+            "step {step}"
+        );
+    }
+}
+
+fn reported_pairs(app: &mut bevy_app::App) -> BTreeSet<(Entity, Entity)> {
+    let pairs = &app.world().resource::<BroadPhasePairs>().pairs;
+    let set: BTreeSet<_> = pairs.iter().map(|&(a, b)| (a.min(b), a.max(b))).collect();
+    assert_eq!(set.len(), pairs.len(), "no pair twice");
+    set
+}
+
+fn brute_force_pairs(app: &mut bevy_app::App) -> BTreeSet<(Entity, Entity)> {
+    let mut q = app.world_mut().query_filtered::<
+        (Entity, &BoundingVolume, Has<Velocity>, Has<Static>),
+        (With<Collider>, Without<Quarantined>),
+    >();
+    let bodies: Vec<_> = q
+        .iter(app.world())
+        .map(|(e, b, v, s)| (e, b.0, v && !s))
+        .collect();
+    let mut set = BTreeSet::new();
+    for (i, (a, ba, ma)) in bodies.iter().enumerate() {
+        for (b, bb, mb) in &bodies[i + 1..] {
+            if (*ma || *mb) && ba.intersects(bb) {
+                set.insert(((*a).min(*b), (*a).max(*b)));
+            }
+        }
+    }
+    set
+}
