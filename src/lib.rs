@@ -34,6 +34,7 @@ pub mod components;
 pub mod debug;
 pub mod dynamics;
 pub mod geometry;
+pub mod hierarchy;
 pub mod plugins;
 pub mod schedule;
 pub mod settings;
