@@ -29,8 +29,11 @@ use crate::geometry::{Isometry, Shape};
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
 
-/// Where a body is: the world position of its origin (centre of mass).
+/// Where a body is: the position of its origin (centre of mass) in its parent's frame — the
+/// world for a body without [`ChildOf`](bevy_ecs::hierarchy::ChildOf), the parent body for a
+/// part of a compound (a wheel of a car, a link of an arm).
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+#[require(Rotation, GlobalPose, BoundingVolume)]
 pub struct Position(pub Vec3);
 
 impl Position {
@@ -40,7 +43,8 @@ impl Position {
     }
 }
 
-/// Orientation of a body's collider; identity when absent. Bodies do not spin by themselves
+/// Orientation of a body's collider in its parent's frame (see [`Position`]); identity when
+/// absent. Bodies do not spin by themselves
 /// (contacts act through the centre of mass); set it to place boxes and planes.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 pub struct Rotation(pub Quat);
@@ -126,7 +130,7 @@ pub struct Restitution(pub f32);
 
 /// The shape a body collides with, in the body's frame.
 #[derive(Component, Clone, Debug, PartialEq)]
-#[require(Position, Rotation, BoundingVolume)]
+#[require(Position)]
 pub struct Collider {
     /// The shape.
     pub shape: Shape,
@@ -155,9 +159,16 @@ impl Collider {
     }
 }
 
-/// The world-space AABB the broad phase reads, kept up to date by the physics step.
+/// The world-space AABB the broad phase reads, kept up to date by the physics step. In a
+/// hierarchy it bounds the node's own collider *and* all its descendants (the scene graph is the
+/// BV hierarchy); empty for a body with no collider at or below it.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 pub struct BoundingVolume(pub Aabb);
+
+/// The world pose of a body, derived each substep from [`Position`] and [`Rotation`]: a root's
+/// own, or its parent's world pose composed with its local one. Read it, don't write it.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct GlobalPose(pub Isometry);
 
 /// Marks scenery that never moves.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -9,7 +9,9 @@
 //! 3. [`PhysicsSet::Substeps`] — run [`SubstepSchedule`] `substeps` times with `dt / substeps`
 //!    (the slides' brute-force cure for late contacts and tunnelling):
 //!    1. [`SubstepSet::Integrate`] — advance positions and velocities.
-//!    2. [`SubstepSet::BroadPhase`] — refit bounding volumes of moved bodies, find candidate pairs.
+//!    2. [`SubstepSet::BroadPhase`] — propagate world poses down hierarchies, refit bounding
+//!       volumes up them (only where something moved), update the broad-phase structures, list
+//!       candidate pairs ([`BroadPhaseSystems`]).
 //!    3. [`SubstepSet::NarrowPhase`] — exact tests on the candidates, producing contacts.
 //!    4. [`SubstepSet::Response`] — impulses and position correction; collision messages.
 //! 4. [`PhysicsSet::Debug`] — consumers of the finished step (the rerun recording). Nothing
@@ -40,6 +42,19 @@ pub enum PhysicsSet {
     Substeps,
     /// Debug output (read-only consumers).
     Debug,
+}
+
+/// The steps of [`SubstepSet::BroadPhase`], chained in this order.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum BroadPhaseSystems {
+    /// World poses propagate down hierarchies.
+    Poses,
+    /// Bounding volumes refit up hierarchies, only along changed paths.
+    Refit,
+    /// The broad-phase structures follow the world (insert, move, remove).
+    Index,
+    /// Candidate pairs are listed.
+    Pairs,
 }
 
 /// The sets of [`SubstepSchedule`], chained in this order.

@@ -1,5 +1,6 @@
-//! The BroadPhase stage: refits the world-space [`BoundingVolume`] of moved colliders, keeps the
-//! broad-phase structures in step with the world, and lists the candidate pairs.
+//! The BroadPhase stage (after [`HierarchyPlugin`](crate::plugins::HierarchyPlugin) refit the
+//! bounding volumes): keeps the broad-phase structures in step with the world and lists the
+//! candidate pairs of root bodies.
 //!
 //! - Moving bodies are in an incremental sweep and prune (the slides' §8), fed only the bodies
 //!   whose volume changed, so bodies at rest cost nothing.
@@ -16,7 +17,7 @@ use crate::broad_phase::{
 use crate::components::*;
 use crate::plugins::proxy_table::{Proxy, ProxyTable};
 use crate::plugins::validation::quarantine;
-use crate::schedule::{SubstepSchedule, SubstepSet};
+use crate::schedule::{BroadPhaseSystems, SubstepSchedule};
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
@@ -98,84 +99,44 @@ impl Plugin for BroadPhasePlugin {
             .add_systems(
                 SubstepSchedule,
                 (
-                    refit_bounding_volumes,
-                    sync_broad_phase,
-                    find_candidate_pairs,
+                    sync_broad_phase.in_set(BroadPhaseSystems::Index),
+                    find_candidate_pairs.in_set(BroadPhaseSystems::Pairs),
                 )
-                    .chain()
-                    .run_if(any_with_component::<Collider>)
-                    .in_set(SubstepSet::BroadPhase),
+                    .run_if(any_with_component::<Collider>),
             );
     }
 }
 
-type Moved = (
-    Without<Quarantined>,
-    Or<(Changed<Position>, Changed<Rotation>, Changed<Collider>)>,
-);
+/// What the broad phase needs to know of a root body.
+type Indexed<'a> = (Entity, &'a BoundingVolume, Has<Static>, Has<Velocity>);
+type IndexedRow<'a> = (Entity, &'a BoundingVolume, bool, bool);
+type Root = (Without<ChildOf>, Without<Quarantined>);
+type NoLongerRoot = Or<(Added<Quarantined>, Changed<ChildOf>)>;
 
-/// Recomputes the world AABB of colliders whose pose or shape changed; a non-finite result
-/// (a bounded shape at an overflowing pose) quarantines the body.
-fn refit_bounding_volumes(
-    mut colliders: Query<(Entity, &Collider, &Position, &Rotation, &mut BoundingVolume), Moved>,
-    mut stats: ResMut<PhysicsStats>,
-    mut commands: Commands,
-) {
-    let start = Instant::now();
-    let mut refits = 0u32;
-    for (entity, collider, p, r, mut bv) in &mut colliders {
-        let aabb = collider.shape.world_aabb(&pose(p, Some(r)));
-        if !collider.shape.is_unbounded() && !aabb.is_finite() {
-            quarantine(
-                &mut commands,
-                entity,
-                format!("bounding volume is not finite: {aabb:?}"),
-            );
-            continue;
-        }
-        bv.set_if_neq(BoundingVolume(aabb));
-        refits += 1;
-    }
-    stats.set_counter("broad_phase/refits", refits as f64);
-    stats.add_time(Stage::BroadPhase, start.elapsed());
-}
-
-/// What the broad phase needs to know of a collider.
-type Indexed<'a> = (
-    Entity,
-    &'a Collider,
-    &'a BoundingVolume,
-    Has<Static>,
-    Has<Velocity>,
-);
-type IndexedRow<'a> = (Entity, &'a Collider, &'a BoundingVolume, bool, bool);
-type IndexChanged = (
-    Without<Quarantined>,
-    Or<(Added<Collider>, Changed<BoundingVolume>)>,
-);
-
-/// Brings the structures in step with the world: registers new colliders (in bulk), moves
-/// changed ones, drops removed, despawned and quarantined ones, then commits.
+/// Brings the structures in step with the world: registers new roots (in bulk), moves changed
+/// ones, drops removed, despawned, quarantined and re-parented ones, then commits. Only roots of
+/// hierarchies are indexed; their volume bounds their whole compound body.
 #[allow(clippy::too_many_arguments)]
 fn sync_broad_phase(
     mut index: ResMut<BroadPhaseIndex>,
-    changed: Query<Indexed, IndexChanged>,
-    all: Query<Indexed, Without<Quarantined>>,
-    newly_quarantined: Query<Entity, Added<Quarantined>>,
-    mut removed: RemovedComponents<Collider>,
+    changed: Query<Indexed, (Root, Changed<BoundingVolume>)>,
+    roots: Query<Indexed, Root>,
+    gone: Query<Entity, NoLongerRoot>,
+    mut despawned: RemovedComponents<BoundingVolume>,
     mut released: RemovedComponents<Quarantined>,
+    mut orphaned: RemovedComponents<ChildOf>,
     mut stats: ResMut<PhysicsStats>,
     mut commands: Commands,
 ) {
     let start = Instant::now();
     let index = &mut *index;
-    for e in removed.read().chain(newly_quarantined.iter()) {
+    for e in despawned.read().chain(gone.iter()) {
         index.forget(e);
     }
-    let back: Vec<Entity> = released.read().collect();
+    let back: Vec<Entity> = released.read().chain(orphaned.read()).collect();
     for row in back
         .iter()
-        .filter_map(|e| all.get(*e).ok())
+        .filter_map(|e| roots.get(*e).ok())
         .chain(changed.iter())
     {
         index.upsert(row);
@@ -204,9 +165,14 @@ impl BroadPhaseIndex {
         }
     }
 
-    /// Registers a new collider or moves a known one (re-registering it if its kind changed).
-    fn upsert(&mut self, (e, collider, bv, is_static, has_velocity): IndexedRow) {
-        let bounded = !collider.shape.is_unbounded();
+    /// Registers a new root or moves a known one (re-registering it if its kind changed); a
+    /// root with nothing to collide (an empty volume) is dropped.
+    fn upsert(&mut self, (e, bv, is_static, has_velocity): IndexedRow) {
+        if !bv.0.is_valid() {
+            self.forget(e);
+            return;
+        }
+        let bounded = bv.0.is_finite();
         let moving = has_velocity && !is_static;
         let wanted = |p: Proxy| match p {
             Proxy::Moving(_) => bounded && moving,

@@ -1,7 +1,9 @@
 //! The core plugin: schedules, settings, statistics, and the two ways a step is driven —
 //! Bevy's fixed-timestep loop in an `App`, or [`step`] on a standalone world.
 
-use crate::schedule::{PhysicsSchedule, PhysicsSet, SubstepSchedule, SubstepSet};
+use crate::schedule::{
+    BroadPhaseSystems, PhysicsSchedule, PhysicsSet, SubstepSchedule, SubstepSet,
+};
 use crate::settings::{ContactSettings, Integration, PhysicsTimestep};
 use crate::stats::PhysicsStats;
 use bevy_app::prelude::*;
@@ -62,6 +64,16 @@ impl Plugin for PhysicsCorePlugin {
                 SubstepSet::Response,
             )
                 .chain(),
+        );
+        substep.configure_sets(
+            (
+                BroadPhaseSystems::Poses,
+                BroadPhaseSystems::Refit,
+                BroadPhaseSystems::Index,
+                BroadPhaseSystems::Pairs,
+            )
+                .chain()
+                .in_set(SubstepSet::BroadPhase),
         );
         app.add_schedule(substep);
 

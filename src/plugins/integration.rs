@@ -43,7 +43,7 @@ struct IntegrationBuffers {
 }
 
 type Moving<'a> = (Entity, &'a mut Position, &'a mut Velocity, &'a Mass);
-type MovingFilter = (Without<Static>, Without<Quarantined>);
+type MovingFilter = (Without<Static>, Without<Quarantined>, Without<ChildOf>);
 
 fn integrate_bodies(
     mut queries: ParamSet<(Query<Moving, MovingFilter>, Query<&Position>)>,

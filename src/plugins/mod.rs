@@ -15,6 +15,7 @@
 pub mod broad_phase;
 pub mod core;
 pub mod forces;
+pub mod hierarchy;
 pub mod integration;
 pub mod narrow_phase;
 mod proxy_table;
@@ -24,6 +25,7 @@ pub mod validation;
 pub use broad_phase::{BroadPhaseIndex, BroadPhasePairs, BroadPhasePlugin};
 pub use core::{PhysicsCorePlugin, StepError, step};
 pub use forces::{ForcesPlugin, GatheredForces};
+pub use hierarchy::HierarchyPlugin;
 pub use integration::IntegrationPlugin;
 pub use narrow_phase::{ContactPair, Contacts, NarrowPhasePlugin};
 pub use response::{CollisionEnded, CollisionStarted, ResponsePlugin};
@@ -60,6 +62,7 @@ impl PluginGroup for UrtoPlugins {
             .add(ValidationPlugin)
             .add(ForcesPlugin)
             .add(IntegrationPlugin)
+            .add(HierarchyPlugin)
             .add(BroadPhasePlugin::default())
             .add(NarrowPhasePlugin)
             .add(ResponsePlugin)

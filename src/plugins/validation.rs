@@ -1,7 +1,8 @@
 //! The Prepare stage: bad input is set aside before it can spread.
 //!
 //! A body whose state is unusable — a NaN or infinite position, velocity, force or rotation, a
-//! zero, negative or NaN mass, a shape with impossible numbers — gets a
+//! zero, negative or NaN mass, a shape with impossible numbers, a part of a compound body with a
+//! velocity of its own — gets a
 //! [`Quarantined`] marker and a logged warning. Every other stage filters quarantined
 //! entities out, so their NaN never reaches a neighbour through a contact or a spring. Only
 //! added or changed components are checked, so a scene at rest costs nothing here.
@@ -35,6 +36,7 @@ type BodyData<'a> = (
     Option<&'a Rotation>,
     Option<&'a Collider>,
     Option<&'a Force>,
+    Has<ChildOf>,
 );
 
 type ChangedBody = (
@@ -46,6 +48,7 @@ type ChangedBody = (
         Changed<Rotation>,
         Changed<Collider>,
         Changed<Force>,
+        Changed<ChildOf>,
     )>,
 );
 
@@ -55,8 +58,15 @@ fn quarantine_invalid_bodies(
     mut commands: Commands,
 ) {
     stats.time(Stage::Prepare, "prepare/validate", || {
-        for (entity, p, v, m, r, c, f) in &bodies {
-            if let Some(reason) = why_invalid(p, v, m, r, c, f) {
+        for (entity, p, v, m, r, c, f, is_child) in &bodies {
+            let reason = why_invalid(p, v, m, r, c, f).or_else(|| {
+                (is_child && v.is_some()).then(|| {
+                    "a part of a compound body cannot have its own Velocity: it moves with its \
+                     root (remove the Velocity, or the ChildOf)"
+                        .to_string()
+                })
+            });
+            if let Some(reason) = reason {
                 quarantine(&mut commands, entity, reason);
             }
         }

@@ -1,0 +1,222 @@
+//! The scene graph as the BV hierarchy: volumes bound their subtrees, refits touch only what
+//! changed, and re-parenting or despawning keeps the broad phase consistent.
+
+mod common;
+
+use bevy_app::App;
+use bevy_ecs::prelude::*;
+use glam::{Quat, Vec3};
+use urto::bounding::Aabb;
+use urto::plugins::BroadPhasePairs;
+use urto::prelude::*;
+
+fn refits(app: &App) -> f64 {
+    let stats = app.world().resource::<PhysicsStats>();
+    stats.counter("hierarchy/refits").unwrap_or(0.0)
+}
+
+fn bv(app: &App, e: Entity) -> Aabb {
+    app.world().get::<BoundingVolume>(e).unwrap().0
+}
+
+/// A static block of `n` houses in a row under one root with no collider of its own.
+fn town_block(app: &mut App, n: usize, at: Vec3) -> (Entity, Vec<Entity>) {
+    let root = app.world_mut().spawn((Position(at), Static)).id();
+    let houses = (0..n)
+        .map(|i| {
+            app.world_mut()
+                .spawn((
+                    Collider::cuboid(0.4, 0.4, 0.5),
+                    Position::new(i as f32, 0.0, 0.5),
+                    Static,
+                    ChildOf(root),
+                ))
+                .id()
+        })
+        .collect();
+    (root, houses)
+}
+
+/// A car: a box chassis with four sphere wheels, moving along +x.
+fn car(app: &mut App, at: Vec3) -> (Entity, Vec<Entity>) {
+    let chassis = app
+        .world_mut()
+        .spawn((
+            Collider::cuboid(1.0, 0.5, 0.25),
+            Position(at),
+            Velocity::new(2.0, 0.0, 0.0),
+        ))
+        .id();
+    let wheels = [(-0.7, -0.6), (-0.7, 0.6), (0.7, -0.6), (0.7, 0.6)]
+        .map(|(x, y)| {
+            app.world_mut()
+                .spawn((
+                    Collider::sphere(0.3),
+                    Position::new(x, y, -0.25),
+                    ChildOf(chassis),
+                ))
+                .id()
+        })
+        .to_vec();
+    (chassis, wheels)
+}
+
+#[test]
+fn refits_touch_only_changed_branches() {
+    let mut app = common::app();
+    let (block, houses) = town_block(&mut app, 200, Vec3::new(0.0, 10.0, 0.0));
+    let (chassis, wheels) = car(&mut app, Vec3::ZERO);
+    urto::step(app.world_mut(), 2).unwrap();
+    // Steady state: the car (chassis + 4 wheels) refits every step, the town never.
+    urto::step(app.world_mut(), 1).unwrap();
+    assert_eq!(refits(&app), 5.0);
+    // One house is moved by game code: that house and its block root, nothing else.
+    app.world_mut()
+        .entity_mut(chassis)
+        .insert(Velocity::default());
+    app.world_mut().get_mut::<Position>(houses[17]).unwrap().0.z = 3.0;
+    urto::step(app.world_mut(), 1).unwrap();
+    assert_eq!(refits(&app), 2.0);
+    assert!(
+        bv(&app, block).max.z >= 3.5 - 1e-6,
+        "the block grew with its house"
+    );
+    urto::step(app.world_mut(), 1).unwrap();
+    assert_eq!(refits(&app), 0.0, "nothing moved");
+    // A wheel turns (local rotation): the wheel and the chassis.
+    app.world_mut().get_mut::<Rotation>(wheels[0]).unwrap().0 = Quat::from_rotation_y(0.5);
+    urto::step(app.world_mut(), 1).unwrap();
+    assert_eq!(refits(&app), 2.0);
+}
+
+fn assert_bounds_subtree(app: &mut App, root: Entity) {
+    let mut stack = vec![root];
+    while let Some(e) = stack.pop() {
+        let node = bv(app, e);
+        let world = app.world();
+        if let (Some(c), Some(g)) = (world.get::<Collider>(e), world.get::<GlobalPose>(e)) {
+            let own = c.shape.world_aabb(&g.0);
+            assert!(
+                node.expanded(1e-4).contains(&own),
+                "{e}: own collider outside its volume"
+            );
+        }
+        if let Some(children) = world.get::<Children>(e) {
+            for c in children.iter() {
+                assert!(
+                    node.expanded(1e-4).contains(&bv(app, c)),
+                    "{e}: child {c} outside"
+                );
+                stack.push(c);
+            }
+        }
+    }
+}
+
+#[test]
+fn deep_and_wide_hierarchies_bound_their_descendants_as_they_move() {
+    let mut app = common::app();
+    // Depth 8: an arm of links, each turned and offset from its parent.
+    let base = app
+        .world_mut()
+        .spawn((
+            Collider::cuboid(0.5, 0.5, 0.2),
+            Position::default(),
+            Velocity::new(0.0, 1.0, 0.5),
+        ))
+        .id();
+    let mut parent = base;
+    for depth in 1..=8 {
+        parent = app
+            .world_mut()
+            .spawn((
+                Collider::cuboid(0.1, 0.1, 0.4),
+                Position::new(0.0, 0.0, 0.8),
+                Rotation(Quat::from_rotation_x(0.3 * depth as f32)),
+                ChildOf(parent),
+            ))
+            .id();
+    }
+    // Width 1000: a block of houses.
+    let (block, _) = town_block(&mut app, 1000, Vec3::new(5.0, 0.0, 0.0));
+    for _ in 0..30 {
+        urto::step(app.world_mut(), 1).unwrap();
+        assert_bounds_subtree(&mut app, base);
+    }
+    assert_bounds_subtree(&mut app, block);
+    let tip = app.world().get::<GlobalPose>(parent).unwrap().0.translation;
+    assert!(bv(&app, base).contains_point(tip));
+    assert!(bv(&app, block).extents().x > 999.0);
+}
+
+fn pairs(app: &App) -> Vec<(Entity, Entity)> {
+    let mut p: Vec<_> = app
+        .world()
+        .resource::<BroadPhasePairs>()
+        .pairs
+        .iter()
+        .map(|&(a, b)| (a.min(b), a.max(b)))
+        .collect();
+    p.sort_unstable();
+    p
+}
+
+#[test]
+fn reparenting_and_despawning_a_subtree_keep_the_broad_phase_consistent() {
+    let mut app = common::app();
+    let (block_a, houses_a) = town_block(&mut app, 10, Vec3::ZERO);
+    let (block_b, _) = town_block(&mut app, 10, Vec3::new(0.0, 50.0, 0.0));
+    let (chassis, _) = car(&mut app, Vec3::new(4.0, 50.0, 0.5));
+    urto::step(app.world_mut(), 1).unwrap();
+    assert_eq!(
+        pairs(&app),
+        vec![(block_b.min(chassis), block_b.max(chassis))]
+    );
+
+    // Move house 3 of block A next to the car: block B's volume does not change, block A's
+    // shrinks back once the house leaves; the car now meets block A through that house.
+    app.world_mut()
+        .entity_mut(houses_a[3])
+        .insert(ChildOf(block_b));
+    app.world_mut().get_mut::<Position>(houses_a[3]).unwrap().0 = Vec3::new(4.0, 0.0, 0.5);
+    urto::step(app.world_mut(), 1).unwrap();
+    assert_bounds_subtree(&mut app, block_a);
+    assert_bounds_subtree(&mut app, block_b);
+    assert!(bv(&app, block_b).contains_point(Vec3::new(4.0, 50.0, 0.5)));
+
+    // A house becomes a root of its own: the broad phase sees it.
+    app.world_mut().entity_mut(houses_a[5]).remove::<ChildOf>();
+    urto::step(app.world_mut(), 1).unwrap();
+    let moving_pairs_with_house = pairs(&app)
+        .iter()
+        .any(|p| p.0 == houses_a[5] || p.1 == houses_a[5]);
+    assert!(
+        !moving_pairs_with_house,
+        "a static house far from the car has no pair"
+    );
+    // Despawning block B (and its houses, by bevy's linked despawn) removes every pair with it.
+    app.world_mut().entity_mut(block_b).despawn();
+    urto::step(app.world_mut(), 1).unwrap();
+    assert!(pairs(&app).iter().all(|p| p.0 != block_b && p.1 != block_b));
+    assert!(
+        app.world().get_entity(houses_a[3]).is_err(),
+        "the moved house went with block B"
+    );
+    assert_bounds_subtree(&mut app, block_a);
+}
+
+#[test]
+fn a_part_with_its_own_velocity_is_quarantined() {
+    let mut app = common::app();
+    let (chassis, wheels) = car(&mut app, Vec3::ZERO);
+    app.world_mut()
+        .entity_mut(wheels[1])
+        .insert(Velocity::new(1.0, 0.0, 0.0));
+    urto::step(app.world_mut(), 1).unwrap();
+    let q = app
+        .world()
+        .get::<Quarantined>(wheels[1])
+        .expect("quarantined");
+    assert!(q.reason.contains("compound"), "{}", q.reason);
+    assert!(app.world().get::<Quarantined>(chassis).is_none());
+}
