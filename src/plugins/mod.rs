@@ -20,6 +20,7 @@ pub mod integration;
 pub mod narrow_phase;
 mod proxy_table;
 pub mod response;
+pub mod transform_sync;
 pub mod validation;
 
 pub use broad_phase::{BroadPhaseIndex, BroadPhasePairs, BroadPhasePlugin};
@@ -29,6 +30,7 @@ pub use hierarchy::HierarchyPlugin;
 pub use integration::IntegrationPlugin;
 pub use narrow_phase::{ContactPair, Contacts, NarrowPhasePlugin};
 pub use response::{CollisionEnded, CollisionStarted, ResponsePlugin};
+pub use transform_sync::TransformSyncPlugin;
 pub use validation::ValidationPlugin;
 
 use crate::settings::PhysicsTimestep;
@@ -66,5 +68,6 @@ impl PluginGroup for UrtoPlugins {
             .add(BroadPhasePlugin::default())
             .add(NarrowPhasePlugin)
             .add(ResponsePlugin)
+            .add(TransformSyncPlugin)
     }
 }
