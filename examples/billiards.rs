@@ -134,6 +134,9 @@ fn ball(at: Vec3, v: Vec3) -> impl Bundle {
         Mass(BALL_MASS),
         Restitution(0.95),
         LinearDrag(DRAG),
+        // Balls roll rather than slide; urto's bodies do not spin, so rolling resistance is
+        // modelled by the drag and sliding friction is off.
+        Friction(0.0),
     )
 }
 

@@ -128,6 +128,12 @@ pub struct Spring {
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
 pub struct Restitution(pub f32);
 
+/// Coulomb friction coefficient (0 = ice). The pair uses the geometric mean of its two bodies'
+/// values, so ice on anything slides; absent means
+/// [`ContactSettings::default_friction`](crate::ContactSettings).
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+pub struct Friction(pub f32);
+
 /// The shape a body collides with, in the body's frame.
 #[derive(Component, Clone, Debug, PartialEq)]
 #[require(Position)]

@@ -158,6 +158,8 @@ pub struct Integration(pub Integrator);
 pub struct ContactSettings {
     /// Restitution of bodies without a [`Restitution`](crate::components::Restitution).
     pub default_restitution: f32,
+    /// Friction of bodies without a [`Friction`](crate::components::Friction).
+    pub default_friction: f32,
     /// The contact solver's tunables.
     pub solver: SolverSettings,
 }
@@ -166,6 +168,7 @@ impl Default for ContactSettings {
     fn default() -> Self {
         Self {
             default_restitution: 0.5,
+            default_friction: 0.5,
             solver: SolverSettings::default(),
         }
     }

@@ -12,6 +12,7 @@ use std::collections::BTreeSet;
 use urto::plugins::BroadPhasePairs;
 use urto::prelude::*;
 
+/// A frictionless ball, so that impacts exchange momentum along the normal only.
 fn ball(app: &mut bevy_app::App, at: Vec3, v: Vec3, m: f32, e: f32) -> Entity {
     app.world_mut()
         .spawn((
@@ -20,6 +21,7 @@ fn ball(app: &mut bevy_app::App, at: Vec3, v: Vec3, m: f32, e: f32) -> Entity {
             Velocity(v),
             Mass(m),
             Restitution(e),
+            Friction(0.0),
         ))
         .id()
 }

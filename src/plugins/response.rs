@@ -1,5 +1,6 @@
-//! The Response stage: impulses and position correction for the contacts, and the collision
-//! started / ended messages game code listens to.
+//! The Response stage: impulses (restitution, Coulomb friction, warm-started from the previous
+//! substep's impulses of the same contact) and position correction for the contacts, and the
+//! collision started / ended messages game code listens to.
 
 use crate::components::*;
 use crate::dynamics::response::{ContactConstraint, correct_positions, solve_velocities};
@@ -12,6 +13,7 @@ use bevy_ecs::entity::EntityHashMap;
 use bevy_ecs::message::Messages;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
+use std::collections::HashMap;
 use std::time::Instant;
 
 /// Resolves contacts and reports collisions.
@@ -62,20 +64,30 @@ struct ResponseBuffers {
     inverse_mass: Vec<f32>,
     constraints: Vec<ContactConstraint>,
     displacement: Vec<Vec3>,
+    /// Each constraint's key: the pair and its rank among that pair's manifolds.
+    keys: Vec<ContactKey>,
+    /// Last substep's impulses (normal, friction) per contact, for warm starting; looked up,
+    /// never iterated, so its hashing order reaches no result.
+    warm: HashMap<ContactKey, (f32, Vec3)>,
 }
+
+type ContactKey = (Entity, Entity, u16);
 
 type Movable<'a> = (&'a mut Position, &'a mut Velocity, &'a Mass);
 type MovableFilter = (Without<Static>, Without<Quarantined>);
 
+#[allow(clippy::too_many_arguments)]
 fn resolve_contacts(
     contacts: Res<Contacts>,
     mut bodies: Query<Movable, MovableFilter>,
     restitution: Query<&Restitution>,
+    friction: Query<&Friction>,
     settings: Res<ContactSettings>,
     mut buffers: ResMut<ResponseBuffers>,
     mut stats: ResMut<PhysicsStats>,
 ) {
     if contacts.pairs.is_empty() {
+        buffers.warm.clear();
         return;
     }
     let start = Instant::now();
@@ -86,13 +98,30 @@ fn resolve_contacts(
             .get(e)
             .map_or(settings.default_restitution, |r| r.0)
     };
-    for c in &contacts.pairs {
-        let ia = b.slot(c.a, &bodies);
-        let ib = b.slot(c.b, &bodies);
-        let e = 0.5 * (e_of(c.a) + e_of(c.b));
+    let mu_of = |e: Entity| friction.get(e).map_or(settings.default_friction, |f| f.0);
+    let mut rank = 0u16;
+    for (i, c) in contacts.pairs.iter().enumerate() {
+        // The k-th manifold of a pair in this list is the same contact as last substep's k-th.
+        let previous = i
+            .checked_sub(1)
+            .map(|j| (contacts.pairs[j].a, contacts.pairs[j].b));
+        rank = if previous == Some((c.a, c.b)) {
+            rank + 1
+        } else {
+            0
+        };
+        let key = (c.a, c.b, rank);
+        let (ia, ib) = (b.slot(c.a, &bodies), b.slot(c.b, &bodies));
         let m = &c.manifold;
-        b.constraints
-            .push(ContactConstraint::new(ia, ib, m.normal, m.max_depth(), e));
+        let mu = (mu_of(c.a).max(0.0) * mu_of(c.b).max(0.0)).sqrt();
+        let e = 0.5 * (e_of(c.a) + e_of(c.b));
+        let (jn, jt) = b.warm.get(&key).copied().unwrap_or_default();
+        b.keys.push(key);
+        b.constraints.push(
+            ContactConstraint::new(ia, ib, m.normal, m.max_depth(), e)
+                .with_friction(mu)
+                .with_warm_start(jn, jt),
+        );
     }
     solve_velocities(
         &mut b.constraints,
@@ -107,6 +136,7 @@ fn resolve_contacts(
         &settings.solver,
         &mut b.displacement,
     );
+    b.remember_impulses();
     for i in 1..b.entities.len() {
         if b.inverse_mass[i] > 0.0
             && let Ok((mut p, mut v, _)) = bodies.get_mut(b.entities[i])
@@ -123,6 +153,7 @@ impl ResponseBuffers {
     fn clear(&mut self) {
         self.index.clear();
         self.constraints.clear();
+        self.keys.clear();
         self.entities.clear();
         self.positions.clear();
         self.velocities.clear();
@@ -132,6 +163,14 @@ impl ResponseBuffers {
         self.positions.push(Vec3::ZERO);
         self.velocities.push(Vec3::ZERO);
         self.inverse_mass.push(0.0);
+    }
+
+    /// Keeps this substep's impulses for the next one; contacts that ended are forgotten.
+    fn remember_impulses(&mut self) {
+        self.warm.clear();
+        for (key, c) in self.keys.iter().zip(&self.constraints) {
+            self.warm.insert(*key, (c.impulse(), c.tangent_impulse()));
+        }
     }
 
     /// The solver index of `e`, adding it on first sight; statics share slot 0.

@@ -1,0 +1,371 @@
+//! Numerically hard cases, each with the bound it must hold in its name or doc line.
+//!
+//! Units are SI (m, kg, s), 60 Hz, gravity 9.8 m/s² along -z, solver defaults unless stated.
+
+mod common;
+
+use bevy_app::App;
+use bevy_ecs::prelude::*;
+use glam::Vec3;
+use urto::dynamics::forces::{ForceModel, Spring, SpringEnd};
+use urto::dynamics::{Integrator, IntegratorScratch, integrate};
+use urto::plugins::Contacts;
+use urto::prelude::*;
+
+fn app_with_ground() -> App {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    app.world_mut()
+        .spawn((Collider::half_space(Vec3::Z), Static, Restitution(0.5)));
+    app
+}
+
+fn z(app: &App, e: Entity) -> f32 {
+    app.world().get::<Position>(e).unwrap().0.z
+}
+
+fn speed(app: &App, e: Entity) -> f32 {
+    app.world().get::<Velocity>(e).unwrap().0.length()
+}
+
+/// Resting ball, 10,000 steps: never more than 5 mm into the ground (the solver's 2 mm slop plus
+/// one step of gravity, g·dt² = 2.7 mm), never faster than 1 mm/s after settling.
+#[test]
+fn resting_ball_sinks_under_5mm_and_jitters_under_1mm_per_s_over_10000_steps() {
+    let mut app = app_with_ground();
+    let ball = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(0.0, 0.0, 0.5),
+            Velocity::default(),
+        ))
+        .id();
+    let (mut deepest, mut fastest) = (0.0f32, 0.0f32);
+    for _ in 0..10_000 {
+        urto::step(app.world_mut(), 1).unwrap();
+        deepest = deepest.max(0.5 - z(&app, ball));
+        fastest = fastest.max(speed(&app, ball));
+    }
+    assert!(deepest < 0.005, "sank {deepest} m");
+    assert!(fastest < 1e-3, "jittered at {fastest} m/s");
+}
+
+/// A stack of five boxes settles: after 3 s every box is slower than 1 cm/s, sits within 1 cm of
+/// its ideal height, and the stack stays upright (each box within 1 mm of the column's axis).
+#[test]
+fn a_stack_of_five_boxes_settles_within_1cm_and_1cm_per_s() {
+    let mut app = app_with_ground();
+    let boxes: Vec<Entity> = (0..5)
+        .map(|i| {
+            app.world_mut()
+                .spawn((
+                    Collider::cuboid(0.5, 0.5, 0.5),
+                    Position::new(0.0, 0.0, 0.5 + i as f32 * 1.0),
+                    Velocity::default(),
+                    Restitution(0.0),
+                ))
+                .id()
+        })
+        .collect();
+    urto::step(app.world_mut(), 180).unwrap();
+    for (i, b) in boxes.iter().enumerate() {
+        let p = app.world().get::<Position>(*b).unwrap().0;
+        assert!(
+            speed(&app, *b) < 0.01,
+            "box {i} still moving at {}",
+            speed(&app, *b)
+        );
+        assert!(
+            (p.z - (0.5 + i as f32)).abs() < 0.01,
+            "box {i} at height {}",
+            p.z
+        );
+        assert!(p.truncate().length() < 1e-3, "box {i} slid to {p}");
+    }
+}
+
+/// A pile of 64 balls poured into a walled pit settles: after 6 s the fastest ball is slower
+/// than 5 cm/s and none has left the pit or sunk under the ground by more than 5 mm.
+#[test]
+fn a_pile_of_64_balls_settles_below_5cm_per_s_inside_its_pit() {
+    let mut app = app_with_ground();
+    for (pos, half) in [
+        (Vec3::new(2.1, 0.0, 1.0), Vec3::new(0.1, 2.2, 1.0)),
+        (Vec3::new(-2.1, 0.0, 1.0), Vec3::new(0.1, 2.2, 1.0)),
+        (Vec3::new(0.0, 2.1, 1.0), Vec3::new(2.0, 0.1, 1.0)),
+        (Vec3::new(0.0, -2.1, 1.0), Vec3::new(2.0, 0.1, 1.0)),
+    ] {
+        app.world_mut().spawn((
+            Collider::cuboid(half.x, half.y, half.z),
+            Position(pos),
+            Static,
+        ));
+    }
+    let mut rng = common::rng::Rng::new(3);
+    let balls: Vec<Entity> = (0..64)
+        .map(|i| {
+            let at = Vec3::new(
+                rng.range(-1.5, 1.5),
+                rng.range(-1.5, 1.5),
+                1.0 + i as f32 * 0.3,
+            );
+            app.world_mut()
+                .spawn((
+                    Collider::sphere(0.3),
+                    Position(at),
+                    Velocity::default(),
+                    Restitution(0.3),
+                ))
+                .id()
+        })
+        .collect();
+    urto::step(app.world_mut(), 360).unwrap();
+    for b in balls {
+        let p = app.world().get::<Position>(b).unwrap().0;
+        assert!(
+            speed(&app, b) < 0.05,
+            "ball at {p} moves at {}",
+            speed(&app, b)
+        );
+        assert!(p.x.abs() < 2.0 && p.y.abs() < 2.0, "ball escaped to {p}");
+        assert!(p.z > 0.3 - 0.005, "ball sank to {p}");
+    }
+}
+
+fn spring_energy(method: Integrator, dt: f32, steps: usize) -> (f32, f32) {
+    let mut model = ForceModel::default();
+    model.reset(1);
+    model.inverse_mass[0] = 1.0;
+    model.springs.push(Spring {
+        body: 0,
+        other: SpringEnd::Anchor(Vec3::ZERO),
+        rest_length: 0.0,
+        stiffness: 1.0,
+        damping: 0.0,
+    });
+    let (mut p, mut v) = ([Vec3::X], [Vec3::ZERO]);
+    let energy = |p: &[Vec3], v: &[Vec3]| model.kinetic_energy(v) + model.potential_energy(p);
+    let e0 = energy(&p, &v);
+    let mut worst = 0.0f32;
+    let mut s = IntegratorScratch::default();
+    for _ in 0..steps {
+        integrate(method, dt, &mut p, &mut v, &model, &mut s);
+        worst = worst.max((energy(&p, &v) / e0 - 1.0).abs());
+    }
+    (energy(&p, &v) / e0, worst)
+}
+
+/// Symplectic integrators keep a spring's energy within 0.5 % for a million steps (ω·dt = 0.1,
+/// about 16,000 periods); their error oscillates instead of drifting.
+#[test]
+fn symplectic_energy_stays_within_half_a_percent_over_a_million_steps() {
+    for method in [Integrator::SymplecticEuler, Integrator::VelocityVerlet] {
+        let (_, worst) = spring_energy(method, 0.1, 1_000_000);
+        assert!(worst < 5e-3, "{}: energy off by {worst}", method.name());
+    }
+}
+
+/// Explicit Euler's energy on a spring grows by exactly (1 + ω²dt²) per step: after 10,000 steps
+/// at ω·dt = 0.01 the measured growth matches the theory within 0.1 %.
+#[test]
+fn explicit_euler_energy_growth_matches_theory_within_a_tenth_of_a_percent() {
+    let (ratio, _) = spring_energy(Integrator::ExplicitEuler, 0.01, 10_000);
+    let theory = (1.0f64 + 1e-4).powi(10_000) as f32;
+    assert!((ratio / theory - 1.0).abs() < 1e-3, "{ratio} vs {theory}");
+}
+
+/// Exactly touching spheres are in contact with depth 0 (the closed-set convention); one ulp
+/// further apart they are not. Neither case moves the bodies (no approach, no penetration).
+#[test]
+fn exactly_touching_is_a_depth_zero_contact_and_a_one_ulp_gap_is_none() {
+    for (gap, expected) in [(1.0f32, 1usize), (1.0f32.next_up(), 0)] {
+        let mut app = common::app();
+        let a = app
+            .world_mut()
+            .spawn((
+                Collider::sphere(0.5),
+                Position::new(0.0, 0.0, 0.0),
+                Velocity::default(),
+            ))
+            .id();
+        let b = app
+            .world_mut()
+            .spawn((
+                Collider::sphere(0.5),
+                Position::new(gap, 0.0, 0.0),
+                Velocity::default(),
+            ))
+            .id();
+        urto::step(app.world_mut(), 1).unwrap();
+        let contacts = &app.world().resource::<Contacts>().pairs;
+        assert_eq!(contacts.len(), expected, "gap {gap}");
+        if let Some(c) = contacts.first() {
+            assert_eq!(c.manifold.max_depth(), 0.0);
+        }
+        assert_eq!(app.world().get::<Position>(a).unwrap().0, Vec3::ZERO);
+        assert_eq!(app.world().get::<Position>(b).unwrap().0.x, gap);
+    }
+}
+
+/// Coincident centres: two balls spawned at the same point separate along world up (the
+/// documented fallback normal), stay finite, and do so identically on every run.
+#[test]
+fn coincident_centres_separate_along_up_finitely_and_deterministically() {
+    let run = || {
+        let mut app = common::app();
+        let ids: Vec<Entity> = [0.5, 0.4]
+            .iter()
+            .map(|&r| {
+                app.world_mut()
+                    .spawn((
+                        Collider::sphere(r),
+                        Position::new(1.0, 2.0, 3.0),
+                        Velocity::default(),
+                    ))
+                    .id()
+            })
+            .collect();
+        urto::step(app.world_mut(), 60).unwrap();
+        ids.iter()
+            .map(|e| app.world().get::<Position>(*e).unwrap().0)
+            .collect::<Vec<_>>()
+    };
+    let (first, second) = (run(), run());
+    assert_eq!(first, second);
+    assert!(first.iter().all(|p| p.is_finite()));
+    let d = first[1] - first[0];
+    assert!(d.z > 0.85 && d.truncate().length() < 1e-6, "separation {d}");
+}
+
+/// Mass ratio 10⁶:1 — a 1,000 t ball hits a 1 kg ball elastically: momentum is kept to 10⁻⁶
+/// relative, the light ball leaves at twice the heavy one's speed within 0.1 %.
+#[test]
+fn a_million_to_one_mass_ratio_keeps_momentum_to_a_millionth() {
+    let mut app = common::app();
+    let heavy = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(-2.0, 0.0, 0.0),
+            Velocity::new(1.0, 0.0, 0.0),
+            Mass(1e6),
+            Restitution(1.0),
+        ))
+        .id();
+    let light = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(0.0, 0.0, 0.0),
+            Velocity::default(),
+            Mass(1.0),
+            Restitution(1.0),
+        ))
+        .id();
+    urto::step(app.world_mut(), 90).unwrap();
+    let (vh, vl) = (
+        app.world().get::<Velocity>(heavy).unwrap().0.x as f64,
+        app.world().get::<Velocity>(light).unwrap().0.x as f64,
+    );
+    let momentum = 1e6 * vh + vl;
+    assert!((momentum / 1e6 - 1.0).abs() < 1e-6, "momentum {momentum}");
+    let expected = 2.0 * 1e6 / (1e6 + 1.0);
+    assert!((vl / expected - 1.0).abs() < 1e-3, "light ball at {vl}");
+}
+
+/// A 100 kg box resting on a 1 kg box on the ground: the light box is squeezed less than 1 cm
+/// into the ground and the heavy box less than 1 cm into it, after 5 s.
+#[test]
+fn a_heavy_box_on_a_light_one_is_held_within_1cm() {
+    let mut app = app_with_ground();
+    let light = app
+        .world_mut()
+        .spawn((
+            Collider::cuboid(0.5, 0.5, 0.5),
+            Position::new(0.0, 0.0, 0.5),
+            Velocity::default(),
+            Mass(1.0),
+            Restitution(0.0),
+        ))
+        .id();
+    let heavy = app
+        .world_mut()
+        .spawn((
+            Collider::cuboid(0.5, 0.5, 0.5),
+            Position::new(0.0, 0.0, 1.5),
+            Velocity::default(),
+            Mass(100.0),
+            Restitution(0.0),
+        ))
+        .id();
+    urto::step(app.world_mut(), 300).unwrap();
+    assert!(
+        z(&app, light) > 0.5 - 0.01,
+        "light box sank to {}",
+        z(&app, light)
+    );
+    assert!(
+        z(&app, heavy) - z(&app, light) > 1.0 - 0.01,
+        "gap {}",
+        z(&app, heavy) - z(&app, light)
+    );
+}
+
+/// 100 balls packed edge to edge on the ground (hundreds of simultaneous contacts): after 2 s
+/// none is faster than 1 cm/s and none has moved more than 1 cm sideways.
+#[test]
+fn a_hundred_balls_packed_edge_to_edge_stay_put_within_1cm() {
+    let mut app = app_with_ground();
+    let balls: Vec<(Entity, Vec3)> = (0..100)
+        .map(|i| {
+            let at = Vec3::new((i % 10) as f32, (i / 10) as f32, 0.5);
+            let e = app
+                .world_mut()
+                .spawn((Collider::sphere(0.5), Position(at), Velocity::default()))
+                .id();
+            (e, at)
+        })
+        .collect();
+    urto::step(app.world_mut(), 120).unwrap();
+    let contacts = app
+        .world()
+        .resource::<PhysicsStats>()
+        .counter("narrow_phase/contacts");
+    assert!(contacts.unwrap_or(0.0) >= 280.0, "{contacts:?} contacts");
+    for (e, at) in balls {
+        let p = app.world().get::<Position>(e).unwrap().0;
+        assert!(speed(&app, e) < 0.01, "ball moves at {}", speed(&app, e));
+        assert!((p - at).truncate().length() < 0.01, "ball drifted to {p}");
+    }
+}
+
+/// Scale ratio 1:1000: a 5 cm ball dropped on a 50 m slab comes to rest on it, at most 5 mm (a
+/// tenth of its size) into it, and stops bouncing within 3 s.
+#[test]
+fn a_5cm_ball_on_a_50m_slab_rests_within_a_tenth_of_its_size() {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    app.world_mut().spawn((
+        Collider::cuboid(25.0, 25.0, 1.0),
+        Position::new(0.0, 0.0, -1.0),
+        Static,
+    ));
+    let ball = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.025),
+            Position::new(3.0, -7.0, 1.0),
+            Velocity::default(),
+            Restitution(0.5),
+        ))
+        .id();
+    urto::step(app.world_mut(), 180).unwrap();
+    assert!(z(&app, ball) > 0.025 - 0.005, "sank to {}", z(&app, ball));
+    assert!(
+        z(&app, ball) < 0.025 + 1e-3,
+        "still bouncing at {}",
+        z(&app, ball)
+    );
+    assert!(speed(&app, ball) < 1e-3);
+}
