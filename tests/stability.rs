@@ -51,10 +51,11 @@ fn resting_ball_sinks_under_5mm_and_jitters_under_1mm_per_s_over_10000_steps() {
     assert!(fastest < 1e-3, "jittered at {fastest} m/s");
 }
 
-/// A stack of five boxes settles: after 3 s every box is slower than 1 cm/s, sits within 1 cm of
-/// its ideal height, and the stack stays upright (each box within 1 mm of the column's axis).
+/// A stack of five boxes settles: after 3 s every box is slower than 1 mm/s, every contact
+/// rests within the solver's 2 mm slop plus 0.5 mm (so box `i` sits at most `(i+1)·2.5 mm` below
+/// its ideal height), and the stack stays upright (each box within 1 mm of the column's axis).
 #[test]
-fn a_stack_of_five_boxes_settles_within_1cm_and_1cm_per_s() {
+fn a_stack_of_five_boxes_settles_with_each_contact_within_its_slop() {
     let mut app = app_with_ground();
     let boxes: Vec<Entity> = (0..5)
         .map(|i| {
@@ -71,15 +72,15 @@ fn a_stack_of_five_boxes_settles_within_1cm_and_1cm_per_s() {
     urto::step(app.world_mut(), 180).unwrap();
     for (i, b) in boxes.iter().enumerate() {
         let p = app.world().get::<Position>(*b).unwrap().0;
+        let sunk = 0.5 + i as f32 - p.z;
         assert!(
-            speed(&app, *b) < 0.01,
+            speed(&app, *b) < 1e-3,
             "box {i} still moving at {}",
             speed(&app, *b)
         );
         assert!(
-            (p.z - (0.5 + i as f32)).abs() < 0.01,
-            "box {i} at height {}",
-            p.z
+            sunk >= 0.0 && sunk < (i + 1) as f32 * 0.0025,
+            "box {i} sunk {sunk}"
         );
         assert!(p.truncate().length() < 1e-3, "box {i} slid to {p}");
     }
@@ -134,6 +135,60 @@ fn a_pile_of_64_balls_settles_below_5cm_per_s_inside_its_pit() {
 }
 
 fn spring_energy(method: Integrator, dt: f32, steps: usize) -> (f32, f32) {
+    let (ratio, worst, _) = spring_energy_windows(method, dt, steps, 0);
+    (ratio, worst)
+}
+
+/// Symplectic integrators keep a spring's energy in a band set by the step and do not drift
+/// over a million steps (ω·dt = 0.1, about 16,000 periods): the energy error of symplectic Euler
+/// oscillates with amplitude ≈ ω·dt/2 = 5 %, velocity Verlet's ≈ (ω·dt)²/4 = 0.25 % (Hairer,
+/// Lubich & Wanner 2006); both stay under twice that, and the last 1,000 steps' worst error is
+/// within 1 % (relative) of the first 1,000 steps'.
+#[test]
+fn symplectic_energy_stays_in_its_band_without_drift_over_a_million_steps() {
+    for (method, band) in [
+        (Integrator::SymplecticEuler, 0.05f32),
+        (Integrator::VelocityVerlet, 0.0025),
+    ] {
+        let first = spring_energy(method, 0.1, 1_000).1;
+        let (_, worst, last) = spring_energy_windows(method, 0.1, 1_000_000, 1_000);
+        assert!(
+            worst < 2.0 * band,
+            "{}: energy off by {worst}",
+            method.name()
+        );
+        assert!(
+            (last / first - 1.0).abs() < 0.01,
+            "{}: drift {first} -> {last}",
+            method.name()
+        );
+    }
+}
+
+/// Like [`spring_energy`], also returning the worst error over the last `window` steps.
+fn spring_energy_windows(
+    method: Integrator,
+    dt: f32,
+    steps: usize,
+    window: usize,
+) -> (f32, f32, f32) {
+    let (model, mut p, mut v) = spring_model();
+    let energy = |p: &[Vec3], v: &[Vec3]| model.kinetic_energy(v) + model.potential_energy(p);
+    let e0 = energy(&p, &v);
+    let (mut worst, mut last) = (0.0f32, 0.0f32);
+    let mut s = IntegratorScratch::default();
+    for i in 0..steps {
+        integrate(method, dt, &mut p, &mut v, &model, &mut s);
+        let err = (energy(&p, &v) / e0 - 1.0).abs();
+        worst = worst.max(err);
+        if i + window >= steps {
+            last = last.max(err);
+        }
+    }
+    (energy(&p, &v) / e0, worst, last)
+}
+
+fn spring_model() -> (ForceModel, [Vec3; 1], [Vec3; 1]) {
     let mut model = ForceModel::default();
     model.reset(1);
     model.inverse_mass[0] = 1.0;
@@ -144,26 +199,7 @@ fn spring_energy(method: Integrator, dt: f32, steps: usize) -> (f32, f32) {
         stiffness: 1.0,
         damping: 0.0,
     });
-    let (mut p, mut v) = ([Vec3::X], [Vec3::ZERO]);
-    let energy = |p: &[Vec3], v: &[Vec3]| model.kinetic_energy(v) + model.potential_energy(p);
-    let e0 = energy(&p, &v);
-    let mut worst = 0.0f32;
-    let mut s = IntegratorScratch::default();
-    for _ in 0..steps {
-        integrate(method, dt, &mut p, &mut v, &model, &mut s);
-        worst = worst.max((energy(&p, &v) / e0 - 1.0).abs());
-    }
-    (energy(&p, &v) / e0, worst)
-}
-
-/// Symplectic integrators keep a spring's energy within 0.5 % for a million steps (ω·dt = 0.1,
-/// about 16,000 periods); their error oscillates instead of drifting.
-#[test]
-fn symplectic_energy_stays_within_half_a_percent_over_a_million_steps() {
-    for method in [Integrator::SymplecticEuler, Integrator::VelocityVerlet] {
-        let (_, worst) = spring_energy(method, 0.1, 1_000_000);
-        assert!(worst < 5e-3, "{}: energy off by {worst}", method.name());
-    }
+    (model, [Vec3::X], [Vec3::ZERO])
 }
 
 /// Explicit Euler's energy on a spring grows by exactly (1 + ω²dt²) per step: after 10,000 steps

@@ -70,6 +70,9 @@ pub struct ContactConstraint {
     /// Coulomb friction coefficient of the pair: the tangential impulse is at most
     /// `friction × normal impulse`.
     pub friction: f32,
+    /// The caller's tag, carried through [`SupportGraph::order`]'s sorting (e.g. an index into
+    /// the caller's own per-contact data).
+    pub tag: u32,
     /// Separation speed the solver aims for (from restitution), set by [`prepare`](Self::prepare).
     target_speed: f32,
     /// Normal impulse accumulated over the sweeps (`>= 0`: contacts push, never pull).
@@ -88,10 +91,18 @@ impl ContactConstraint {
             depth,
             restitution,
             friction: 0.0,
+            tag: 0,
             target_speed: 0.0,
             normal_impulse: 0.0,
             tangent_impulse: Vec3::ZERO,
         }
+    }
+
+    /// The same contact with the caller's tag.
+    #[must_use]
+    pub fn with_tag(mut self, tag: u32) -> Self {
+        self.tag = tag;
+        self
     }
 
     /// The same contact with Coulomb friction `mu`.
@@ -159,6 +170,24 @@ impl ContactConstraint {
         self.apply(self.normal * j, v, im);
     }
 
+    /// Shock propagation: a resting contact still approaching after the sweeps is stopped by
+    /// changing the upper body's velocity alone (the lower one counts as fixed). Not added to
+    /// the accumulated impulse, so warm starting keeps learning the physical impulses.
+    fn propagate_shock(&self, v: &mut [Vec3], im: &[f32], level: &[u32]) {
+        if self.target_speed > 0.0 {
+            return; // a bounce: the sweeps' answer stands
+        }
+        let approach = -self.relative_velocity(v).dot(self.normal);
+        if approach <= 0.0 {
+            return;
+        }
+        match level[self.a].cmp(&level[self.b]) {
+            std::cmp::Ordering::Less if im[self.b] > 0.0 => v[self.b] += self.normal * approach,
+            std::cmp::Ordering::Greater if im[self.a] > 0.0 => v[self.a] -= self.normal * approach,
+            _ => {}
+        }
+    }
+
     /// Friction: cancel the tangential relative velocity, within the Coulomb disc.
     fn solve_friction(&mut self, v: &mut [Vec3], im: &[f32], k: f32) {
         if self.friction <= 0.0 {
@@ -188,10 +217,17 @@ fn clamp_length(v: Vec3, max: f32) -> Vec3 {
 }
 
 /// Solves the velocity constraints in place; `inverse_mass[i] == 0` marks immovable bodies.
+///
+/// With `levels` (from [`SupportGraph`]), a final shock-propagation pass walks the contacts from
+/// the ground up and removes whatever approach is left at resting contacts by moving only the
+/// upper body, as if the lower one were fixed (Guendelman, Bridson & Fedkiw 2003). Where the
+/// sweeps converged it changes nothing; where they could not (a heavy load on a light body) it
+/// keeps the stack from sinking or ringing.
 pub fn solve_velocities(
     contacts: &mut [ContactConstraint],
     velocities: &mut [Vec3],
     inverse_mass: &[f32],
+    levels: Option<&[u32]>,
     settings: &SolverSettings,
 ) {
     for c in contacts.iter_mut() {
@@ -209,14 +245,94 @@ pub fn solve_velocities(
             }
         }
     }
+    if let Some(level) = levels {
+        for c in contacts.iter() {
+            c.propagate_shock(velocities, inverse_mass, level);
+        }
+    }
 }
 
-/// Pushes bodies apart along the contact normals until penetration is below `slop`, sharing
-/// the motion by inverse mass. `positions` are moved in place.
+/// Support levels of the contact graph (Guendelman, Bridson & Fedkiw 2003, "Nonconvex rigid
+/// bodies with stacking", shock propagation): immovable bodies are level 0, a body touching a
+/// level-`k` body is level `k+1`, bodies with no chain of contacts down to an immovable one are
+/// unsupported (`u32::MAX`).
+///
+/// Ordering contacts by level makes each Gauss–Seidel sweep carry corrections from the ground up
+/// a whole stack at once; and in position correction the lower body of a contact is treated as
+/// fixed, so a light box under a heavy one is not pushed back into the floor.
+#[derive(Debug, Default)]
+pub struct SupportGraph {
+    level: Vec<u32>,
+    first: Vec<u32>,
+    next: Vec<u32>,
+    queue: Vec<u32>,
+}
+
+const NONE: u32 = u32::MAX;
+
+impl SupportGraph {
+    /// Computes the levels of `inverse_mass.len()` bodies and sorts `contacts` from the ground up
+    /// (stable: contacts of equal level keep their order).
+    pub fn order(&mut self, contacts: &mut [ContactConstraint], inverse_mass: &[f32]) {
+        self.link(contacts, inverse_mass.len());
+        self.level.clear();
+        self.level.resize(inverse_mass.len(), NONE);
+        self.queue.clear();
+        for (i, im) in inverse_mass.iter().enumerate() {
+            if *im == 0.0 {
+                self.level[i] = 0;
+                self.queue.push(i as u32);
+            }
+        }
+        let mut head = 0;
+        while head < self.queue.len() {
+            let body = self.queue[head] as usize;
+            head += 1;
+            let mut edge = self.first[body];
+            while edge != NONE {
+                let c = &contacts[edge as usize / 2];
+                let other = if edge.is_multiple_of(2) { c.b } else { c.a };
+                if self.level[other] == NONE {
+                    self.level[other] = self.level[body] + 1;
+                    self.queue.push(other as u32);
+                }
+                edge = self.next[edge as usize];
+            }
+        }
+        let level = &self.level;
+        contacts.sort_by_key(|c| level[c.a].min(level[c.b]));
+    }
+
+    /// Level of each body after [`order`](Self::order).
+    pub fn levels(&self) -> &[u32] {
+        &self.level
+    }
+
+    /// Per-body linked lists of half-edges: edge `2i` is contact `i` seen from `a`, `2i+1` from `b`.
+    fn link(&mut self, contacts: &[ContactConstraint], bodies: usize) {
+        self.first.clear();
+        self.first.resize(bodies, NONE);
+        self.next.clear();
+        self.next.resize(contacts.len() * 2, NONE);
+        for (i, c) in contacts.iter().enumerate() {
+            for (side, body) in [(0, c.a), (1, c.b)] {
+                let edge = (2 * i + side) as u32;
+                self.next[edge as usize] = self.first[body];
+                self.first[body] = edge;
+            }
+        }
+    }
+}
+
+/// Pushes bodies apart along the contact normals until penetration is below `slop`. With
+/// `levels` (from [`SupportGraph`]) the lower body of a contact stays put and the upper one
+/// moves; between bodies of equal level (or without levels) the motion is shared by inverse
+/// mass. `positions` are moved in place.
 pub fn correct_positions(
     contacts: &[ContactConstraint],
     positions: &mut [Vec3],
     inverse_mass: &[f32],
+    levels: Option<&[u32]>,
     settings: &SolverSettings,
     scratch: &mut Vec<Vec3>,
 ) {
@@ -225,15 +341,22 @@ pub fn correct_positions(
     scratch.resize(positions.len(), Vec3::ZERO);
     for _ in 0..settings.position_iterations {
         for c in contacts {
-            let (ia, ib) = (inverse_mass[c.a], inverse_mass[c.b]);
-            let k = ia + ib;
+            let (mut wa, mut wb) = (inverse_mass[c.a], inverse_mass[c.b]);
+            if let Some(level) = levels {
+                match level[c.a].cmp(&level[c.b]) {
+                    std::cmp::Ordering::Less if wb > 0.0 => wa = 0.0,
+                    std::cmp::Ordering::Greater if wa > 0.0 => wb = 0.0,
+                    _ => {}
+                }
+            }
+            let k = wa + wb;
             if k <= 0.0 {
                 continue;
             }
             let depth = c.depth - (scratch[c.b] - scratch[c.a]).dot(c.normal);
             let push = settings.correction_fraction * (depth - settings.slop).max(0.0) / k;
-            scratch[c.a] -= c.normal * (push * ia);
-            scratch[c.b] += c.normal * (push * ib);
+            scratch[c.a] -= c.normal * (push * wa);
+            scratch[c.b] += c.normal * (push * wb);
         }
     }
     for (p, d) in positions.iter_mut().zip(scratch.iter()) {
@@ -253,7 +376,7 @@ mod tests {
             restitution_threshold: 0.0,
             ..Default::default()
         };
-        solve_velocities(&mut c, &mut v, &im, &settings);
+        solve_velocities(&mut c, &mut v, &im, None, &settings);
         v
     }
 
@@ -310,10 +433,10 @@ mod tests {
         let mut v = [Vec3::new(0.0, 0.0, -0.1), Vec3::ZERO];
         let im = [1.0, 0.0];
         let mut c = [ContactConstraint::new(0, 1, -Vec3::Z, 0.05, 1.0)];
-        solve_velocities(&mut c, &mut v, &im, &settings);
+        solve_velocities(&mut c, &mut v, &im, None, &settings);
         assert!(v[0].z.abs() < 1e-6, "resting contact bounced: {}", v[0]);
         let mut p = [Vec3::ZERO, Vec3::ZERO];
-        correct_positions(&c, &mut p, &im, &settings, &mut Vec::new());
+        correct_positions(&c, &mut p, &im, None, &settings, &mut Vec::new());
         let left = 0.05 - p[0].z;
         assert!(
             left > settings.slop - 1e-6 && left < settings.slop + 0.01,
@@ -329,7 +452,7 @@ mod tests {
         let press = |slide: f32, mu: f32| {
             let mut v = [Vec3::new(slide, 0.0, -1.0), Vec3::ZERO];
             let mut c = [ContactConstraint::new(0, 1, -Vec3::Z, 0.0, 0.0).with_friction(mu)];
-            solve_velocities(&mut c, &mut v, &im, &settings);
+            solve_velocities(&mut c, &mut v, &im, None, &settings);
             (v[0], c[0])
         };
         let (v, c) = press(0.3, 0.5);
@@ -358,14 +481,14 @@ mod tests {
             Vec3::new(0.0, 0.0, -0.1635),
         ];
         let mut cold = gravity_step;
-        solve_velocities(&mut contacts(), &mut cold, &im, &settings);
+        solve_velocities(&mut contacts(), &mut cold, &im, None, &settings);
         let mut warm_contacts = contacts();
         let mut warm = gravity_step;
         // At 100:1 each sweep removes about 1/101 of the error: warm starting keeps that progress
         // from step to step (8 sweeps each), a cold start throws it away every step.
         for _ in 0..120 {
             warm = gravity_step;
-            solve_velocities(&mut warm_contacts, &mut warm, &im, &settings);
+            solve_velocities(&mut warm_contacts, &mut warm, &im, None, &settings);
             for c in &mut warm_contacts {
                 *c = c.with_warm_start(c.impulse(), c.tangent_impulse());
             }

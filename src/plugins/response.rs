@@ -3,7 +3,9 @@
 //! collision started / ended messages game code listens to.
 
 use crate::components::*;
-use crate::dynamics::response::{ContactConstraint, correct_positions, solve_velocities};
+use crate::dynamics::response::{
+    ContactConstraint, SupportGraph, correct_positions, solve_velocities,
+};
 use crate::plugins::narrow_phase::Contacts;
 use crate::schedule::{SubstepSchedule, SubstepSet};
 use crate::settings::ContactSettings;
@@ -64,7 +66,10 @@ struct ResponseBuffers {
     inverse_mass: Vec<f32>,
     constraints: Vec<ContactConstraint>,
     displacement: Vec<Vec3>,
-    /// Each constraint's key: the pair and its rank among that pair's manifolds.
+    /// Contacts ordered from the ground up (shock propagation).
+    support: SupportGraph,
+    /// Each constraint's key (indexed by the constraint's tag): the pair and its rank among that
+    /// pair's manifolds.
     keys: Vec<ContactKey>,
     /// Last substep's impulses (normal, friction) per contact, for warm starting; looked up,
     /// never iterated, so its hashing order reaches no result.
@@ -116,23 +121,27 @@ fn resolve_contacts(
         let mu = (mu_of(c.a).max(0.0) * mu_of(c.b).max(0.0)).sqrt();
         let e = 0.5 * (e_of(c.a) + e_of(c.b));
         let (jn, jt) = b.warm.get(&key).copied().unwrap_or_default();
-        b.keys.push(key);
         b.constraints.push(
             ContactConstraint::new(ia, ib, m.normal, m.max_depth(), e)
                 .with_friction(mu)
-                .with_warm_start(jn, jt),
+                .with_warm_start(jn, jt)
+                .with_tag(b.keys.len() as u32),
         );
+        b.keys.push(key);
     }
+    b.support.order(&mut b.constraints, &b.inverse_mass);
     solve_velocities(
         &mut b.constraints,
         &mut b.velocities,
         &b.inverse_mass,
+        Some(b.support.levels()),
         &settings.solver,
     );
     correct_positions(
         &b.constraints,
         &mut b.positions,
         &b.inverse_mass,
+        Some(b.support.levels()),
         &settings.solver,
         &mut b.displacement,
     );
@@ -168,8 +177,9 @@ impl ResponseBuffers {
     /// Keeps this substep's impulses for the next one; contacts that ended are forgotten.
     fn remember_impulses(&mut self) {
         self.warm.clear();
-        for (key, c) in self.keys.iter().zip(&self.constraints) {
-            self.warm.insert(*key, (c.impulse(), c.tangent_impulse()));
+        for c in &self.constraints {
+            let key = self.keys[c.tag as usize];
+            self.warm.insert(key, (c.impulse(), c.tangent_impulse()));
         }
     }
 
