@@ -29,6 +29,7 @@
 pub mod bounding;
 pub mod broad_phase;
 pub mod bvh;
+pub mod ccd;
 pub mod clock;
 pub mod components;
 pub mod debug;

@@ -22,7 +22,8 @@ pub fn contact_sphere_sphere(
         return None;
     }
     let dist = dist2.sqrt();
-    let normal = if dist > 0.0 {
+    // Below MIN_POSITIVE the squared distance is subnormal and `d / dist` is no longer unit.
+    let normal = if dist2 >= f32::MIN_POSITIVE {
         d / dist
     } else if a.radius >= b.radius {
         FALLBACK_NORMAL
@@ -41,6 +42,13 @@ pub fn contact_sphere_sphere(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn nearly_coincident_centres_still_give_a_unit_normal() {
+        let s = Sphere { radius: 0.5 };
+        let m = contact_sphere_sphere(Vec3::ZERO, &s, Vec3::new(1e-22, 0.0, 0.0), &s).unwrap();
+        assert!((m.normal.length() - 1.0).abs() < 1e-6, "{}", m.normal);
+    }
 
     #[test]
     fn overlapping_touching_and_apart() {
