@@ -7,6 +7,7 @@
 //! hierarchy's cost counters (`Nv`, `Nn`, `Ns` of the slides' `Tc = Nv*Cv + Nn*Cn + Ns*Cs`) over
 //! the queries it served, so a caller can report the work of a whole step.
 
+use super::mesh_manifold::Contribution;
 use crate::bvh::{QueryScratch, QueryStats};
 use crate::geometry::ContactPoint;
 
@@ -20,8 +21,12 @@ pub struct ContactScratch {
     pub(crate) query: QueryScratch,
     /// Triangle pairs of the last query, in the caller's (A, B) order.
     pub(crate) hits: Vec<[u32; 2]>,
-    /// Candidate contact points, before reduction to a manifold.
+    /// The triangle contacts, before merging.
+    pub(crate) contributions: Vec<Contribution>,
+    /// Their candidate contact points.
     pub(crate) points: Vec<ContactPoint>,
+    /// The points of the contributions kept by the merge.
+    pub(crate) kept: Vec<ContactPoint>,
     /// Vertex indices (the mesh–half-space test collects each vertex once).
     pub(crate) vertices: Vec<u32>,
     record_hits: bool,
@@ -73,8 +78,23 @@ impl ContactScratch {
     /// Clears the per-query buffers.
     pub(crate) fn begin_query(&mut self) {
         self.hits.clear();
+        self.contributions.clear();
         self.points.clear();
         self.vertices.clear();
+    }
+
+    /// Merges the contributions into one manifold carried to the world by `pose` (see
+    /// `mesh_manifold.rs`).
+    pub(crate) fn merge(
+        &mut self,
+        pose: &crate::geometry::Isometry,
+    ) -> Option<crate::geometry::ContactManifold> {
+        super::mesh_manifold::merge_contributions(
+            &self.contributions,
+            &self.points,
+            &mut self.kept,
+            pose,
+        )
     }
 
     /// Swaps the sides of the recorded hits (the dispatch ran the pair in the other order).
@@ -83,4 +103,25 @@ impl ContactScratch {
             h.swap(0, 1);
         }
     }
+}
+
+/// Adds a contribution and its points to the two pools (a free function, so that callers holding
+/// other fields of the scratch can use it).
+pub(crate) fn push_contribution(
+    contributions: &mut Vec<Contribution>,
+    pool: &mut Vec<ContactPoint>,
+    normal: glam::Vec3,
+    depth: f32,
+    side: u8,
+    points: &[ContactPoint],
+) {
+    // Pools hold far fewer than u32::MAX points: one query's candidates.
+    contributions.push(Contribution {
+        normal,
+        depth,
+        side,
+        first: pool.len() as u32,
+        count: points.len() as u32,
+    });
+    pool.extend_from_slice(points);
 }

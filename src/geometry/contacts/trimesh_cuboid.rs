@@ -4,8 +4,7 @@
 //! `triangle_cuboid.rs`. The triangle contacts are merged into one manifold as
 //! `mesh_manifold.rs` explains.
 
-use super::mesh_manifold::{NormalMerge, reduce_to_manifold};
-use super::mesh_scratch::{ContactScratch, NO_TRIANGLE};
+use super::mesh_scratch::{ContactScratch, NO_TRIANGLE, push_contribution};
 use super::triangle_cuboid::triangle_box_contact;
 use crate::bounding::{Bv, Obb, RELATIVE_SLACK, RelativePose};
 use crate::geometry::{ContactManifold, Cuboid, Isometry, MeshCollider};
@@ -38,10 +37,10 @@ pub fn contact_trimesh_cuboid(
     };
     let same_frame = RelativePose::new(&Isometry::IDENTITY);
     let record = scratch.records_hits();
-    let mut merge = NormalMerge::default();
     let ContactScratch {
         query,
         hits,
+        contributions,
         points,
         ..
     } = scratch;
@@ -54,8 +53,7 @@ pub fn contact_trimesh_cuboid(
             };
             let local = tri.vertices().map(|p| mesh_in_box.transform_point(p));
             if let Some(c) = triangle_box_contact(local, h) {
-                merge.add(c.normal, c.depth);
-                points.extend_from_slice(c.points());
+                push_contribution(contributions, points, c.normal, c.depth, 0, c.points());
                 if record {
                     hits.push([t, NO_TRIANGLE]);
                 }
@@ -64,6 +62,5 @@ pub fn contact_trimesh_cuboid(
         },
     );
     scratch.count(stats);
-    let normal = merge.normal()?;
-    reduce_to_manifold(normal, &scratch.points, pose_box)
+    scratch.merge(pose_box)
 }

@@ -7,8 +7,7 @@
 //! Triangles are two-sided surfaces: a sphere is pushed away from whichever side of a triangle
 //! it is on, and a sphere entirely inside a closed mesh touches nothing.
 
-use super::mesh_manifold::{NormalMerge, reduce_to_manifold};
-use super::mesh_scratch::{ContactScratch, NO_TRIANGLE};
+use super::mesh_scratch::{ContactScratch, NO_TRIANGLE, push_contribution};
 use crate::bounding::{Obb, RELATIVE_SLACK};
 use crate::geometry::{ContactManifold, Isometry, MeshCollider, Sphere, contact_triangle_sphere};
 use glam::Vec3;
@@ -34,10 +33,10 @@ pub fn contact_trimesh_sphere(
         sphere.radius + RELATIVE_SLACK * (local.abs().max_element() + mesh.bounding_radius());
     let reach2 = reach * reach;
     let record = scratch.records_hits();
-    let mut merge = NormalMerge::default();
     let ContactScratch {
         query,
         hits,
+        contributions,
         points,
         ..
     } = scratch;
@@ -49,9 +48,14 @@ pub fn contact_trimesh_sphere(
                 return ControlFlow::Continue(());
             };
             if let Some(m) = contact_triangle_sphere(&tri, local, sphere) {
-                let p = m.points()[0];
-                merge.add(m.normal, p.depth);
-                points.push(p);
+                push_contribution(
+                    contributions,
+                    points,
+                    m.normal,
+                    m.max_depth(),
+                    0,
+                    m.points(),
+                );
                 if record {
                     hits.push([t, NO_TRIANGLE]);
                 }
@@ -60,8 +64,7 @@ pub fn contact_trimesh_sphere(
         },
     );
     scratch.count(stats);
-    let normal = merge.normal()?;
-    reduce_to_manifold(normal, &scratch.points, pose_mesh)
+    scratch.merge(pose_mesh)
 }
 
 /// True when the box comes within `sqrt(reach2)` of `p` (both in the mesh's frame).

@@ -8,41 +8,49 @@
 //!
 //! Two intersecting triangles say *that* the surfaces cross, not how deep one solid is inside the
 //! other. The estimate uses the triangles' front normals (counter-clockwise corners, outward for
-//! a closed mesh, up for a floor):
-//! - A's corners behind B's plane reach `d_a` deep: B would move along `-n_b` by `d_a`;
-//! - B's corners behind A's plane reach `d_b` deep: B would move along `n_a` by `d_b`;
+//! a closed mesh, up for a floor), in the manner of the triangle–triangle contact of Bullet's
+//! GImpact (clip one triangle to the other's prism, measure what lies behind its plane):
+//! - the part of A's triangle above or below B's triangle (A's triangle clipped by the three
+//!   planes through B's edges, perpendicular to B) reaches `d_a` behind B's plane: B would move
+//!   along `-n_b` by `d_a`;
+//! - likewise B's triangle behind A's reaches `d_b`: B would move along `n_a` by `d_b`;
 //! - the smaller wins (the shorter way out), ties going to A's normal. The point is the midpoint
 //!   of the intersection segment (for coplanar or degenerate pairs, a point of both triangles).
 //!
 //! For a small triangle crossing a large one (a body's facets dipping into a floor) this is the
-//! dip of the small triangle below the large one's plane, which is right. It fails:
+//! dip of the small triangle below the large one's plane, which is right; clipping keeps a large
+//! triangle's far corners (behind the small one's plane only because the plane extends beyond
+//! the triangle) out of the measure. The merge then drops pairs whose direction disagrees with
+//! the rest (a floor triangle entering a box through its side: `mesh_manifold.rs`). It fails:
 //! - on **open or thin meshes**, and on meshes whose triangles face inward or inconsistently:
 //!   "behind" then is not "inside", and the normal can point the wrong way;
-//! - when a triangle is pushed **more than its own size** through the other surface: it then
-//!   leaves the intersection, the surfaces cross elsewhere or not at all, and a body entirely
-//!   inside a closed mesh touches nothing (urto collides surfaces, not volumes);
-//! - the depth measured from corners is an overestimate where a corner behind the plane lies
-//!   outside the other triangle's outline.
+//! - when a triangle is pushed **further than its own size** through the other surface: it then
+//!   leaves the intersection, the triangles still crossing are shallower, and the depth is
+//!   underestimated (the normal stays right as long as some triangles cross); a body entirely
+//!   inside a closed mesh touches nothing (urto collides surfaces, not volumes).
 //!
 //! The computation is symmetric: the meshes are put in a canonical order first, so
 //! `contact(b, a)` is exactly `contact(a, b)` flipped.
 
 use super::FALLBACK_NORMAL;
-use super::mesh_manifold::{NormalMerge, reduce_to_manifold};
-use super::mesh_scratch::ContactScratch;
+use super::mesh_scratch::{ContactScratch, push_contribution};
+use super::polygon_clip::ClipPolygon;
 use crate::bvh::TraversalOrder;
 use crate::geometry::{
-    ContactManifold, Isometry, MeshCollider, TriTriIntersection, Triangle, tri_tri_intersection,
+    ContactManifold, ContactPoint, Isometry, MeshCollider, TriTriIntersection, Triangle,
+    tri_tri_intersection,
 };
 use glam::Vec3;
 use std::cmp::Ordering;
 
-/// One intersecting triangle pair's estimate: normal from A to B, depth, point.
+/// One intersecting triangle pair's estimate: normal from A to B, depth, point, and whose
+/// triangle gave the normal (0: A's, 1: B's, 2: neither).
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct PairContact {
     normal: Vec3,
     depth: f32,
     point: Vec3,
+    side: u8,
 }
 
 /// Contact between a mesh at `pose_a` (shape A) and a mesh at `pose_b` (shape B).
@@ -119,10 +127,10 @@ fn contact_in_order(
 ) -> Option<ContactManifold> {
     scratch.begin_query();
     let b_in_a = pose_a.inv_mul(pose_b);
-    let mut merge = NormalMerge::default();
     let ContactScratch {
         query,
         hits,
+        contributions,
         points,
         ..
     } = scratch;
@@ -143,18 +151,17 @@ fn contact_in_order(
             let Some(c) = pair_contact(&ta, &tb.transformed(&b_in_a)) else {
                 return false;
             };
-            merge.add(c.normal, c.depth);
-            points.push(crate::geometry::ContactPoint {
+            let point = ContactPoint {
                 point: c.point,
                 depth: c.depth,
-            });
+            };
+            push_contribution(contributions, points, c.normal, c.depth, c.side, &[point]);
             true
         },
         hits,
     );
     scratch.count(stats);
-    let normal = merge.normal()?;
-    reduce_to_manifold(normal, &scratch.points, pose_a)
+    scratch.merge(pose_a)
 }
 
 /// The per-pair estimate of the module notes.
@@ -165,34 +172,44 @@ fn pair_contact(ta: &Triangle, tb: &Triangle) -> Option<PairContact> {
         TriTriIntersection::Coplanar | TriTriIntersection::Degenerate => shared_point(ta, tb),
     };
     let (na, nb) = (ta.normal(), tb.normal());
-    let a_behind_b = nb.map(|n| depth_behind(ta, tb.a, n));
-    let b_behind_a = na.map(|n| depth_behind(tb, ta.a, n));
-    let (normal, depth) = match (na, nb, a_behind_b, b_behind_a) {
-        (Some(na), _, Some(da), Some(db)) if db <= da => (na, db),
-        (_, Some(nb), Some(da), _) => (-nb, da),
-        (Some(na), _, _, Some(db)) => (na, db),
+    let a_behind_b = nb.map(|n| depth_behind(ta, tb, n));
+    let b_behind_a = na.map(|n| depth_behind(tb, ta, n));
+    let (normal, depth, side) = match (na, nb, a_behind_b, b_behind_a) {
+        (Some(na), _, Some(da), Some(db)) if db <= da => (na, db, 0),
+        (_, Some(nb), Some(da), _) => (-nb, da, 1),
+        (Some(na), _, _, Some(db)) => (na, db, 0),
         // Two zero-area triangles (meshes drop them; a caller of the public test may not).
         _ => (
             (tb.centroid() - ta.centroid())
                 .try_normalize()
                 .unwrap_or(FALLBACK_NORMAL),
             0.0,
+            2,
         ),
     };
     Some(PairContact {
         normal,
         depth,
         point,
+        side,
     })
 }
 
-/// How far the corners of `t` reach behind the plane through `origin` with front normal `n`
-/// (0 when none is behind).
-#[inline]
-fn depth_behind(t: &Triangle, origin: Vec3, n: Vec3) -> f32 {
-    t.vertices()
-        .into_iter()
-        .fold(0.0f32, |d, v| d.max(0.0 - n.dot(v - origin)))
+/// How far the part of `t` inside the prism of `base` (the infinite prism swept by `base` along
+/// its unit normal `n`) reaches behind `base`'s plane; 0 when none of it is behind, or when
+/// nothing is left after clipping (a pair meeting only at `base`'s border).
+fn depth_behind(t: &Triangle, base: &Triangle, n: Vec3) -> f32 {
+    let mut part = ClipPolygon::<6>::from_corners(&t.vertices());
+    let corners = base.vertices();
+    for k in 0..3 {
+        let (a, b) = (corners[k], corners[(k + 1) % 3]);
+        // Points outside the edge `a → b` (counter-clockwise about n) have `out·x > out·a`.
+        let out = (b - a).cross(n);
+        part = part.clipped(out, out.dot(a));
+    }
+    part.vertices()
+        .iter()
+        .fold(0.0f32, |d, &v| d.max(0.0 - n.dot(v - base.a)))
 }
 
 /// A point of both (meeting) triangles, near their common region: the point of `tb` nearest to
