@@ -9,7 +9,7 @@
 //! | `world/bodies/spheres`, `world/bodies/boxes` | moving bodies (orange dynamic, blue kinematic, red quarantined) | `Ellipsoids3D`, `Boxes3D` |
 //! | `world/static/...` | static scenery (grey), re-logged only when it changes | `Ellipsoids3D`, `Boxes3D` |
 //! | `world/meshes/<name>_<entity>` | each mesh body: its triangles once (grey static, orange dynamic, blue kinematic) and its pose per recorded step (static meshes: when moved) | `Mesh3D` + `Transform3D` |
-//! | `world/meshes/<name>_<entity>/bvh/level_<k>` | the mesh's hierarchy, level `k` (root 0), in the mesh's frame, once; only with [`RerunConfig::bvh_levels`] | `Boxes3D` |
+//! | `hierarchy/level_<k>/moving`, `…/static` | the OBBs of level `k` (root 0) of every mesh's hierarchy, world space (static meshes' re-logged only when they change); only with [`RerunConfig::bvh_levels`], each level in its own tab of the layout | `Boxes3D` |
 //! | `narrow_phase/overlapping_leaves` | the triangles of the hierarchy leaves through which meshes touched (cyan: first body, pink: second); only with [`RerunConfig::overlapping_leaves`] | `LineStrips3D` |
 //! | `narrow_phase/overlapping_leaf_boxes` | the boxes of those leaves | `Boxes3D` |
 //! | `world/bounding_volumes` | the world AABBs the broad phase reads (green wireframe) | `Boxes3D` |
@@ -75,7 +75,8 @@ pub struct RerunConfig {
     pub contacts: bool,
     /// Half size of the square drawn for each half-space (they are infinite).
     pub plane_half_size: f32,
-    /// Log the first `bvh_levels` levels of each mesh's hierarchy (0: none), once per mesh.
+    /// Log the first `bvh_levels` levels of each mesh's hierarchy (0: none); the layout then
+    /// shows one tab per level.
     pub bvh_levels: u32,
     /// Log the hierarchy leaves through which meshes touch, every recorded step. Makes the
     /// narrow phase record them (see
@@ -185,7 +186,7 @@ impl Plugin for RerunDebugPlugin {
             UpAxis::Y => rerun::ViewCoordinates::RIGHT_HAND_Y_UP(),
         };
         report(rec.log_static("world", &coordinates));
-        report(default_layout().send(rec, Default::default()));
+        report(default_layout(self.config.bvh_levels).send(rec, Default::default()));
         if self.config.overlapping_leaves {
             app.insert_resource(OverlappingLeaves {
                 enabled: true,
@@ -228,16 +229,38 @@ impl Drop for RerunRecording {
 
 /// The layout the viewer opens on: the 3D scene large on the left; on the right the wall time
 /// of each stage in one plot and the step's counters in another (instead of one plot each).
-fn default_layout() -> rerun::blueprint::Blueprint {
+/// With hierarchy levels recorded, a tab per level (the meshes and that level's boxes) sits on top
+/// of the right column, and the main scene leaves the boxes out.
+fn default_layout(bvh_levels: u32) -> rerun::blueprint::Blueprint {
     use rerun::blueprint::components::PanelState;
     use rerun::blueprint::*;
-    let scene = Spatial3DView::new("scene").with_origin("/");
+    let scene = Spatial3DView::new("scene")
+        .with_origin("/")
+        .with_contents(["+ /**", "- /hierarchy/**"]);
     let timing = TimeSeriesView::new("time per stage (ms)").with_origin("/timing");
     let counters = TimeSeriesView::new("counters").with_origin("/counters");
     let log = TextLogView::new("log").with_origin("/log");
-    let side = Vertical::new([timing.into(), counters.into(), log.into()])
-        .with_row_shares([0.4, 0.4, 0.2]);
-    Blueprint::new(Horizontal::new([scene.into(), side.into()]).with_column_shares([0.62, 0.38]))
+    let side = if bvh_levels == 0 {
+        Vertical::new([timing.into(), counters.into(), log.into()]).with_row_shares([0.4, 0.4, 0.2])
+    } else {
+        let levels = (0..bvh_levels).map(|k| {
+            Spatial3DView::new(format!("BVH level {k}"))
+                .with_origin("/")
+                .with_contents([
+                    "+ /world/meshes/**".to_owned(),
+                    format!("+ /hierarchy/level_{k}/**"),
+                ])
+                .into()
+        });
+        Vertical::new([
+            Tabs::new(levels).into(),
+            timing.into(),
+            counters.into(),
+            log.into(),
+        ])
+        .with_row_shares([0.45, 0.22, 0.23, 0.1])
+    };
+    Blueprint::new(Horizontal::new([scene.into(), side.into()]).with_column_shares([0.6, 0.4]))
         .with_blueprint_panel(BlueprintPanel::new().with_state(PanelState::Collapsed))
         .with_selection_panel(SelectionPanel::new().with_state(PanelState::Collapsed))
 }
@@ -490,7 +513,8 @@ type MeshBody<'a> = (
 );
 
 /// Mesh bodies: the triangles once per body (again only if its collider changes), the pose on
-/// every recorded step (static ones only when moved), and a clear when the body goes away.
+/// every recorded step (static ones only when moved), and a clear when the body goes away; and,
+/// if asked, their hierarchies' first levels.
 fn record_meshes(
     rec: Res<RerunRecording>,
     stats: Res<PhysicsStats>,
@@ -500,15 +524,18 @@ fn record_meshes(
 ) {
     let stream = &rec.stream;
     set_time(stream, &stats);
+    let mut statics_changed = false;
     for entity in removed.read() {
         if let Some(path) = logged.0.remove(&entity) {
             report(stream.log(path, &rerun::Clear::recursive()));
+            statics_changed = true;
         }
     }
     for (entity, collider, p, r, is_static, mass) in &bodies {
         let Shape::TriMesh(mesh) = &collider.shape else {
             if let Some(path) = logged.0.remove(&entity) {
                 report(stream.log(path, &rerun::Clear::recursive()));
+                statics_changed = true;
             }
             continue;
         };
@@ -523,11 +550,28 @@ fn record_meshes(
                 (false, Some(m)) if m.inverse() == 0.0 => KINEMATIC,
                 _ => DYNAMIC,
             };
-            log_mesh(stream, path, mesh, tint, rec.config.bvh_levels);
+            log_mesh(stream, path, mesh, tint);
         }
-        if fresh || !is_static || p.is_changed() || r.is_changed() {
+        let moved = fresh || p.is_changed() || r.is_changed();
+        if moved || !is_static {
             let pose = rerun::Transform3D::from_translation_rotation(arr(p.0), quat(r.0));
             report(stream.log(path.as_str(), &pose));
+        }
+        statics_changed |= is_static && moved;
+    }
+    let levels = rec.config.bvh_levels as usize;
+    if levels > 0 {
+        let mut moving = LevelBoxes::new(levels);
+        let mut fixed = LevelBoxes::new(levels);
+        for (_, collider, p, r, is_static, _) in &bodies {
+            if let Shape::TriMesh(mesh) = &collider.shape {
+                let batch = if is_static { &mut fixed } else { &mut moving };
+                batch.add(mesh, &pose(&p, Some(&r)));
+            }
+        }
+        moving.log(stream, "moving");
+        if statics_changed {
+            fixed.log(stream, "static");
         }
     }
 }
@@ -548,8 +592,8 @@ fn mesh_path(mesh: &MeshCollider, entity: Entity) -> String {
     format!("world/meshes/{name}_{entity}")
 }
 
-/// The mesh's triangles (with smooth normals, for shading) and, if asked, its hierarchy levels.
-fn log_mesh(stream: &RecordingStream, path: &str, mesh: &MeshCollider, tint: [u8; 3], levels: u32) {
+/// The mesh's triangles, with smooth normals for shading.
+fn log_mesh(stream: &RecordingStream, path: &str, mesh: &MeshCollider, tint: [u8; 3]) {
     let m = mesh.mesh();
     let albedo = rerun::datatypes::Rgba32::from_rgb(tint[0], tint[1], tint[2]);
     let triangles = rerun::Mesh3D::new(m.vertices().iter().map(|v| arr(*v)))
@@ -557,10 +601,6 @@ fn log_mesh(stream: &RecordingStream, path: &str, mesh: &MeshCollider, tint: [u8
         .with_vertex_normals(vertex_normals(m).into_iter().map(arr))
         .with_albedo_factor(albedo);
     report(stream.log(path, &triangles));
-    for level in 0..levels {
-        let boxes = bvh_level_boxes(mesh, level as usize);
-        report(stream.log(format!("{path}/bvh/level_{level}"), &boxes));
-    }
 }
 
 /// Area-weighted vertex normals (zero for a vertex no triangle uses).
@@ -578,27 +618,64 @@ fn vertex_normals(mesh: &crate::geometry::TriMesh) -> Vec<Vec3> {
         .collect()
 }
 
-/// The OBBs of the hierarchy's nodes at depth `level` (the root is level 0), in the mesh's frame.
-fn bvh_level_boxes(mesh: &MeshCollider, level: usize) -> rerun::Boxes3D {
-    let nodes = mesh.bvh().nodes();
-    // Children follow their parent in the array, so one forward sweep sets every depth.
-    let mut depth = vec![0usize; nodes.len()];
-    let (mut centers, mut halves, mut rotations) = (Vec::new(), Vec::new(), Vec::new());
-    for (i, node) in nodes.iter().enumerate() {
-        if let Some(children) = node.children() {
-            for c in children {
-                depth[c as usize] = depth[i] + 1;
-            }
-        }
-        if depth[i] == level {
-            centers.push(arr(node.bv.center));
-            halves.push(arr(node.bv.half_extents));
-            rotations.push(quat(Quat::from_mat3(&node.bv.axes)));
+/// World-space OBBs of the first levels of some hierarchies, one batch per level.
+struct LevelBoxes {
+    centers: Vec<Vec<[f32; 3]>>,
+    halves: Vec<Vec<[f32; 3]>>,
+    rotations: Vec<Vec<rerun::Quaternion>>,
+    /// Node indices of the level being expanded, and of the next (reused buffers).
+    frontier: Vec<u32>,
+    next: Vec<u32>,
+}
+
+impl LevelBoxes {
+    fn new(levels: usize) -> Self {
+        Self {
+            centers: vec![Vec::new(); levels],
+            halves: vec![Vec::new(); levels],
+            rotations: vec![Vec::new(); levels],
+            frontier: Vec::new(),
+            next: Vec::new(),
         }
     }
-    rerun::Boxes3D::from_centers_and_half_sizes(centers, halves)
-        .with_quaternions(rotations)
-        .with_colors([color(LEVELS[level % LEVELS.len()])])
+
+    /// Adds the nodes of `mesh`'s hierarchy at depths below the level count (root: level 0),
+    /// placed by `pose`; a leaf ends its branch.
+    fn add(&mut self, mesh: &MeshCollider, pose: &crate::geometry::Isometry) {
+        let nodes = mesh.bvh().nodes();
+        self.frontier.clear();
+        self.frontier.push(0);
+        for level in 0..self.centers.len() {
+            self.next.clear();
+            for &i in &self.frontier {
+                let Some(node) = nodes.get(i as usize) else {
+                    continue;
+                };
+                self.centers[level].push(arr(pose.transform_point(node.bv.center)));
+                self.halves[level].push(arr(node.bv.half_extents));
+                self.rotations[level].push(quat(pose.rotation * Quat::from_mat3(&node.bv.axes)));
+                if let Some(children) = node.children() {
+                    self.next.extend(children);
+                }
+            }
+            std::mem::swap(&mut self.frontier, &mut self.next);
+        }
+    }
+
+    /// Logs level `k` at `hierarchy/level_<k>/<group>`.
+    fn log(self, stream: &RecordingStream, group: &str) {
+        let levels = self
+            .centers
+            .into_iter()
+            .zip(self.halves)
+            .zip(self.rotations);
+        for (k, ((centers, halves), rotations)) in levels.enumerate() {
+            let boxes = rerun::Boxes3D::from_centers_and_half_sizes(centers, halves)
+                .with_quaternions(rotations)
+                .with_colors([color(LEVELS[k % LEVELS.len()])]);
+            report(stream.log(format!("hierarchy/level_{k}/{group}"), &boxes));
+        }
+    }
 }
 
 /// The leaves of each mesh contact: their triangles (world space, as closed outlines) and their

@@ -148,7 +148,13 @@ fn contact_in_order(
             };
             // The same carrying as `TriMesh::intersecting_pairs_brute_force`, so both decide
             // on the same coordinates.
-            let Some(c) = pair_contact(&ta, &tb.transformed(&b_in_a)) else {
+            let tb = tb.transformed(&b_in_a);
+            // Exact on the same coordinates (min/max do not round), so it rejects no touching
+            // pair, and it spares the exact test most of a leaf pair's triangle pairs.
+            if !ta.aabb().intersects(&tb.aabb()) {
+                return false;
+            }
+            let Some(c) = pair_contact(&ta, &tb) else {
                 return false;
             };
             let point = ContactPoint {
