@@ -461,11 +461,13 @@ fn a_mesh_sunk_into_a_floor_is_pushed_up_by_its_sinking() {
     }
 }
 
-/// The test meshes are closed with outward triangles (what the mesh–mesh estimate assumes):
-/// their signed volumes are positive.
+/// The test and example meshes are closed with outward triangles (what the mesh–mesh estimate
+/// assumes): their signed volumes are positive.
 #[test]
 fn test_meshes_face_outwards() {
-    for (name, mesh) in meshes().into_iter().filter(|(n, _)| *n != "floor") {
+    let nut = ("nut", collider(scanned("nut.ply", 1.0)));
+    let closed = meshes().into_iter().filter(|(n, _)| *n != "floor");
+    for (name, mesh) in closed.chain([nut]) {
         let volume: f64 = mesh
             .mesh()
             .iter_triangles()
