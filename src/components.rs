@@ -25,7 +25,7 @@
 //! spread to their neighbours.
 
 use crate::bounding::Aabb;
-use crate::geometry::{Isometry, Shape};
+use crate::geometry::{Isometry, MeshCollider, MeshColliderError, Shape, TriMesh};
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
 
@@ -161,6 +161,26 @@ impl Collider {
     pub fn half_space(normal: Vec3) -> Self {
         Self {
             shape: Shape::half_space(normal),
+        }
+    }
+
+    /// A triangle mesh (validated by [`TriMesh::new`]) with its hierarchy, built here once.
+    /// Errors only if the hierarchy cannot be built (more than `u32::MAX` triangles).
+    pub fn trimesh(mesh: TriMesh) -> Result<Self, MeshColliderError> {
+        MeshCollider::new(mesh).map(Self::mesh)
+    }
+
+    /// A mesh loaded from an OBJ, STL or PLY file (chosen by extension). Errors: unreadable
+    /// file, unknown extension, content that does not parse, or geometry that is not a valid
+    /// mesh (no triangles, non-finite coordinates, every triangle degenerate).
+    pub fn from_mesh_file(path: impl AsRef<std::path::Path>) -> Result<Self, MeshColliderError> {
+        MeshCollider::from_file(path).map(Self::mesh)
+    }
+
+    /// A mesh collider built beforehand: cheap, so many bodies can share one mesh.
+    pub fn mesh(collider: MeshCollider) -> Self {
+        Self {
+            shape: Shape::TriMesh(collider),
         }
     }
 }

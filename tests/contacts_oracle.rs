@@ -103,6 +103,7 @@ fn to_parry(
         Shape::Sphere(s) => Box::new(parry3d::shape::Ball::new(s.radius)),
         Shape::Cuboid(c) => Box::new(parry3d::shape::Cuboid::new(v(c.half_extents))),
         Shape::HalfSpace(h) => Box::new(parry3d::shape::HalfSpace::new(v(h.normal))),
+        Shape::TriMesh(_) => unreachable!("this oracle covers primitives (meshes: tests/mesh_*)"),
     };
     (parry_shape, parry_pose)
 }
@@ -153,6 +154,7 @@ fn distance_outside(shape: &Shape, pose: &Isometry, p: Vec3) -> f32 {
         Shape::Sphere(s) => (local.length() - s.radius).max(0.0),
         Shape::Cuboid(c) => (local.abs() - c.half_extents).max(Vec3::ZERO).length(),
         Shape::HalfSpace(h) => h.normal.dot(local).max(0.0),
+        Shape::TriMesh(_) => unreachable!("primitives only"),
     }
 }
 
@@ -170,6 +172,7 @@ fn overlap_along(a: &Shape, pa: &Isometry, b: &Shape, pb: &Isometry, n: Vec3) ->
                 })
                 .fold(f32::NEG_INFINITY, f32::max),
             Shape::HalfSpace(_) => f32::INFINITY,
+            Shape::TriMesh(_) => unreachable!("primitives only"),
         }
     };
     reach(a, pa, n) + reach(b, pb, -n)

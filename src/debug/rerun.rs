@@ -8,6 +8,10 @@
 //! |---|---|---|
 //! | `world/bodies/spheres`, `world/bodies/boxes` | moving bodies (orange dynamic, blue kinematic, red quarantined) | `Ellipsoids3D`, `Boxes3D` |
 //! | `world/static/...` | static scenery (grey), re-logged only when it changes | `Ellipsoids3D`, `Boxes3D` |
+//! | `world/meshes/<name>_<entity>` | each mesh body: its triangles once (grey static, orange dynamic, blue kinematic) and its pose per recorded step (static meshes: when moved) | `Mesh3D` + `Transform3D` |
+//! | `hierarchy/level_<k>/moving`, `…/static` | the OBBs of level `k` (root 0) of every mesh's hierarchy, world space (static meshes' re-logged only when they change); only with [`RerunConfig::bvh_levels`], each level in its own tab of the layout | `Boxes3D` |
+//! | `narrow_phase/overlapping_leaves` | the triangles of the hierarchy leaves through which meshes touched (cyan: first body, pink: second); only with [`RerunConfig::overlapping_leaves`] | `LineStrips3D` |
+//! | `narrow_phase/overlapping_leaf_boxes` | the boxes of those leaves | `Boxes3D` |
 //! | `world/bounding_volumes` | the world AABBs the broad phase reads (green wireframe) | `Boxes3D` |
 //! | `world/velocities` | velocity arrows (yellow) | `Arrows3D` |
 //! | `world/contacts` | contact points with their normals scaled by depth (magenta) | `Arrows3D` |
@@ -19,7 +23,8 @@
 //! Conversion to rerun's types happens here and only here: the rest of urto never sees rerun.
 
 use crate::components::*;
-use crate::geometry::Shape;
+use crate::geometry::{MeshCollider, Shape};
+use crate::plugins::narrow_phase::{NO_LEAF, OverlappingLeaves};
 use crate::plugins::{BroadPhasePairs, Contacts};
 use crate::schedule::{PhysicsSchedule, PhysicsSet};
 use crate::stats::{PhysicsStats, Stage};
@@ -27,6 +32,7 @@ use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
 use rerun::RecordingStream;
+use std::collections::BTreeMap;
 use std::fmt;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -69,6 +75,13 @@ pub struct RerunConfig {
     pub contacts: bool,
     /// Half size of the square drawn for each half-space (they are infinite).
     pub plane_half_size: f32,
+    /// Log the first `bvh_levels` levels of each mesh's hierarchy (0: none); the layout then
+    /// shows one tab per level.
+    pub bvh_levels: u32,
+    /// Log the hierarchy leaves through which meshes touch, every recorded step. Makes the
+    /// narrow phase record them (see
+    /// [`OverlappingLeaves`](crate::plugins::narrow_phase::OverlappingLeaves)).
+    pub overlapping_leaves: bool,
 }
 
 impl RerunConfig {
@@ -83,6 +96,8 @@ impl RerunConfig {
             velocities: true,
             contacts: true,
             plane_half_size: 10.0,
+            bvh_levels: 0,
+            overlapping_leaves: false,
         }
     }
 }
@@ -171,8 +186,15 @@ impl Plugin for RerunDebugPlugin {
             UpAxis::Y => rerun::ViewCoordinates::RIGHT_HAND_Y_UP(),
         };
         report(rec.log_static("world", &coordinates));
-        report(default_layout().send(rec, Default::default()));
+        report(default_layout(self.config.bvh_levels).send(rec, Default::default()));
+        if self.config.overlapping_leaves {
+            app.insert_resource(OverlappingLeaves {
+                enabled: true,
+                pairs: Vec::new(),
+            });
+        }
         app.init_resource::<DebugClock>()
+            .init_resource::<LoggedMeshes>()
             .insert_resource(RerunRecording {
                 stream: self.recording.clone(),
                 config: self.config.clone(),
@@ -183,7 +205,9 @@ impl Plugin for RerunDebugPlugin {
                     start_debug_clock,
                     record_statics,
                     record_bodies,
+                    record_meshes,
                     record_pairs,
+                    record_overlapping_leaves,
                     record_stats,
                 )
                     .chain()
@@ -205,16 +229,38 @@ impl Drop for RerunRecording {
 
 /// The layout the viewer opens on: the 3D scene large on the left; on the right the wall time
 /// of each stage in one plot and the step's counters in another (instead of one plot each).
-fn default_layout() -> rerun::blueprint::Blueprint {
+/// With hierarchy levels recorded, a tab per level (the meshes and that level's boxes) sits on top
+/// of the right column, and the main scene leaves the boxes out.
+fn default_layout(bvh_levels: u32) -> rerun::blueprint::Blueprint {
     use rerun::blueprint::components::PanelState;
     use rerun::blueprint::*;
-    let scene = Spatial3DView::new("scene").with_origin("/");
+    let scene = Spatial3DView::new("scene")
+        .with_origin("/")
+        .with_contents(["+ /**", "- /hierarchy/**"]);
     let timing = TimeSeriesView::new("time per stage (ms)").with_origin("/timing");
     let counters = TimeSeriesView::new("counters").with_origin("/counters");
     let log = TextLogView::new("log").with_origin("/log");
-    let side = Vertical::new([timing.into(), counters.into(), log.into()])
-        .with_row_shares([0.4, 0.4, 0.2]);
-    Blueprint::new(Horizontal::new([scene.into(), side.into()]).with_column_shares([0.62, 0.38]))
+    let side = if bvh_levels == 0 {
+        Vertical::new([timing.into(), counters.into(), log.into()]).with_row_shares([0.4, 0.4, 0.2])
+    } else {
+        let levels = (0..bvh_levels).map(|k| {
+            Spatial3DView::new(format!("BVH level {k}"))
+                .with_origin("/")
+                .with_contents([
+                    "+ /world/meshes/**".to_owned(),
+                    format!("+ /hierarchy/level_{k}/**"),
+                ])
+                .into()
+        });
+        Vertical::new([
+            Tabs::new(levels).into(),
+            timing.into(),
+            counters.into(),
+            log.into(),
+        ])
+        .with_row_shares([0.45, 0.22, 0.23, 0.1])
+    };
+    Blueprint::new(Horizontal::new([scene.into(), side.into()]).with_column_shares([0.6, 0.4]))
         .with_blueprint_panel(BlueprintPanel::new().with_state(PanelState::Collapsed))
         .with_selection_panel(SelectionPanel::new().with_state(PanelState::Collapsed))
 }
@@ -227,6 +273,21 @@ const BV: [u8; 3] = [46, 204, 113];
 const VELOCITY: [u8; 3] = [241, 196, 15];
 const CONTACT: [u8; 3] = [217, 70, 239];
 const PAIR: [u8; 3] = [120, 120, 120];
+const LEAF_A: [u8; 3] = [26, 188, 196];
+const LEAF_B: [u8; 3] = [255, 99, 146];
+/// Hierarchy levels cycle through these colours.
+const LEVELS: [[u8; 3]; 6] = [
+    [46, 204, 113],
+    [52, 152, 219],
+    [155, 89, 182],
+    [241, 196, 15],
+    [230, 126, 34],
+    [231, 76, 60],
+];
+
+fn color([r, g, b]: [u8; 3]) -> rerun::Color {
+    rerun::Color::from_rgb(r, g, b)
+}
 
 fn report<E: fmt::Display>(r: Result<(), E>) {
     if let Err(e) = r {
@@ -280,6 +341,8 @@ impl ShapeBatch {
                 let half = Vec3::new(plane_half_size, plane_half_size, 0.005);
                 self.push_box(p - normal * 0.005, half, facing, color);
             }
+            // Meshes have their own entities (`record_meshes`).
+            Shape::TriMesh(_) => {}
         }
     }
 
@@ -434,6 +497,248 @@ fn record_pairs(
             .with_colors([rerun::Color::from_rgb(PAIR[0], PAIR[1], PAIR[2])]);
         report(stream.log("broad_phase/pairs", &lines));
     }
+}
+
+/// The entity path of each mesh body logged so far (sorted by entity: deterministic).
+#[derive(Resource, Default)]
+struct LoggedMeshes(BTreeMap<Entity, String>);
+
+type MeshBody<'a> = (
+    Entity,
+    Ref<'a, Collider>,
+    Ref<'a, Position>,
+    Ref<'a, Rotation>,
+    Has<Static>,
+    Option<&'a Mass>,
+);
+
+/// Mesh bodies: the triangles once per body (again only if its collider changes), the pose on
+/// every recorded step (static ones only when moved), and a clear when the body goes away; and,
+/// if asked, their hierarchies' first levels.
+fn record_meshes(
+    rec: Res<RerunRecording>,
+    stats: Res<PhysicsStats>,
+    bodies: Query<MeshBody>,
+    mut removed: RemovedComponents<Collider>,
+    mut logged: ResMut<LoggedMeshes>,
+) {
+    let stream = &rec.stream;
+    set_time(stream, &stats);
+    let mut statics_changed = false;
+    for entity in removed.read() {
+        if let Some(path) = logged.0.remove(&entity) {
+            report(stream.log(path, &rerun::Clear::recursive()));
+            statics_changed = true;
+        }
+    }
+    for (entity, collider, p, r, is_static, mass) in &bodies {
+        let Shape::TriMesh(mesh) = &collider.shape else {
+            if let Some(path) = logged.0.remove(&entity) {
+                report(stream.log(path, &rerun::Clear::recursive()));
+                statics_changed = true;
+            }
+            continue;
+        };
+        let fresh = collider.is_changed() || !logged.0.contains_key(&entity);
+        let path = logged
+            .0
+            .entry(entity)
+            .or_insert_with(|| mesh_path(mesh, entity));
+        if fresh {
+            let tint = match (is_static, mass) {
+                (true, _) => STATIC,
+                (false, Some(m)) if m.inverse() == 0.0 => KINEMATIC,
+                _ => DYNAMIC,
+            };
+            log_mesh(stream, path, mesh, tint);
+        }
+        let moved = fresh || p.is_changed() || r.is_changed();
+        if moved || !is_static {
+            let pose = rerun::Transform3D::from_translation_rotation(arr(p.0), quat(r.0));
+            report(stream.log(path.as_str(), &pose));
+        }
+        statics_changed |= is_static && moved;
+    }
+    let levels = rec.config.bvh_levels as usize;
+    if levels > 0 {
+        let mut moving = LevelBoxes::new(levels);
+        let mut fixed = LevelBoxes::new(levels);
+        for (_, collider, p, r, is_static, _) in &bodies {
+            if let Shape::TriMesh(mesh) = &collider.shape {
+                let batch = if is_static { &mut fixed } else { &mut moving };
+                batch.add(mesh, &pose(&p, Some(&r)));
+            }
+        }
+        moving.log(stream, "moving");
+        if statics_changed {
+            fixed.log(stream, "static");
+        }
+    }
+}
+
+/// `world/meshes/<name>_<entity>`, the name reduced to characters safe in an entity path.
+fn mesh_path(mesh: &MeshCollider, entity: Entity) -> String {
+    let name: String = mesh
+        .name()
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    format!("world/meshes/{name}_{entity}")
+}
+
+/// The mesh's triangles, with smooth normals for shading.
+fn log_mesh(stream: &RecordingStream, path: &str, mesh: &MeshCollider, tint: [u8; 3]) {
+    let m = mesh.mesh();
+    let albedo = rerun::datatypes::Rgba32::from_rgb(tint[0], tint[1], tint[2]);
+    let triangles = rerun::Mesh3D::new(m.vertices().iter().map(|v| arr(*v)))
+        .with_triangle_indices(m.triangles().iter().copied())
+        .with_vertex_normals(vertex_normals(m).into_iter().map(arr))
+        .with_albedo_factor(albedo);
+    report(stream.log(path, &triangles));
+}
+
+/// Area-weighted vertex normals (zero for a vertex no triangle uses).
+fn vertex_normals(mesh: &crate::geometry::TriMesh) -> Vec<Vec3> {
+    let mut normals = vec![Vec3::ZERO; mesh.vertex_count()];
+    for (t, corners) in mesh.iter_triangles().zip(mesh.triangles()) {
+        let n = t.scaled_normal();
+        for &i in corners {
+            normals[i as usize] += n;
+        }
+    }
+    normals
+        .into_iter()
+        .map(|n| n.try_normalize().unwrap_or(Vec3::ZERO))
+        .collect()
+}
+
+/// World-space OBBs of the first levels of some hierarchies, one batch per level.
+struct LevelBoxes {
+    centers: Vec<Vec<[f32; 3]>>,
+    halves: Vec<Vec<[f32; 3]>>,
+    rotations: Vec<Vec<rerun::Quaternion>>,
+    /// Node indices of the level being expanded, and of the next (reused buffers).
+    frontier: Vec<u32>,
+    next: Vec<u32>,
+}
+
+impl LevelBoxes {
+    fn new(levels: usize) -> Self {
+        Self {
+            centers: vec![Vec::new(); levels],
+            halves: vec![Vec::new(); levels],
+            rotations: vec![Vec::new(); levels],
+            frontier: Vec::new(),
+            next: Vec::new(),
+        }
+    }
+
+    /// Adds the nodes of `mesh`'s hierarchy at depths below the level count (root: level 0),
+    /// placed by `pose`; a leaf ends its branch.
+    fn add(&mut self, mesh: &MeshCollider, pose: &crate::geometry::Isometry) {
+        let nodes = mesh.bvh().nodes();
+        self.frontier.clear();
+        self.frontier.push(0);
+        for level in 0..self.centers.len() {
+            self.next.clear();
+            for &i in &self.frontier {
+                let Some(node) = nodes.get(i as usize) else {
+                    continue;
+                };
+                self.centers[level].push(arr(pose.transform_point(node.bv.center)));
+                self.halves[level].push(arr(node.bv.half_extents));
+                self.rotations[level].push(quat(pose.rotation * Quat::from_mat3(&node.bv.axes)));
+                if let Some(children) = node.children() {
+                    self.next.extend(children);
+                }
+            }
+            std::mem::swap(&mut self.frontier, &mut self.next);
+        }
+    }
+
+    /// Logs level `k` at `hierarchy/level_<k>/<group>`.
+    fn log(self, stream: &RecordingStream, group: &str) {
+        let levels = self
+            .centers
+            .into_iter()
+            .zip(self.halves)
+            .zip(self.rotations);
+        for (k, ((centers, halves), rotations)) in levels.enumerate() {
+            let boxes = rerun::Boxes3D::from_centers_and_half_sizes(centers, halves)
+                .with_quaternions(rotations)
+                .with_colors([color(LEVELS[k % LEVELS.len()])]);
+            report(stream.log(format!("hierarchy/level_{k}/{group}"), &boxes));
+        }
+    }
+}
+
+/// The leaves of each mesh contact: their triangles (world space, as closed outlines) and their
+/// boxes, first body's cyan, second body's pink.
+fn record_overlapping_leaves(
+    rec: Res<RerunRecording>,
+    leaves: Res<OverlappingLeaves>,
+    colliders: Query<(&Collider, &Position, &Rotation)>,
+) {
+    if !rec.config.overlapping_leaves {
+        return;
+    }
+    let mut strips: Vec<[[f32; 3]; 4]> = Vec::new();
+    let mut strip_colors = Vec::new();
+    let (mut centers, mut halves, mut rotations, mut box_colors) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut side_leaves = Vec::new();
+    for overlap in &leaves.pairs {
+        for (side, entity, tint) in [(0, overlap.a, LEAF_A), (1, overlap.b, LEAF_B)] {
+            let Ok((c, p, r)) = colliders.get(entity) else {
+                continue;
+            };
+            let Shape::TriMesh(mesh) = &c.shape else {
+                continue;
+            };
+            side_leaves.clear();
+            side_leaves.extend(
+                overlap
+                    .leaves
+                    .iter()
+                    .map(|l| l[side])
+                    .filter(|&l| l != NO_LEAF),
+            );
+            side_leaves.sort_unstable();
+            side_leaves.dedup();
+            let pose = pose(p, Some(r));
+            for &leaf in &side_leaves {
+                let Some(node) = mesh.bvh().nodes().get(leaf as usize) else {
+                    continue;
+                };
+                for &t in mesh.bvh().leaf_triangles(node) {
+                    if let Some(tri) = mesh.mesh().triangle(t as usize) {
+                        let [a, b, c] = tri.vertices().map(|v| arr(pose.transform_point(v)));
+                        strips.push([a, b, c, a]);
+                        strip_colors.push(color(tint));
+                    }
+                }
+                centers.push(arr(pose.transform_point(node.bv.center)));
+                halves.push(arr(node.bv.half_extents));
+                rotations.push(quat(pose.rotation * Quat::from_mat3(&node.bv.axes)));
+                box_colors.push(color(tint));
+            }
+        }
+    }
+    let lines = rerun::LineStrips3D::new(strips).with_colors(strip_colors);
+    report(rec.stream.log("narrow_phase/overlapping_leaves", &lines));
+    let boxes = rerun::Boxes3D::from_centers_and_half_sizes(centers, halves)
+        .with_quaternions(rotations)
+        .with_colors(box_colors);
+    report(
+        rec.stream
+            .log("narrow_phase/overlapping_leaf_boxes", &boxes),
+    );
 }
 
 /// When this step's recording began: the Debug stage times itself without writing to the

@@ -1,8 +1,10 @@
-//! Geometry: poses, shapes, and the shape-pair tests that produce contacts.
+//! Geometry: poses, shapes (primitives and triangle meshes), and the shape-pair tests that
+//! produce contacts.
 
 mod contact;
 pub mod contacts;
 mod isometry;
+mod mesh_collider;
 pub mod mesh_io;
 pub(crate) mod predicates;
 mod primitives_mesh;
@@ -14,6 +16,7 @@ mod weld;
 
 pub use contact::{ContactManifold, ContactPoint, MAX_MANIFOLD_POINTS};
 pub use isometry::Isometry;
+pub use mesh_collider::{MeshCollider, MeshColliderError};
 pub use primitives_mesh::MAX_PROCEDURAL_VERTICES;
 pub use shapes::{Cuboid, HalfSpace, Shape, ShapeError, Sphere};
 pub use tri_tri::{TriTriIntersection, tri_tri_intersect, tri_tri_intersection};

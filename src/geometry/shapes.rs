@@ -1,10 +1,10 @@
-//! Collision shapes in their local frames: the slides' closed-form shapes (sphere, plane)
-//! and the box that OBB tests and games both need.
+//! Collision shapes in their local frames: the slides' closed-form shapes (sphere, plane),
+//! the box that OBB tests and games both need, and triangle meshes with their hierarchy.
 //!
 //! A shape never stores its pose: the pose comes with every query (see [`Isometry`]).
 
 use crate::bounding::Aabb;
-use crate::geometry::Isometry;
+use crate::geometry::{Isometry, MeshCollider};
 use glam::Vec3;
 use std::fmt;
 
@@ -41,6 +41,9 @@ pub enum Shape {
     Cuboid(Cuboid),
     /// See [`HalfSpace`].
     HalfSpace(HalfSpace),
+    /// A triangle mesh (a surface: open meshes are fine) with its hierarchy; see
+    /// [`MeshCollider`]. Cheap to clone (shared).
+    TriMesh(MeshCollider),
 }
 
 /// Why a shape cannot be simulated.
@@ -87,7 +90,8 @@ impl Shape {
         })
     }
 
-    /// Checks that the shape's numbers describe a real shape.
+    /// Checks that the shape's numbers describe a real shape. Meshes are validated when their
+    /// [`MeshCollider`] is built, so they always pass.
     pub fn validate(&self) -> Result<(), ShapeError> {
         match self {
             Self::Sphere(s) if !(s.radius.is_finite() && s.radius >= 0.0) => {
@@ -120,6 +124,7 @@ impl Shape {
                 Aabb::from_center_half_extents(Vec3::ZERO, c.half_extents).transformed(pose)
             }
             Self::HalfSpace(_) => Aabb::new(Vec3::NEG_INFINITY, Vec3::INFINITY),
+            Self::TriMesh(m) => m.world_aabb(pose),
         }
     }
 
@@ -129,6 +134,7 @@ impl Shape {
             Self::Sphere(s) => s.radius,
             Self::Cuboid(c) => c.half_extents.length(),
             Self::HalfSpace(_) => f32::INFINITY,
+            Self::TriMesh(m) => m.bounding_radius(),
         }
     }
 }

@@ -338,7 +338,8 @@ fn face_contact(
         + reference.half.max_element()
         + incident.half.max_element();
     let margin = CLIP_MARGIN_FRACTION * scale;
-    let mut polygon = ClipPolygon::from_quad(incident_face(incident, ref_normal));
+    let mut polygon =
+        ClipPolygon::<MAX_CLIP_VERTICES>::from_quad(incident_face(incident, ref_normal));
     for k in [(axis + 1) % 3, (axis + 2) % 3] {
         let side = reference.axes.col(k);
         let centre = reference.center.dot(side);

@@ -1,5 +1,6 @@
-//! Shape-pair contact tests (the narrow phase for primitives), one file per pair as in parry's
-//! `query/contact/contact_<shape1>_<shape2>.rs`, and [`contact`], which dispatches on the pair.
+//! Shape-pair contact tests (the narrow phase), one file per pair as in parry's
+//! `query/contact/contact_<shape1>_<shape2>.rs`, and [`contact`] / [`contact_with_scratch`], which
+//! dispatch on the pair.
 //!
 //! Every test follows the conventions of [`ContactManifold`]: normal from A to B, touching counts
 //! (depth 0), and degenerate input (coincident centres, zero-size shapes) gives a finite normal
@@ -7,16 +8,27 @@
 //!
 //! # The pairs
 //!
-//! | A \ B         | `Sphere`                      | `Cuboid`                          | `HalfSpace`                   |
-//! |---------------|-------------------------------|-----------------------------------|-------------------------------|
-//! | **Sphere**    | [`contact_sphere_sphere`]     | [`contact_sphere_cuboid`]         | [`contact_sphere_halfspace`]  |
-//! | **Cuboid**    | sphere–cuboid, flipped        | [`contact_cuboid_cuboid`] (SAT)   | [`contact_cuboid_halfspace`]  |
-//! | **HalfSpace** | sphere–half-space, flipped    | cuboid–half-space, flipped        | `None` (both static, infinite) |
+//! | A \ B         | `Sphere`                      | `Cuboid`                          | `HalfSpace`                   | `TriMesh`                     |
+//! |---------------|-------------------------------|-----------------------------------|-------------------------------|-------------------------------|
+//! | **Sphere**    | [`contact_sphere_sphere`]     | [`contact_sphere_cuboid`]         | [`contact_sphere_halfspace`]  | mesh–sphere, flipped          |
+//! | **Cuboid**    | sphere–cuboid, flipped        | [`contact_cuboid_cuboid`] (SAT)   | [`contact_cuboid_halfspace`]  | mesh–box, flipped             |
+//! | **HalfSpace** | sphere–half-space, flipped    | cuboid–half-space, flipped        | `None` (both static, infinite) | mesh–half-space, flipped      |
+//! | **TriMesh**   | [`contact_trimesh_sphere`]    | [`contact_trimesh_cuboid`]        | [`contact_trimesh_halfspace`] | [`contact_trimesh_trimesh`]   |
 //!
 //! "Flipped" means the test runs with the arguments swapped and the manifold is turned around
-//! with [`ContactManifold::flipped`] (normal negated, points unchanged). Box–box puts its two
-//! boxes in a canonical order the same way, so for every pair `contact(a, b)` and
+//! with [`ContactManifold::flipped`] (normal negated, points unchanged). Box–box and mesh–mesh put
+//! their two shapes in a canonical order the same way, so for every pair `contact(a, b)` and
 //! `contact(b, a)` report opposite normals and equal depths (but for the one exception below).
+//!
+//! # Meshes
+//!
+//! Mesh tests descend the mesh's OBB hierarchy ([`MeshCollider`](crate::geometry::MeshCollider))
+//! with the other shape, test the triangles of the leaves they reach exactly, and merge the
+//! triangle contacts into one manifold (`mesh_manifold.rs`: depth-weighted normal, deepest and
+//! widest points). Triangles are two-sided surfaces, so a shape entirely inside a closed mesh
+//! touches nothing. They need buffers: [`contact_with_scratch`] takes a [`ContactScratch`] that
+//! a caller keeps from query to query (so a warm query allocates nothing) and that sums the
+//! hierarchy work (`Nv`, `Nn`, `Ns`); [`contact`] makes a fresh one per mesh query.
 //!
 //! # Degenerate geometry
 //!
@@ -35,16 +47,29 @@ mod closest_segment_points;
 mod cuboid_cuboid;
 mod cuboid_halfspace;
 mod manifold_reduction;
+mod mesh_manifold;
+mod mesh_scratch;
 mod polygon_clip;
 mod sphere_cuboid;
 mod sphere_halfspace;
 mod sphere_sphere;
+mod triangle_cuboid;
+mod trimesh_cuboid;
+mod trimesh_halfspace;
+mod trimesh_sphere;
+mod trimesh_trimesh;
 
 pub use cuboid_cuboid::contact_cuboid_cuboid;
 pub use cuboid_halfspace::contact_cuboid_halfspace;
+pub use mesh_scratch::{ContactScratch, NO_TRIANGLE};
 pub use sphere_cuboid::contact_sphere_cuboid;
 pub use sphere_halfspace::contact_sphere_halfspace;
 pub use sphere_sphere::contact_sphere_sphere;
+pub use triangle_cuboid::contact_triangle_cuboid;
+pub use trimesh_cuboid::contact_trimesh_cuboid;
+pub use trimesh_halfspace::contact_trimesh_halfspace;
+pub use trimesh_sphere::contact_trimesh_sphere;
+pub use trimesh_trimesh::{contact_triangle_triangle, contact_trimesh_trimesh};
 
 use crate::geometry::{ContactManifold, Isometry, Shape};
 use glam::Vec3;
@@ -69,7 +94,54 @@ pub(crate) fn prefer_towards_fallback(candidate_up: f32, best_up: f32) -> bool {
 /// Contact between shape `a` at `pose_a` and shape `b` at `pose_b`, or `None` when they are
 /// apart. `None` is also returned for pairs no test covers (two half-spaces). See the module
 /// docs for the table of pairs.
+///
+/// A convenience: a pair involving a mesh gets fresh buffers, which allocates. Code that runs
+/// many queries (the narrow phase) keeps a [`ContactScratch`] and calls [`contact_with_scratch`].
 pub fn contact(
+    a: &Shape,
+    pose_a: &Isometry,
+    b: &Shape,
+    pose_b: &Isometry,
+) -> Option<ContactManifold> {
+    if matches!(a, Shape::TriMesh(_)) || matches!(b, Shape::TriMesh(_)) {
+        contact_with_scratch(a, pose_a, b, pose_b, &mut ContactScratch::new())
+    } else {
+        primitive_contact(a, pose_a, b, pose_b)
+    }
+}
+
+/// [`contact`] with caller-owned buffers: mesh queries reuse `scratch` (no allocation once it
+/// has grown), add their hierarchy work to its counters, and leave their triangle hits in it
+/// ([`ContactScratch::hits`], in this call's A/B order). Pairs of primitives only clear the hits.
+pub fn contact_with_scratch(
+    a: &Shape,
+    pose_a: &Isometry,
+    b: &Shape,
+    pose_b: &Isometry,
+    scratch: &mut ContactScratch,
+) -> Option<ContactManifold> {
+    use Shape::*;
+    match (a, b) {
+        (TriMesh(m), Sphere(s)) => {
+            contact_trimesh_sphere(pose_a, m, pose_b.translation, s, scratch)
+        }
+        (TriMesh(m), Cuboid(c)) => contact_trimesh_cuboid(pose_a, m, pose_b, c, scratch),
+        (TriMesh(m), HalfSpace(h)) => contact_trimesh_halfspace(pose_a, m, pose_b, h, scratch),
+        (TriMesh(ma), TriMesh(mb)) => contact_trimesh_trimesh(pose_a, ma, pose_b, mb, scratch),
+        (Sphere(_) | Cuboid(_) | HalfSpace(_), TriMesh(_)) => {
+            let m = contact_with_scratch(b, pose_b, a, pose_a, scratch);
+            scratch.flip_hits();
+            m.map(ContactManifold::flipped)
+        }
+        _ => {
+            scratch.begin_query();
+            primitive_contact(a, pose_a, b, pose_b)
+        }
+    }
+}
+
+/// The pairs of primitives (no mesh): closed-form tests, no buffers.
+fn primitive_contact(
     a: &Shape,
     pose_a: &Isometry,
     b: &Shape,
@@ -85,9 +157,9 @@ pub fn contact(
         (Cuboid(ca), Cuboid(cb)) => contact_cuboid_cuboid(pose_a, ca, pose_b, cb),
         (Cuboid(c), HalfSpace(h)) => contact_cuboid_halfspace(pose_a, c, pose_b, h),
         (Cuboid(_), Sphere(_)) | (HalfSpace(_), Sphere(_)) | (HalfSpace(_), Cuboid(_)) => {
-            contact(b, pose_b, a, pose_a).map(ContactManifold::flipped)
+            primitive_contact(b, pose_b, a, pose_a).map(ContactManifold::flipped)
         }
-        (HalfSpace(_), HalfSpace(_)) => None,
+        (HalfSpace(_), HalfSpace(_)) | (TriMesh(_), _) | (_, TriMesh(_)) => None,
     }
 }
 
@@ -96,11 +168,13 @@ mod tests {
     use super::*;
     use glam::Quat;
 
-    fn shapes() -> [Shape; 3] {
+    fn shapes() -> [Shape; 4] {
+        let ball = crate::geometry::TriMesh::uv_sphere(0.7, 24, 12).unwrap();
         [
             Shape::sphere(0.7),
             Shape::cuboid(Vec3::new(0.5, 0.8, 0.3)),
             Shape::half_space(Vec3::new(0.1, 0.2, 1.0)),
+            Shape::TriMesh(crate::geometry::MeshCollider::new(ball).unwrap()),
         ]
     }
 
@@ -155,12 +229,15 @@ mod tests {
     fn far_apart_pairs_give_none() {
         let pa = Isometry::IDENTITY;
         let pb = Isometry::from_translation(Vec3::new(0.0, 0.0, 10.0));
-        let [sphere, cuboid, half_space] = shapes();
+        let [sphere, cuboid, half_space, mesh] = shapes();
         for (a, b) in [
             (&sphere, &sphere),
             (&sphere, &cuboid),
             (&cuboid, &sphere),
             (&cuboid, &cuboid),
+            (&mesh, &sphere),
+            (&cuboid, &mesh),
+            (&mesh, &mesh),
         ] {
             assert!(contact(a, &pa, b, &pb).is_none());
         }
@@ -168,5 +245,7 @@ mod tests {
         assert!(contact(&cuboid, &pb, &half_space, &pa).is_none());
         assert!(contact(&half_space, &pa, &sphere, &pb).is_none());
         assert!(contact(&cuboid, &pa, &half_space, &pb).is_some());
+        assert!(contact(&half_space, &pa, &mesh, &pb).is_none());
+        assert!(contact(&mesh, &pa, &half_space, &pb).is_some());
     }
 }

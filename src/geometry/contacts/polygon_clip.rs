@@ -1,25 +1,40 @@
 //! Clipping a convex polygon against a plane (Sutherland & Hodgman 1974, "Reentrant polygon
 //! clipping"), in a fixed-size buffer: the face–face contact of two boxes clips a quad against
-//! four planes, so it never holds more than eight vertices and needs no heap.
+//! four planes, so it never holds more than eight vertices and needs no heap; the triangle–box
+//! contact clips a triangle against six planes, at most nine vertices.
 
 use glam::Vec3;
 
-/// Most vertices a [`ClipPolygon`] holds: a quad clipped by four planes, each adding at most one.
+/// Most vertices the box–box [`ClipPolygon`] holds: a quad clipped by four planes, each adding
+/// at most one.
 pub(crate) const MAX_CLIP_VERTICES: usize = 8;
 
-/// A planar convex polygon of at most [`MAX_CLIP_VERTICES`] vertices, in order.
+/// Most vertices the triangle–box [`ClipPolygon`] holds: a triangle clipped by six planes.
+pub(crate) const MAX_TRIANGLE_CLIP_VERTICES: usize = 9;
+
+/// A planar convex polygon of at most `N` vertices, in order.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct ClipPolygon {
-    vertices: [Vec3; MAX_CLIP_VERTICES],
+pub(crate) struct ClipPolygon<const N: usize> {
+    vertices: [Vec3; N],
     len: usize,
 }
 
-impl ClipPolygon {
+impl<const N: usize> ClipPolygon<N> {
+    /// The polygon of the first `N` (at most) of `corners`, in order around it.
+    pub(crate) fn from_corners(corners: &[Vec3]) -> Self {
+        let mut out = Self {
+            vertices: [Vec3::ZERO; N],
+            len: 0,
+        };
+        for &c in corners {
+            out.push(c);
+        }
+        out
+    }
+
     /// The quad `corners`, in order around it.
     pub(crate) fn from_quad(corners: [Vec3; 4]) -> Self {
-        let mut vertices = [Vec3::ZERO; MAX_CLIP_VERTICES];
-        vertices[..4].copy_from_slice(&corners);
-        Self { vertices, len: 4 }
+        Self::from_corners(&corners)
     }
 
     /// The vertices, in order.
@@ -38,7 +53,7 @@ impl ClipPolygon {
     #[must_use]
     pub(crate) fn clipped(&self, normal: Vec3, offset: f32) -> Self {
         let mut out = Self {
-            vertices: [Vec3::ZERO; MAX_CLIP_VERTICES],
+            vertices: [Vec3::ZERO; N],
             len: 0,
         };
         let Some(&last) = self.vertices().last() else {
@@ -62,7 +77,7 @@ impl ClipPolygon {
     }
 
     fn push(&mut self, v: Vec3) {
-        if self.len < MAX_CLIP_VERTICES {
+        if self.len < N {
             self.vertices[self.len] = v;
             self.len += 1;
         }
@@ -73,7 +88,7 @@ impl ClipPolygon {
 mod tests {
     use super::*;
 
-    fn square(h: f32) -> ClipPolygon {
+    fn square(h: f32) -> ClipPolygon<MAX_CLIP_VERTICES> {
         ClipPolygon::from_quad([
             Vec3::new(h, h, 0.0),
             Vec3::new(-h, h, 0.0),
@@ -82,7 +97,7 @@ mod tests {
         ])
     }
 
-    fn area(p: &ClipPolygon) -> f32 {
+    fn area<const N: usize>(p: &ClipPolygon<N>) -> f32 {
         let v = p.vertices();
         (0..v.len())
             .map(|i| v[i].cross(v[(i + 1) % v.len()]).z)
@@ -107,7 +122,7 @@ mod tests {
     #[test]
     fn a_square_rotated_45_degrees_clipped_by_a_square_is_an_octagon() {
         let r = 2f32.sqrt();
-        let diamond = ClipPolygon::from_quad([
+        let diamond = ClipPolygon::<MAX_CLIP_VERTICES>::from_quad([
             Vec3::new(r, 0.0, 0.0),
             Vec3::new(0.0, r, 0.0),
             Vec3::new(-r, 0.0, 0.0),

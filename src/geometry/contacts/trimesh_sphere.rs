@@ -1,0 +1,76 @@
+//! Mesh–sphere: the sphere, carried into the mesh's frame, descends the mesh's OBB hierarchy
+//! (a node is kept while its box comes within the radius of the centre, Arvo 1990's clamp in the
+//! box's frame), and every triangle of the leaves reached is tested exactly by
+//! [`contact_triangle_sphere`] (Ericson 2005's closest point). The triangle contacts are merged
+//! into one manifold as `mesh_manifold.rs` explains.
+//!
+//! Triangles are two-sided surfaces: a sphere is pushed away from whichever side of a triangle
+//! it is on, and a sphere entirely inside a closed mesh touches nothing.
+
+use super::mesh_scratch::{ContactScratch, NO_TRIANGLE, push_contribution};
+use crate::bounding::{Obb, RELATIVE_SLACK};
+use crate::geometry::{ContactManifold, Isometry, MeshCollider, Sphere, contact_triangle_sphere};
+use glam::Vec3;
+use std::ops::ControlFlow;
+
+/// Contact between a mesh at `pose_mesh` (shape A) and a sphere centred at `center` (shape B).
+///
+/// The normal (from the mesh to the sphere) is the depth-weighted average of the normals of the
+/// triangles in contact; the points are the deepest and widest few of their contact points,
+/// each with its own depth. Fills `scratch`'s hits when recording is on, and adds the hierarchy
+/// work to its counters.
+pub fn contact_trimesh_sphere(
+    pose_mesh: &Isometry,
+    mesh: &MeshCollider,
+    center: Vec3,
+    sphere: &Sphere,
+    scratch: &mut ContactScratch,
+) -> Option<ContactManifold> {
+    scratch.begin_query();
+    let local = pose_mesh.inverse_transform_point(center);
+    // Rounding slack of the carried centre, so the box test never rejects a touching sphere.
+    let reach =
+        sphere.radius + RELATIVE_SLACK * (local.abs().max_element() + mesh.bounding_radius());
+    let reach2 = reach * reach;
+    let record = scratch.records_hits();
+    let ContactScratch {
+        query,
+        hits,
+        contributions,
+        points,
+        ..
+    } = scratch;
+    let stats = mesh.bvh().descend(
+        query,
+        |bv| obb_within(bv, local, reach2),
+        |t| {
+            let Some(tri) = mesh.mesh().triangle(t as usize) else {
+                return ControlFlow::Continue(());
+            };
+            if let Some(m) = contact_triangle_sphere(&tri, local, sphere) {
+                push_contribution(
+                    contributions,
+                    points,
+                    m.normal,
+                    m.max_depth(),
+                    0,
+                    m.points(),
+                );
+                if record {
+                    hits.push([t, NO_TRIANGLE]);
+                }
+            }
+            ControlFlow::Continue(())
+        },
+    );
+    scratch.count(stats);
+    scratch.merge(pose_mesh)
+}
+
+/// True when the box comes within `sqrt(reach2)` of `p` (both in the mesh's frame).
+#[inline]
+pub(crate) fn obb_within(bv: &Obb, p: Vec3, reach2: f32) -> bool {
+    let q = bv.axes.transpose() * (p - bv.center);
+    let outside = (q.abs() - bv.half_extents).max(Vec3::ZERO);
+    outside.length_squared() <= reach2
+}

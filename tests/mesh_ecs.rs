@@ -1,0 +1,183 @@
+//! Mesh colliders through the full plugin: mesh bodies (procedural and scanned) dropped on a mesh
+//! floor come to rest on it — no NaN, no sinking beyond `SINK_TOLERANCE`, no flying off — and
+//! the narrow phase reports the hierarchy's work as counters. Bad mesh input is an error at the
+//! constructor, never a panic later.
+
+mod common;
+
+use bevy_ecs::prelude::*;
+use glam::Vec3;
+use urto::geometry::{MeshColliderError, MeshError, TriMesh};
+use urto::prelude::*;
+
+/// How far below the floor a resting body's lowest vertex may be: the solver's slop (2 mm) plus
+/// one step of gravity (9.8 / 60² ≈ 2.7 mm) plus margin. A body that sank through a facet would
+/// be tens of centimetres down.
+const SINK_TOLERANCE: f32 = 0.01;
+
+fn asset(name: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
+}
+
+/// A scanned mesh centred on its box and scaled to about `radius`, as a collider.
+fn scanned(name: &str, radius: f32) -> Collider {
+    let mesh = urto::geometry::mesh_io::load(asset(name)).expect("test mesh loads");
+    let c = mesh.local_aabb().center();
+    let r = mesh
+        .vertices()
+        .iter()
+        .fold(0.0f32, |m, v| m.max((*v - c).length()));
+    let vertices = mesh
+        .vertices()
+        .iter()
+        .map(|v| (*v - c) * (radius / r))
+        .collect();
+    let mesh = TriMesh::new(vertices, mesh.triangles().to_vec()).expect("still valid");
+    Collider::trimesh(mesh).expect("collider builds")
+}
+
+/// The lowest point of a body's mesh in the world (bodies do not rotate).
+fn lowest_point(world: &World, body: Entity) -> f32 {
+    let c = world.get::<Collider>(body).unwrap();
+    let p = world.get::<Position>(body).unwrap().0;
+    match &c.shape {
+        urto::geometry::Shape::TriMesh(m) => p.z + m.local_aabb().min.z,
+        _ => unreachable!("mesh bodies only"),
+    }
+}
+
+#[test]
+fn mesh_bodies_dropped_on_a_mesh_floor_come_to_rest_on_it() {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    let world = app.world_mut();
+    let floor = Collider::trimesh(TriMesh::grid_floor(12.0, 24).unwrap()).unwrap();
+    world.spawn((floor, Static));
+    let bodies = [
+        Collider::trimesh(TriMesh::uv_sphere(0.4, 16, 8).unwrap()).unwrap(),
+        Collider::trimesh(TriMesh::cuboid(Vec3::new(0.4, 0.3, 0.2)).unwrap()).unwrap(),
+        Collider::trimesh(TriMesh::torus(0.4, 0.15, 24, 12).unwrap()).unwrap(),
+        scanned("ant.ply", 0.5),
+        scanned("nut.ply", 0.4),
+    ];
+    let spawned: Vec<Entity> = bodies
+        .into_iter()
+        .enumerate()
+        .map(|(i, c)| {
+            let x = -3.0 + 1.5 * i as f32;
+            world
+                .spawn((
+                    c,
+                    Position::new(x, 0.3, 1.0 + 0.3 * i as f32),
+                    Velocity::default(),
+                ))
+                .id()
+        })
+        .collect();
+
+    for second in 0..5 {
+        urto::step(app.world_mut(), 60).unwrap();
+        for &b in &spawned {
+            let low = lowest_point(app.world(), b);
+            assert!(low.is_finite(), "NaN after {second} s");
+            assert!(
+                low > -SINK_TOLERANCE,
+                "body sank to {low} after {} s",
+                second + 1
+            );
+        }
+    }
+    let world = app.world();
+    for (i, &b) in spawned.iter().enumerate() {
+        let p = world.get::<Position>(b).unwrap().0;
+        let v = world.get::<Velocity>(b).unwrap().0;
+        let low = lowest_point(world, b);
+        assert!(low < 0.02, "body {i} floats at {low}");
+        assert!(v.length() < 0.2, "body {i} still moving at {v}");
+        let x = -3.0 + 1.5 * i as f32;
+        assert!(
+            (p.x - x).abs() < 0.5 && (p.y - 0.3).abs() < 0.5,
+            "body {i} slid to {p}"
+        );
+        assert!(world.get::<Quarantined>(b).is_none());
+    }
+    let stats = world.resource::<PhysicsStats>();
+    for name in [
+        "narrow_phase/bvh_nodes_visited",
+        "narrow_phase/bv_tests",
+        "narrow_phase/triangle_tests",
+        "narrow_phase/mesh_pairs",
+    ] {
+        let value = stats.counter(name).unwrap_or(0.0);
+        assert!(value > 0.0, "{name} = {value}");
+    }
+}
+
+/// Two meshes stacked: the upper one rests on the lower one, which rests on the floor.
+#[test]
+fn a_mesh_rests_on_another_mesh() {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    let world = app.world_mut();
+    let bumpy = TriMesh::height_field(8.0, 32, |x, y| 0.05 * (x * 2.0).sin() * (y * 1.5).cos());
+    world.spawn((Collider::trimesh(bumpy.unwrap()).unwrap(), Static));
+    let slab = TriMesh::cuboid(Vec3::new(0.8, 0.8, 0.1)).unwrap();
+    let lower = world
+        .spawn((
+            Collider::trimesh(slab).unwrap(),
+            Position::new(0.0, 0.0, 0.4),
+            Velocity::default(),
+        ))
+        .id();
+    let ball = TriMesh::uv_sphere(0.3, 16, 8).unwrap();
+    let upper = world
+        .spawn((
+            Collider::trimesh(ball).unwrap(),
+            Position::new(0.1, -0.1, 1.2),
+            Velocity::default(),
+        ))
+        .id();
+    urto::step(app.world_mut(), 240).unwrap();
+    let world = app.world();
+    let slab_top = world.get::<Position>(lower).unwrap().0.z + 0.1;
+    let ball_bottom = world.get::<Position>(upper).unwrap().0.z - 0.3;
+    assert!(slab_top > 0.1, "slab sank to {slab_top}");
+    assert!(
+        (ball_bottom - slab_top).abs() < SINK_TOLERANCE,
+        "ball bottom {ball_bottom}, slab top {slab_top}"
+    );
+}
+
+#[test]
+fn bad_mesh_input_is_an_error() {
+    // Not a mesh format.
+    let readme = Collider::from_mesh_file(asset("README.md")).unwrap_err();
+    assert!(matches!(readme, MeshColliderError::Load(_)), "{readme}");
+    // A missing file.
+    assert!(Collider::from_mesh_file(asset("no_such_mesh.obj")).is_err());
+    let dir = std::env::temp_dir().join(format!("urto-mesh-ecs-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // A PLY file that does not parse.
+    let corrupt = dir.join("corrupt.ply");
+    std::fs::write(
+        &corrupt,
+        b"ply\nformat ascii 1.0\nelement vertex 3\nend_header\n1 2\n",
+    )
+    .unwrap();
+    let err = Collider::from_mesh_file(&corrupt).unwrap_err();
+    assert!(err.to_string().contains("mesh"), "{err}");
+    // An OBJ file with vertices but no faces: an empty mesh.
+    let empty = dir.join("empty.obj");
+    std::fs::write(&empty, b"v 0 0 0\nv 1 0 0\nv 0 1 0\n").unwrap();
+    assert!(Collider::from_mesh_file(&empty).is_err());
+    // Empty and degenerate arrays.
+    assert_eq!(TriMesh::new(vec![], vec![]), Err(MeshError::NoVertices));
+    let collinear = vec![Vec3::ZERO, Vec3::X, Vec3::X * 2.0];
+    assert!(matches!(
+        TriMesh::new(collinear, vec![[0, 1, 2]]),
+        Err(MeshError::AllTrianglesDegenerate { count: 1 })
+    ));
+    std::fs::remove_dir_all(&dir).ok();
+}
