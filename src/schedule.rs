@@ -14,7 +14,9 @@
 //!       candidate pairs ([`BroadPhaseSystems`]).
 //!    3. [`SubstepSet::NarrowPhase`] — exact tests on the candidates, producing contacts.
 //!    4. [`SubstepSet::Response`] — impulses and position correction; collision messages.
-//! 4. [`PhysicsSet::Debug`] — consumers of the finished step (the rerun recording). Nothing
+//! 4. [`PhysicsSet::Finish`] — world poses and bounding volumes follow the positions the
+//!    response left, so game code and debug output read a consistent state.
+//! 5. [`PhysicsSet::Debug`] — consumers of the finished step (the rerun recording). Nothing
 //!    after it reads what they write, so turning debug output off changes no result.
 //!
 //! In a Bevy `App` the schedule runs once per `FixedPostUpdate` (Bevy's fixed-timestep loop is
@@ -40,6 +42,8 @@ pub enum PhysicsSet {
     Forces,
     /// The substep loop.
     Substeps,
+    /// Derived state (world poses, bounding volumes) brought up to date with the final positions.
+    Finish,
     /// Debug output (read-only consumers).
     Debug,
 }

@@ -1,6 +1,9 @@
 //! The answer of a time-of-impact query, and the dispatch of a sweep against any [`Shape`].
 
-use super::{SphereSweep, toi_sphere_cuboid, toi_sphere_halfspace, toi_sphere_sphere};
+use super::{
+    SphereSweep, toi_sphere_cuboid, toi_sphere_halfspace, toi_sphere_sphere, toi_sphere_trimesh,
+};
+use crate::bvh::QueryScratch;
 use crate::geometry::{Isometry, Shape};
 use glam::Vec3;
 
@@ -27,13 +30,20 @@ pub struct MeshToi {
 }
 
 /// Time of impact of the sweep against `shape` placed at `pose` (static), dispatching to the
-/// pair's query. Meshes are not a [`Shape`]: see
-/// [`toi_sphere_trimesh`](super::toi_sphere_trimesh).
-pub fn toi_sphere_shape(sweep: &SphereSweep, shape: &Shape, pose: &Isometry) -> Option<Toi> {
+/// pair's query; a mesh is swept through its BVH with the reusable `scratch`.
+pub fn toi_sphere_shape(
+    sweep: &SphereSweep,
+    shape: &Shape,
+    pose: &Isometry,
+    scratch: &mut QueryScratch,
+) -> Option<Toi> {
     match shape {
         Shape::Sphere(s) => toi_sphere_sphere(sweep, pose.translation, s),
         Shape::Cuboid(c) => toi_sphere_cuboid(sweep, pose, c),
         Shape::HalfSpace(h) => toi_sphere_halfspace(sweep, pose, h),
+        Shape::TriMesh(m) => toi_sphere_trimesh(sweep, m.mesh(), m.bvh(), pose, scratch)
+            .0
+            .map(|hit| hit.toi),
     }
 }
 
@@ -57,7 +67,8 @@ mod tests {
             ),
         ];
         for (shape, expected_t) in cases {
-            let toi = toi_sphere_shape(&sweep, &shape, &pose).expect("head-on hit");
+            let mut scratch = QueryScratch::new();
+            let toi = toi_sphere_shape(&sweep, &shape, &pose, &mut scratch).expect("head-on hit");
             assert!((toi.t - expected_t).abs() < 1e-6, "{shape:?}: {toi:?}");
             assert!((toi.normal - Vec3::Z).length() < 1e-6);
         }

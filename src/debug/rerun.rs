@@ -370,12 +370,7 @@ impl ShapeBatch {
 
 type StaticChanged = (
     With<Static>,
-    Or<(
-        Added<Collider>,
-        Changed<Position>,
-        Changed<Rotation>,
-        Changed<Collider>,
-    )>,
+    Or<(Added<Collider>, Changed<GlobalPose>, Changed<Collider>)>,
 );
 
 /// Static scenery, re-logged only on the steps where some of it was added, moved or removed.
@@ -384,23 +379,23 @@ fn record_statics(
     stats: Res<PhysicsStats>,
     changed: Query<(), StaticChanged>,
     removed: RemovedComponents<Static>,
-    statics: Query<(&Collider, &Position, &Rotation), With<Static>>,
+    statics: Query<(&Collider, &GlobalPose), With<Static>>,
 ) {
     if changed.is_empty() && removed.is_empty() {
         return;
     }
     set_time(&rec.stream, &stats);
     let mut batch = ShapeBatch::default();
-    for (c, p, r) in &statics {
-        batch.push(&c.shape, p.0, r.0, STATIC, rec.config.plane_half_size);
+    for (c, g) in &statics {
+        let (p, r) = (g.0.translation, g.0.rotation);
+        batch.push(&c.shape, p, r, STATIC, rec.config.plane_half_size);
     }
     batch.log(&rec.stream, "world/static");
 }
 
 type BodyView<'a> = (
     &'a Collider,
-    &'a Position,
-    &'a Rotation,
+    &'a GlobalPose,
     &'a BoundingVolume,
     Option<&'a Velocity>,
     Option<&'a Mass>,
@@ -419,19 +414,20 @@ fn record_bodies(
     let mut batch = ShapeBatch::default();
     let (mut bv_centers, mut bv_half) = (Vec::new(), Vec::new());
     let (mut origins, mut vectors) = (Vec::new(), Vec::new());
-    for (c, p, r, bv, v, m, q) in &bodies {
+    for (c, g, bv, v, m, q) in &bodies {
+        let (p, r) = (g.0.translation, g.0.rotation);
         let color = match (q, m) {
             (Some(_), _) => QUARANTINED,
             (None, Some(m)) if m.inverse() == 0.0 => KINEMATIC,
             _ => DYNAMIC,
         };
-        batch.push(&c.shape, p.0, r.0, color, rec.config.plane_half_size);
+        batch.push(&c.shape, p, r, color, rec.config.plane_half_size);
         if bv.0.is_finite() {
             bv_centers.push(arr(bv.0.center()));
             bv_half.push(arr(bv.0.half_extents()));
         }
         if let Some(v) = v.filter(|v| v.0 != Vec3::ZERO) {
-            origins.push(arr(p.0));
+            origins.push(arr(p));
             vectors.push(arr(v.0 * 0.1));
         }
     }
@@ -464,7 +460,7 @@ fn record_pairs(
     rec: Res<RerunRecording>,
     contacts: Option<Res<Contacts>>,
     pairs: Option<Res<BroadPhasePairs>>,
-    bodies: Query<(&Position, &BoundingVolume)>,
+    bodies: Query<(&GlobalPose, &BoundingVolume)>,
 ) {
     if !rec.config.contacts {
         return;
@@ -490,7 +486,8 @@ fn record_pairs(
             .filter_map(|&(a, b)| {
                 // Pairs with unbounded scenery (every body vs the ground) would only be clutter.
                 let ((pa, ba), (pb, bb)) = (bodies.get(a).ok()?, bodies.get(b).ok()?);
-                (ba.0.is_finite() && bb.0.is_finite()).then(|| [arr(pa.0), arr(pb.0)])
+                (ba.0.is_finite() && bb.0.is_finite())
+                    .then(|| [arr(pa.0.translation), arr(pb.0.translation)])
             })
             .collect();
         let lines = rerun::LineStrips3D::new(strips)
@@ -506,8 +503,7 @@ struct LoggedMeshes(BTreeMap<Entity, String>);
 type MeshBody<'a> = (
     Entity,
     Ref<'a, Collider>,
-    Ref<'a, Position>,
-    Ref<'a, Rotation>,
+    Ref<'a, GlobalPose>,
     Has<Static>,
     Option<&'a Mass>,
 );
@@ -531,7 +527,7 @@ fn record_meshes(
             statics_changed = true;
         }
     }
-    for (entity, collider, p, r, is_static, mass) in &bodies {
+    for (entity, collider, g, is_static, mass) in &bodies {
         let Shape::TriMesh(mesh) = &collider.shape else {
             if let Some(path) = logged.0.remove(&entity) {
                 report(stream.log(path, &rerun::Clear::recursive()));
@@ -552,9 +548,12 @@ fn record_meshes(
             };
             log_mesh(stream, path, mesh, tint);
         }
-        let moved = fresh || p.is_changed() || r.is_changed();
+        let moved = fresh || g.is_changed();
         if moved || !is_static {
-            let pose = rerun::Transform3D::from_translation_rotation(arr(p.0), quat(r.0));
+            let pose = rerun::Transform3D::from_translation_rotation(
+                arr(g.0.translation),
+                quat(g.0.rotation),
+            );
             report(stream.log(path.as_str(), &pose));
         }
         statics_changed |= is_static && moved;
@@ -563,10 +562,10 @@ fn record_meshes(
     if levels > 0 {
         let mut moving = LevelBoxes::new(levels);
         let mut fixed = LevelBoxes::new(levels);
-        for (_, collider, p, r, is_static, _) in &bodies {
+        for (_, collider, g, is_static, _) in &bodies {
             if let Shape::TriMesh(mesh) = &collider.shape {
                 let batch = if is_static { &mut fixed } else { &mut moving };
-                batch.add(mesh, &pose(&p, Some(&r)));
+                batch.add(mesh, &g.0);
             }
         }
         moving.log(stream, "moving");
@@ -683,7 +682,7 @@ impl LevelBoxes {
 fn record_overlapping_leaves(
     rec: Res<RerunRecording>,
     leaves: Res<OverlappingLeaves>,
-    colliders: Query<(&Collider, &Position, &Rotation)>,
+    colliders: Query<(&Collider, &GlobalPose)>,
 ) {
     if !rec.config.overlapping_leaves {
         return;
@@ -695,7 +694,7 @@ fn record_overlapping_leaves(
     let mut side_leaves = Vec::new();
     for overlap in &leaves.pairs {
         for (side, entity, tint) in [(0, overlap.a, LEAF_A), (1, overlap.b, LEAF_B)] {
-            let Ok((c, p, r)) = colliders.get(entity) else {
+            let Ok((c, g)) = colliders.get(entity) else {
                 continue;
             };
             let Shape::TriMesh(mesh) = &c.shape else {
@@ -711,7 +710,7 @@ fn record_overlapping_leaves(
             );
             side_leaves.sort_unstable();
             side_leaves.dedup();
-            let pose = pose(p, Some(r));
+            let pose = g.0;
             for &leaf in &side_leaves {
                 let Some(node) = mesh.bvh().nodes().get(leaf as usize) else {
                     continue;

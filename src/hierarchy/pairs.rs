@@ -28,6 +28,14 @@ pub struct HierarchyStats {
     pub leaf_pairs: u64,
 }
 
+impl std::ops::AddAssign for HierarchyStats {
+    fn add_assign(&mut self, other: Self) {
+        self.bv_tests += other.bv_tests;
+        self.nodes_visited += other.nodes_visited;
+        self.leaf_pairs += other.leaf_pairs;
+    }
+}
+
 /// A node seen whole, or only its own collider (after its children were split off).
 #[derive(Clone, Copy, Debug)]
 enum Item<N> {

@@ -43,6 +43,7 @@ impl Plugin for PhysicsCorePlugin {
                 PhysicsSet::Prepare,
                 PhysicsSet::Forces,
                 PhysicsSet::Substeps,
+                PhysicsSet::Finish,
                 PhysicsSet::Debug,
             )
                 .chain(),

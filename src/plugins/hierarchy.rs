@@ -2,7 +2,8 @@
 //! `Children` relationship makes compound bodies (a car and its wheels, an arm and its links, a
 //! block and its houses).
 //!
-//! Each substep, world poses propagate **down** from the subtrees whose root or local pose
+//! Each substep (and once more at the end of the step, after the response moved bodies), world
+//! poses propagate **down** from the subtrees whose root or local pose
 //! changed, and bounding volumes are refit **up** only along the paths from changed nodes to
 //! their roots ([`refit_order`]): a node's [`BoundingVolume`] bounds its own collider and its
 //! children's volumes. A parked car or a static town costs nothing. The broad phase sees only
@@ -16,7 +17,7 @@ use crate::components::*;
 use crate::geometry::Isometry;
 use crate::hierarchy::refit_order;
 use crate::plugins::validation::quarantine;
-use crate::schedule::{BroadPhaseSystems, SubstepSchedule};
+use crate::schedule::{BroadPhaseSystems, PhysicsSchedule, PhysicsSet, SubstepSchedule};
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
@@ -28,14 +29,22 @@ pub struct HierarchyPlugin;
 
 impl Plugin for HierarchyPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<HierarchyScratch>().add_systems(
-            SubstepSchedule,
-            (
-                propagate_poses.in_set(BroadPhaseSystems::Poses),
-                refit_bounding_volumes.in_set(BroadPhaseSystems::Refit),
+        app.init_resource::<HierarchyScratch>()
+            .add_systems(
+                SubstepSchedule,
+                (
+                    propagate_poses.in_set(BroadPhaseSystems::Poses),
+                    refit_bounding_volumes.in_set(BroadPhaseSystems::Refit),
+                )
+                    .run_if(any_with_component::<BoundingVolume>),
             )
-                .run_if(any_with_component::<BoundingVolume>),
-        );
+            .add_systems(
+                PhysicsSchedule,
+                (propagate_poses, refit_bounding_volumes)
+                    .chain()
+                    .run_if(any_with_component::<BoundingVolume>)
+                    .in_set(PhysicsSet::Finish),
+            );
     }
 }
 

@@ -1,5 +1,11 @@
 //! The NarrowPhase stage: exact shape tests on the broad phase's candidates.
 //!
+//! A candidate pair of compound bodies descends both hierarchies ([`descend_pairs`]: the
+//! scene graph is the BV hierarchy, the larger volume is split first) down to pairs of
+//! colliders, and each collider pair is tested at its world pose ([`GlobalPose`]); the
+//! hierarchy's work is published as `hierarchy/bv_tests`, `hierarchy/nodes_visited` and
+//! `hierarchy/collider_pairs`.
+//!
 //! Pairs involving a mesh go through the mesh's bounding-volume hierarchy
 //! ([`contact_with_scratch`]) with buffers kept in a resource from step to step, so a warm step
 //! allocates nothing. The hierarchy work of the step — the slides' cost counters `Nv`, `Nn`, `Ns`
@@ -11,27 +17,38 @@
 //! hierarchies whose triangles touched; it is filled only while enabled (the rerun recording
 //! enables it on request), so the narrow phase pays nothing for it otherwise.
 
+use crate::bounding::Aabb;
 use crate::bvh::QueryStats;
 use crate::components::*;
 use crate::geometry::contacts::{ContactScratch, NO_TRIANGLE, contact_with_scratch};
 use crate::geometry::{ContactManifold, Shape};
+use crate::hierarchy::{BvTree, HierarchyStats, PairScratch, descend_pairs};
 use crate::plugins::broad_phase::BroadPhasePairs;
 use crate::schedule::{SubstepSchedule, SubstepSet};
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
+use std::time::Instant;
 
 /// Turns candidate pairs into contacts.
 #[derive(Debug, Clone, Default)]
 pub struct NarrowPhasePlugin;
 
-/// A contact between two entities; the manifold's normal points from `a` to `b`.
+/// A contact between two bodies; the manifold's normal points from `a` to `b`.
+///
+/// `a` and `b` are the root bodies that respond (a compound body moves as a whole);
+/// `collider_a` and `collider_b` are the parts that touched (the wheel, the house) — the roots
+/// themselves for bodies without parts.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ContactPair {
     /// First body (a moving one).
     pub a: Entity,
     /// Second body.
     pub b: Entity,
+    /// The collider of `a`'s hierarchy that touched.
+    pub collider_a: Entity,
+    /// The collider of `b`'s hierarchy that touched.
+    pub collider_b: Entity,
     /// Where and how deep they touch.
     pub manifold: ContactManifold,
 }
@@ -68,10 +85,13 @@ pub struct OverlappingLeaves {
     pub pairs: Vec<LeafOverlap>,
 }
 
-/// Buffers of the mesh queries, and the hierarchy work of the current step.
-#[derive(Resource, Debug, Default)]
+/// Buffers of the mesh and hierarchy queries, and the work of the current step.
+#[derive(Resource, Default)]
 struct NarrowPhaseScratch {
     contact: ContactScratch,
+    pairs: PairScratch<Entity, Entity>,
+    leaf_pairs: Vec<(Entity, Entity)>,
+    hierarchy: HierarchyStats,
     /// The step the sums below belong to.
     step: u64,
     work: QueryStats,
@@ -92,9 +112,41 @@ impl Plugin for NarrowPhasePlugin {
     }
 }
 
+type Node<'a> = (
+    Option<&'a Collider>,
+    &'a GlobalPose,
+    &'a BoundingVolume,
+    Option<&'a Children>,
+);
+
+/// A body's hierarchy, seen through the ECS, for the pair descent of [`crate::hierarchy`].
+struct EcsTree<'q, 'w, 's, 'd> {
+    nodes: &'q Query<'w, 's, Node<'d>, Without<Quarantined>>,
+}
+
+impl BvTree for EcsTree<'_, '_, '_, '_> {
+    type Node = Entity;
+
+    fn subtree_bv(&self, n: Entity) -> Aabb {
+        self.nodes.get(n).map_or(Aabb::EMPTY, |(_, _, bv, _)| bv.0)
+    }
+
+    fn own_bv(&self, n: Entity) -> Option<Aabb> {
+        let (collider, global, ..) = self.nodes.get(n).ok()?;
+        collider.map(|c| c.shape.world_aabb(&global.0))
+    }
+
+    fn children(&self, n: Entity, out: &mut Vec<Entity>) {
+        if let Ok((.., Some(children))) = self.nodes.get(n) {
+            out.extend(children.iter());
+        }
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
 fn compute_contacts(
     pairs: Res<BroadPhasePairs>,
-    colliders: Query<(&Collider, &Position, &Rotation)>,
+    nodes: Query<Node, Without<Quarantined>>,
     mut contacts: ResMut<Contacts>,
     mut scratch: ResMut<NarrowPhaseScratch>,
     mut debug: ResMut<OverlappingLeaves>,
@@ -105,44 +157,86 @@ fn compute_contacts(
         scratch.step = stats.step;
         scratch.work = QueryStats::default();
         scratch.mesh_pairs = 0;
+        scratch.hierarchy = HierarchyStats::default();
     }
     let record = debug.enabled;
     scratch.contact.set_record_hits(record);
     debug.pairs.clear();
-    stats.time(Stage::NarrowPhase, "narrow_phase", || {
-        contacts.pairs.clear();
-        for &(a, b) in &pairs.pairs {
-            let (Ok((ca, pa, ra)), Ok((cb, pb, rb))) = (colliders.get(a), colliders.get(b)) else {
-                continue;
-            };
-            let m = contact_with_scratch(
-                &ca.shape,
-                &pose(pa, Some(ra)),
-                &cb.shape,
-                &pose(pb, Some(rb)),
-                &mut scratch.contact,
-            );
-            let involves_mesh = is_mesh(&ca.shape) || is_mesh(&cb.shape);
-            scratch.mesh_pairs += u64::from(involves_mesh);
-            if let Some(manifold) = m {
-                contacts.pairs.push(ContactPair { a, b, manifold });
-                if record && involves_mesh {
-                    debug
-                        .pairs
-                        .push(leaf_overlap(a, &ca.shape, b, &cb.shape, &scratch.contact));
-                }
-            }
+    let tree = EcsTree { nodes: &nodes };
+    let start = Instant::now();
+    contacts.pairs.clear();
+    for &(a, b) in &pairs.pairs {
+        let compound = |e: Entity| matches!(nodes.get(e), Ok((.., Some(_))));
+        if !compound(a) && !compound(b) {
+            scratch.test_leaves(&nodes, (a, b), (a, b), &mut contacts, &mut debug);
+            continue;
         }
-    });
+        let NarrowPhaseScratch {
+            pairs: stack,
+            leaf_pairs,
+            hierarchy,
+            ..
+        } = &mut *scratch;
+        leaf_pairs.clear();
+        *hierarchy += descend_pairs(&tree, a, &tree, b, stack, |la, lb| {
+            leaf_pairs.push((la, lb))
+        });
+        for i in 0..scratch.leaf_pairs.len() {
+            let leaves = scratch.leaf_pairs[i];
+            scratch.test_leaves(&nodes, (a, b), leaves, &mut contacts, &mut debug);
+        }
+    }
+    stats.add_time(Stage::NarrowPhase, start.elapsed());
+    stats.count_run("narrow_phase");
     scratch.work += scratch.contact.take_stats();
     let n = contacts.pairs.len();
     stats.set_counter("narrow_phase/contacts", n as f64);
+    if scratch.hierarchy.bv_tests > 0 || stats.counter("hierarchy/bv_tests").is_some() {
+        let h = scratch.hierarchy;
+        stats.set_counter("hierarchy/bv_tests", h.bv_tests as f64);
+        stats.set_counter("hierarchy/nodes_visited", h.nodes_visited as f64);
+        stats.set_counter("hierarchy/collider_pairs", h.leaf_pairs as f64);
+    }
     if scratch.mesh_pairs > 0 || stats.counter("narrow_phase/mesh_pairs").is_some() {
         let w = scratch.work;
         stats.set_counter("narrow_phase/mesh_pairs", scratch.mesh_pairs as f64);
         stats.set_counter("narrow_phase/bvh_nodes_visited", w.nodes_visited as f64);
         stats.set_counter("narrow_phase/bv_tests", w.bv_tests as f64);
         stats.set_counter("narrow_phase/triangle_tests", w.leaf_tests as f64);
+    }
+}
+
+impl NarrowPhaseScratch {
+    /// Tests collider `leaves.0` (of body `roots.0`) against collider `leaves.1` (of `roots.1`)
+    /// at their world poses; a mesh goes through its BVH.
+    fn test_leaves(
+        &mut self,
+        nodes: &Query<Node, Without<Quarantined>>,
+        (a, b): (Entity, Entity),
+        (la, lb): (Entity, Entity),
+        contacts: &mut Contacts,
+        debug: &mut OverlappingLeaves,
+    ) {
+        let (Ok((Some(ca), ga, ..)), Ok((Some(cb), gb, ..))) = (nodes.get(la), nodes.get(lb))
+        else {
+            return;
+        };
+        let m = contact_with_scratch(&ca.shape, &ga.0, &cb.shape, &gb.0, &mut self.contact);
+        let involves_mesh = is_mesh(&ca.shape) || is_mesh(&cb.shape);
+        self.mesh_pairs += u64::from(involves_mesh);
+        if let Some(manifold) = m {
+            contacts.pairs.push(ContactPair {
+                a,
+                b,
+                collider_a: la,
+                collider_b: lb,
+                manifold,
+            });
+            if debug.enabled && involves_mesh {
+                let overlap = leaf_overlap(la, &ca.shape, lb, &cb.shape, &self.contact);
+                debug.pairs.push(overlap);
+            }
+        }
     }
 }
 

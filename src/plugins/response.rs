@@ -6,7 +6,7 @@ use crate::components::*;
 use crate::dynamics::response::{
     ContactConstraint, SupportGraph, correct_positions, solve_velocities,
 };
-use crate::plugins::narrow_phase::Contacts;
+use crate::plugins::narrow_phase::{ContactPair, Contacts};
 use crate::schedule::{SubstepSchedule, SubstepSet};
 use crate::settings::ContactSettings;
 use crate::stats::{PhysicsStats, Stage};
@@ -68,8 +68,8 @@ struct ResponseBuffers {
     displacement: Vec<Vec3>,
     /// Contacts ordered from the ground up (shock propagation).
     support: SupportGraph,
-    /// Each constraint's key (indexed by the constraint's tag): the pair and its rank among that
-    /// pair's manifolds.
+    /// Each constraint's key (indexed by the constraint's tag): the pair of colliders that
+    /// touched and the manifold's rank among that pair's manifolds.
     keys: Vec<ContactKey>,
     /// Last substep's impulses (normal, friction) per contact, for warm starting; looked up,
     /// never iterated, so its hashing order reaches no result.
@@ -107,15 +107,14 @@ fn resolve_contacts(
     let mut rank = 0u16;
     for (i, c) in contacts.pairs.iter().enumerate() {
         // The k-th manifold of a pair in this list is the same contact as last substep's k-th.
-        let previous = i
-            .checked_sub(1)
-            .map(|j| (contacts.pairs[j].a, contacts.pairs[j].b));
-        rank = if previous == Some((c.a, c.b)) {
+        let touching = |c: &ContactPair| (c.collider_a, c.collider_b);
+        let previous = i.checked_sub(1).map(|j| touching(&contacts.pairs[j]));
+        rank = if previous == Some(touching(c)) {
             rank + 1
         } else {
             0
         };
-        let key = (c.a, c.b, rank);
+        let key = (c.collider_a, c.collider_b, rank);
         let (ia, ib) = (b.slot(c.a, &bodies), b.slot(c.b, &bodies));
         let m = &c.manifold;
         let mu = (mu_of(c.a).max(0.0) * mu_of(c.b).max(0.0)).sqrt();
