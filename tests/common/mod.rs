@@ -70,12 +70,22 @@ pub fn posed_leaf_test<'a>(
     b: &'a Mesh,
     pose: &Isometry,
 ) -> impl FnMut(u32, u32) -> bool + 'a {
+    posed_leaf_test_with(a, b, pose, tri_tri_sat::triangles_intersect)
+}
+
+/// [`posed_leaf_test`] with another triangle–triangle test.
+pub fn posed_leaf_test_with<'a>(
+    a: &'a Mesh,
+    b: &'a Mesh,
+    pose: &Isometry,
+    test: impl Fn(&[Vec3; 3], &[Vec3; 3]) -> bool + 'a,
+) -> impl FnMut(u32, u32) -> bool + 'a {
     let r = pose.rotation_matrix();
     let t = pose.translation;
     move |ta, tb| {
         let ta = a.corners(ta);
         let tb = b.corners(tb).map(|v| r * v + t);
-        tri_tri_sat::triangles_intersect(&ta, &tb)
+        test(&ta, &tb)
     }
 }
 
