@@ -7,8 +7,13 @@ pub(super) fn section(results: &[ShotResult], balls: usize) -> Section {
     let mut body = format!(
         "{balls} balls of radius {RADIUS} m per run, shot along +x at a static `Collider::cuboid` \
          wall through `UrtoPlugins` (dt = 1/60 s, no gravity, restitution 0.5). Cells: measured \
-         fraction through (band model's prediction in brackets). The CCD column is filled when \
-         continuous collision lands.\n\n"
+         fraction through (band model's prediction in brackets). Start offsets follow a \
+         golden-ratio sequence over one step's travel, so every crossing phase is sampled. The \
+         CCD column is filled when continuous collision lands.\n\n\
+         Band model: the contact stops a ball only if a substep ends with the ball's centre \
+         within t/2 + r before the wall's mid-plane (t the wall's thickness, r the radius; past \
+         the mid-plane the nearest face is the far one, and the ball is pushed on through), so \
+         with n substeps the fraction through is max(0, 1 − (t/2 + r) / (v·dt/n)).\n\n"
     );
     body.push_str(&pass_table(results).to_markdown());
     body.push('\n');
