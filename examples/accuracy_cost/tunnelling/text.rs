@@ -143,9 +143,13 @@ pub(super) fn conclusions(results: &[ShotResult]) -> Vec<String> {
         .collect();
     if !leaky.is_empty() {
         out.push(format!(
-            "even 32 substeps let balls through for: {} — the case for continuous collision \
-             (CCD row pending).",
-            leaky.join(", ")
+            "even 32 substeps let balls through for: {} — the case for continuous collision{}.",
+            leaky.join(", "),
+            if results.iter().any(|r| r.ccd.is_none()) {
+                " (CCD row pending)"
+            } else {
+                ""
+            }
         ));
     }
     out
