@@ -11,10 +11,8 @@
 #[path = "../tests/common/mod.rs"]
 mod common;
 
-use common::Mesh;
-use common::meshes::torus;
-use common::rng::Rng;
-use common::tri_tri_sat::triangles_intersect;
+use common::meshes::torus_pair;
+use common::{Mesh, placements, posed_leaf_test};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use urto::bounding::{Aabb, BoundingSphere, Bv, Kdop14, Kdop18, Kdop26, Obb};
@@ -40,13 +38,8 @@ struct Scene {
 }
 
 fn scene(label: &'static str, n: usize) -> Scene {
-    let nv = ((n as f32 / 2.0 / 2.5).sqrt()).max(3.0) as u32;
-    let nu = (n as u32 / 2 / nv).max(3);
-    let a = torus(1.0, 0.3, nu, nv);
-    let b = torus(0.8, 0.25, nu, nv);
-    let mut rng = Rng::new(2024);
-    let reach = a.radius() + b.radius();
-    let poses = (0..PLACEMENTS).map(|_| rng.placement(reach)).collect();
+    let (a, b) = torus_pair(n);
+    let poses = placements(&a, &b, PLACEMENTS, 2024);
     Scene { label, a, b, poses }
 }
 
@@ -57,17 +50,6 @@ fn scenes() -> Vec<Scene> {
         .filter(|(label, _)| wanted.split(',').any(|w| w.trim() == *label))
         .map(|(label, n)| scene(label, n))
         .collect()
-}
-
-/// The leaf test: B's triangle carried into A's frame, then a separating-axis test.
-fn leaf_test<'a>(a: &'a Mesh, b: &'a Mesh, pose: &Isometry) -> impl FnMut(u32, u32) -> bool + 'a {
-    let r = pose.rotation_matrix();
-    let t = pose.translation;
-    move |ta, tb| {
-        let ta = a.corners(ta);
-        let tb = b.corners(tb).map(|v| r * v + t);
-        triangles_intersect(&ta, &tb)
-    }
 }
 
 fn bench_kind<B: Bv>(c: &mut Criterion, kind: &str, s: &Scene) {
@@ -89,7 +71,7 @@ fn bench_kind<B: Bv>(c: &mut Criterion, kind: &str, s: &Scene) {
                     poses
                         .iter()
                         .filter(|pose| {
-                            let test = leaf_test(&s.a, &s.b, pose);
+                            let test = posed_leaf_test(&s.a, &s.b, pose);
                             ta.first_intersecting_pair(&tb, pose, order, &mut scratch, test)
                                 .0
                                 .is_some()
@@ -102,7 +84,7 @@ fn bench_kind<B: Bv>(c: &mut Criterion, kind: &str, s: &Scene) {
                 bench.iter(|| {
                     let mut pairs = 0;
                     for pose in poses {
-                        let test = leaf_test(&s.a, &s.b, pose);
+                        let test = posed_leaf_test(&s.a, &s.b, pose);
                         ta.intersecting_pairs(&tb, pose, order, &mut scratch, test, &mut out);
                         pairs += out.len();
                     }

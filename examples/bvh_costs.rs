@@ -10,11 +10,10 @@
 #[path = "../tests/common/mod.rs"]
 mod common;
 
-use common::Mesh;
-use common::meshes::torus;
-use common::rng::Rng;
-use common::tri_tri_sat::triangles_intersect;
-use std::time::{Duration, Instant};
+use common::meshes::torus_pair;
+use common::timing::mean_time;
+use common::{Mesh, placements, posed_leaf_test};
+use std::time::Duration;
 use urto::bounding::{Aabb, BoundingSphere, Bv, Kdop14, Kdop18, Kdop26, Obb};
 use urto::bvh::{
     BuildOptions, BuildRule, Bvh, QueryScratch, QueryStats, TraversalOrder, measure_unit_costs,
@@ -24,41 +23,9 @@ use urto::geometry::Isometry;
 const PLACEMENTS: usize = 64;
 const MIN_TIME: Duration = Duration::from_millis(40);
 
-/// Two tori of about `n` triangles each.
-fn meshes(n: usize) -> (Mesh, Mesh) {
-    let nv = ((n as f32 / 2.0 / 2.5).sqrt()).max(3.0) as u32;
-    let nu = (n as u32 / 2 / nv).max(3);
-    (torus(1.0, 0.3, nu, nv), torus(0.8, 0.25, nu, nv))
-}
-
-/// Placements of B near A, mostly touching, seeded.
-fn placements(a: &Mesh, b: &Mesh) -> Vec<Isometry> {
-    let mut rng = Rng::new(2024);
-    let reach = a.radius() + b.radius();
-    (0..PLACEMENTS).map(|_| rng.placement(reach)).collect()
-}
-
-/// The leaf test, transforming B's triangle into A's frame on the fly.
-fn leaf_test<'a>(a: &'a Mesh, b: &'a Mesh, pose: &Isometry) -> impl FnMut(u32, u32) -> bool + 'a {
-    let r = pose.rotation_matrix();
-    let t = pose.translation;
-    move |ta, tb| {
-        let ta = a.corners(ta);
-        let tb = b.corners(tb).map(|v| r * v + t);
-        triangles_intersect(&ta, &tb)
-    }
-}
-
 /// Mean time of one call of `f` over at least MIN_TIME.
-fn time<R>(mut f: impl FnMut() -> R) -> Duration {
-    std::hint::black_box(f());
-    let start = Instant::now();
-    let mut n = 0u32;
-    while start.elapsed() < MIN_TIME || n < 3 {
-        std::hint::black_box(f());
-        n += 1;
-    }
-    start.elapsed() / n
+fn time<R>(f: impl FnMut() -> R) -> Duration {
+    mean_time(MIN_TIME, f)
 }
 
 fn per_placement(total: Duration) -> f64 {
@@ -98,7 +65,7 @@ fn run_kind<B: Bv>(name: &str, a: &Mesh, b: &Mesh, poses: &[Isometry]) {
                         pose,
                         order,
                         &mut scratch,
-                        leaf_test(a, b, pose),
+                        posed_leaf_test(a, b, pose),
                     );
                     early_stats += s;
                     hits += usize::from(found.is_some());
@@ -115,7 +82,7 @@ fn run_kind<B: Bv>(name: &str, a: &Mesh, b: &Mesh, poses: &[Isometry]) {
                         pose,
                         order,
                         &mut scratch,
-                        leaf_test(a, b, pose),
+                        posed_leaf_test(a, b, pose),
                         &mut out,
                     );
                     pairs += out.len();
@@ -126,7 +93,7 @@ fn run_kind<B: Bv>(name: &str, a: &Mesh, b: &Mesh, poses: &[Isometry]) {
                 &tb,
                 &poses[0],
                 order,
-                leaf_test(a, b, &poses[0]),
+                posed_leaf_test(a, b, &poses[0]),
                 Duration::from_millis(30),
             );
             let n = PLACEMENTS as f64;
@@ -203,8 +170,8 @@ fn main() {
     let kinds = std::env::var("URTO_BVH_KINDS")
         .unwrap_or_else(|_| "parry,sphere,aabb,obb,kdop14,kdop18,kdop26".into());
     let wanted = |k: &str| kinds.split(',').any(|w| w.trim() == k);
-    let (a, b) = meshes(n);
-    let poses = placements(&a, &b);
+    let (a, b) = torus_pair(n);
+    let poses = placements(&a, &b, PLACEMENTS, 2024);
     println!(
         "A: {} triangles, B: {} triangles, {PLACEMENTS} placements; times per placement",
         a.triangles.len(),

@@ -23,6 +23,14 @@ pub fn torus(major: f32, minor: f32, nu: u32, nv: u32) -> Mesh {
     from_trimesh(TriMesh::torus(major, minor, nu, nv).expect("valid torus parameters"))
 }
 
+/// The BVH measurements' pair: two tori (radii 1 / 0.3 and 0.8 / 0.25) of about `n` triangles
+/// each.
+pub fn torus_pair(n: usize) -> (Mesh, Mesh) {
+    let nv = ((n as f32 / 2.0 / 2.5).sqrt()).max(3.0) as u32;
+    let nu = (n as u32 / 2 / nv).max(3);
+    (torus(1.0, 0.3, nu, nv), torus(0.8, 0.25, nu, nv))
+}
+
 /// `n` independent random triangles of size up to `size` in a ball of radius `spread`.
 pub fn soup(n: usize, spread: f32, size: f32, rng: &mut Rng) -> Mesh {
     let mut vertices = Vec::new();

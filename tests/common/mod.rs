@@ -5,6 +5,7 @@
 
 pub mod meshes;
 pub mod rng;
+pub mod timing;
 pub mod tri_tri_sat;
 
 use bevy_app::App;
@@ -60,6 +61,40 @@ pub fn leaf_test<'a>(
         let tb = b.triangles[tb as usize].map(|i| b_vertices_in_a[i as usize]);
         tri_tri_sat::triangles_intersect(&ta, &tb)
     }
+}
+
+/// The leaf test of the BVH measurements: triangle `tb` of B carried into A's frame by `pose` on
+/// the fly (as a query does, so its cost is part of `Cs`), then the separating-axis test.
+pub fn posed_leaf_test<'a>(
+    a: &'a Mesh,
+    b: &'a Mesh,
+    pose: &Isometry,
+) -> impl FnMut(u32, u32) -> bool + 'a {
+    posed_leaf_test_with(a, b, pose, tri_tri_sat::triangles_intersect)
+}
+
+/// [`posed_leaf_test`] with another triangle–triangle test.
+pub fn posed_leaf_test_with<'a>(
+    a: &'a Mesh,
+    b: &'a Mesh,
+    pose: &Isometry,
+    test: impl Fn(&[Vec3; 3], &[Vec3; 3]) -> bool + 'a,
+) -> impl FnMut(u32, u32) -> bool + 'a {
+    let r = pose.rotation_matrix();
+    let t = pose.translation;
+    move |ta, tb| {
+        let ta = a.corners(ta);
+        let tb = b.corners(tb).map(|v| r * v + t);
+        test(&ta, &tb)
+    }
+}
+
+/// `count` seeded placements of B near A (see [`rng::Rng::placement`]), the same for every
+/// contender measured on the pair.
+pub fn placements(a: &Mesh, b: &Mesh, count: usize, seed: u64) -> Vec<Isometry> {
+    let mut rng = rng::Rng::new(seed);
+    let reach = a.radius() + b.radius();
+    (0..count).map(|_| rng.placement(reach)).collect()
 }
 
 /// Every intersecting pair, by testing all of them, sorted.
