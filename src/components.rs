@@ -196,6 +196,15 @@ pub struct BoundingVolume(pub Aabb);
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 pub struct GlobalPose(pub Isometry);
 
+/// Continuous collision for a fast body: instead of testing only where the step ends (where a
+/// bullet may already be past a thin wall: tunnelling), the body's motion during the step is
+/// swept against static scenery and it stops at the first impact, then spends the rest of the
+/// step from there. Costs one sweep per step; bodies without it pay nothing.
+///
+/// The sweep uses the body's bounding sphere (exact for balls, conservative for other shapes).
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Ccd;
+
 /// Marks scenery that never moves.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[require(Position, Rotation)]
