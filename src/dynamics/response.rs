@@ -77,6 +77,9 @@ pub struct ContactConstraint {
     target_speed: f32,
     /// Normal impulse accumulated over the sweeps (`>= 0`: contacts push, never pull).
     normal_impulse: f32,
+    /// True when the approach was too slow to bounce: a body resting on, or pressed against,
+    /// another.
+    resting: bool,
     /// Friction impulse accumulated over the sweeps, in the contact's tangent plane.
     tangent_impulse: Vec3,
 }
@@ -94,6 +97,7 @@ impl ContactConstraint {
             tag: 0,
             target_speed: 0.0,
             normal_impulse: 0.0,
+            resting: false,
             tangent_impulse: Vec3::ZERO,
         }
     }
@@ -139,11 +143,8 @@ impl ContactConstraint {
     /// Restitution target from the approach speed before any impulse of this step.
     fn prepare(&mut self, v: &[Vec3], settings: &SolverSettings) {
         let approach = -self.relative_velocity(v).dot(self.normal);
-        let e = if approach > settings.restitution_threshold {
-            self.restitution
-        } else {
-            0.0
-        };
+        self.resting = approach <= settings.restitution_threshold;
+        let e = if self.resting { 0.0 } else { self.restitution };
         self.target_speed = e * approach.max(0.0);
     }
 
@@ -252,6 +253,53 @@ pub fn solve_velocities(
     }
 }
 
+/// How far the contact response moves bodies that are only in *resting* contacts, this step:
+/// the motion their solved velocity would have made minus the motion the integrator made,
+/// `(v_after - v_before)·dt`, but never more than the penetration of a contact it undoes.
+///
+/// urto detects contacts after integrating (the slides' order), so each step gravity first moves
+/// a resting body `g·dt²` into its support and only then does the solver stop it. Undoing that
+/// motion with the solved velocity — friction included — keeps stacks and piles from sinking
+/// and creeping sideways, as solving velocities before integrating positions does in Box2D.
+/// Bodies in an impact are left to [`correct_positions`]; a body arriving from above is moved
+/// back only as far as it went in, so it lands on the surface instead of hovering. Pass the
+/// result to [`correct_positions`] as its starting displacement.
+pub fn resting_displacements(
+    contacts: &[ContactConstraint],
+    velocities_before: &[Vec3],
+    velocities_after: &[Vec3],
+    dt: f32,
+    out: &mut Vec<Vec3>,
+    scale: &mut Vec<f32>,
+) {
+    let n = velocities_before.len();
+    // scale < 0 marks a body in an impact (no settling); otherwise the fraction kept.
+    scale.clear();
+    scale.resize(n, 1.0);
+    for c in contacts.iter().filter(|c| !c.resting) {
+        scale[c.a] = -1.0;
+        scale[c.b] = -1.0;
+    }
+    out.clear();
+    out.extend(
+        velocities_before
+            .iter()
+            .zip(velocities_after)
+            .map(|(b, a)| (*a - *b) * dt),
+    );
+    for c in contacts {
+        for (body, outward) in [(c.a, -c.normal), (c.b, c.normal)] {
+            let undo = out[body].dot(outward);
+            if scale[body] > 0.0 && undo > c.depth {
+                scale[body] = scale[body].min(c.depth.max(0.0) / undo);
+            }
+        }
+    }
+    for (d, k) in out.iter_mut().zip(scale.iter()) {
+        *d *= k.max(0.0);
+    }
+}
+
 /// Support levels of the contact graph (Guendelman, Bridson & Fedkiw 2003, "Nonconvex rigid
 /// bodies with stacking", shock propagation): immovable bodies are level 0, a body touching a
 /// level-`k` body is level `k+1`, bodies with no chain of contacts down to an immovable one are
@@ -324,7 +372,8 @@ impl SupportGraph {
     }
 }
 
-/// Pushes bodies apart along the contact normals until penetration is below `slop`. With
+/// Pushes bodies apart along the contact normals until penetration is below `slop`, starting
+/// from the per-body `displacement` given (empty: none), which it extends and applies. With
 /// `levels` (from [`SupportGraph`]) the lower body of a contact stays put and the upper one
 /// moves; between bodies of equal level (or without levels) the motion is shared by inverse
 /// mass. `positions` are moved in place.
@@ -334,11 +383,12 @@ pub fn correct_positions(
     inverse_mass: &[f32],
     levels: Option<&[u32]>,
     settings: &SolverSettings,
-    scratch: &mut Vec<Vec3>,
+    displacement: &mut Vec<Vec3>,
 ) {
-    // Accumulated displacement per body, so later sweeps see the penetration that is left.
-    scratch.clear();
-    scratch.resize(positions.len(), Vec3::ZERO);
+    // Accumulated displacement per body, so later sweeps see the penetration that is left. It
+    // may arrive holding displacements already decided (see `resting_displacements`).
+    displacement.resize(positions.len(), Vec3::ZERO);
+    let scratch = displacement;
     for _ in 0..settings.position_iterations {
         for c in contacts {
             let (mut wa, mut wb) = (inverse_mass[c.a], inverse_mass[c.b]);

@@ -11,13 +11,15 @@
 //! The moving-body algorithm is replaceable: any [`BroadPhase`] works, e.g.
 //! `BroadPhasePlugin { moving: || Box::new(SortAndSweep::new()), ..default() }`.
 
+use crate::bounding::Aabb;
 use crate::broad_phase::{
     AxisTests, BodyKind, BroadPhase, IncrementalSap, ProxyId, StaticGrid, StaticGridConfig,
 };
 use crate::components::*;
+use crate::plugins::core::PrepareIndex;
 use crate::plugins::proxy_table::{Proxy, ProxyTable};
 use crate::plugins::validation::quarantine;
-use crate::schedule::{BroadPhaseSystems, SubstepSchedule};
+use crate::schedule::{BroadPhaseSystems, PhysicsSchedule, SubstepSchedule};
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
@@ -44,6 +46,11 @@ impl Default for BroadPhasePlugin {
     }
 }
 
+/// Indexing bodies spawned, moved or removed between steps, in Prepare: scenery is in the grid
+/// before any substep sweeps against it.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct IndexBodies;
+
 /// Candidate pairs of this substep; the first entity of a pair is always a moving body.
 #[derive(Resource, Debug, Default, Clone)]
 pub struct BroadPhasePairs {
@@ -59,8 +66,8 @@ pub struct BroadPhaseIndex {
     grid: StaticGrid,
     grid_config: StaticGridConfig,
     proxies: ProxyTable,
-    static_batch: Vec<(ProxyId, crate::bounding::Aabb)>,
-    moving_batch: Vec<(ProxyId, crate::bounding::Aabb, BodyKind)>,
+    static_batch: Vec<(ProxyId, Aabb)>,
+    moving_batch: Vec<(ProxyId, Aabb, BodyKind)>,
     hits: Vec<u32>,
 }
 
@@ -90,6 +97,15 @@ impl BroadPhaseIndex {
     pub fn moving(&self) -> &(dyn BroadPhase + Send + Sync) {
         self.moving.as_ref()
     }
+
+    /// Appends to `out` the static roots whose volume meets `aabb` (from the grid, ascending
+    /// proxy id) and then every unbounded static (entity order): the scenery a volume may touch.
+    pub fn statics_touching(&mut self, aabb: &Aabb, out: &mut Vec<Entity>) {
+        if !self.grid.is_empty() && self.grid.query(aabb, &mut self.hits).is_ok() {
+            out.extend(self.hits.iter().map(|&id| self.proxies.entity(id)));
+        }
+        out.extend_from_slice(self.proxies.unbounded());
+    }
 }
 
 impl Plugin for BroadPhasePlugin {
@@ -103,6 +119,13 @@ impl Plugin for BroadPhasePlugin {
                     find_candidate_pairs.in_set(BroadPhaseSystems::Pairs),
                 )
                     .run_if(any_with_component::<Collider>),
+            )
+            .add_systems(
+                PhysicsSchedule,
+                sync_broad_phase
+                    .run_if(any_with_component::<Collider>)
+                    .in_set(IndexBodies)
+                    .in_set(PrepareIndex),
             );
     }
 }

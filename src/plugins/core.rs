@@ -52,7 +52,11 @@ impl Plugin for PhysicsCorePlugin {
             begin_step.in_set(PhysicsSet::Prepare).before(PrepareStart),
             run_substeps.in_set(PhysicsSet::Substeps),
         ));
-        physics.configure_sets(PrepareStart.in_set(PhysicsSet::Prepare));
+        physics.configure_sets(
+            (PrepareStart, PrepareIndex)
+                .chain()
+                .in_set(PhysicsSet::Prepare),
+        );
         app.add_schedule(physics);
 
         let mut substep = Schedule::new(SubstepSchedule);
@@ -93,9 +97,14 @@ impl Plugin for PhysicsCorePlugin {
     }
 }
 
-/// Anchor for Prepare's systems: they run after the step's bookkeeping.
+/// Anchor for Prepare's validation: it runs after the step's bookkeeping.
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct PrepareStart;
+
+/// Prepare's second half: poses, volumes and the broad-phase index follow what game code did
+/// between steps (spawns, teleports), after validation set bad bodies aside.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct PrepareIndex;
 
 fn begin_step(mut stats: ResMut<PhysicsStats>) {
     stats.begin_step();

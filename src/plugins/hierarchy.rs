@@ -2,8 +2,8 @@
 //! `Children` relationship makes compound bodies (a car and its wheels, an arm and its links, a
 //! block and its houses).
 //!
-//! Each substep (and once more at the end of the step, after the response moved bodies), world
-//! poses propagate **down** from the subtrees whose root or local pose
+//! Each substep (and in Prepare, for bodies spawned or moved by game code between steps, and in
+//! Finish, after the response moved bodies), world poses propagate **down** from the subtrees whose root or local pose
 //! changed, and bounding volumes are refit **up** only along the paths from changed nodes to
 //! their roots ([`refit_order`]): a node's [`BoundingVolume`] bounds its own collider and its
 //! children's volumes. A parked car or a static town costs nothing. The broad phase sees only
@@ -16,6 +16,8 @@ use crate::bounding::Aabb;
 use crate::components::*;
 use crate::geometry::Isometry;
 use crate::hierarchy::refit_order;
+use crate::plugins::broad_phase::IndexBodies;
+use crate::plugins::core::PrepareIndex;
 use crate::plugins::validation::quarantine;
 use crate::schedule::{BroadPhaseSystems, PhysicsSchedule, PhysicsSet, SubstepSchedule};
 use crate::stats::{PhysicsStats, Stage};
@@ -44,6 +46,14 @@ impl Plugin for HierarchyPlugin {
                     .chain()
                     .run_if(any_with_component::<BoundingVolume>)
                     .in_set(PhysicsSet::Finish),
+            )
+            .add_systems(
+                PhysicsSchedule,
+                (propagate_poses, refit_bounding_volumes)
+                    .chain()
+                    .run_if(any_with_component::<BoundingVolume>)
+                    .in_set(PrepareIndex)
+                    .before(IndexBodies),
             );
     }
 }

@@ -27,10 +27,16 @@ impl Plugin for IntegrationPlugin {
             SubstepSchedule,
             integrate_bodies
                 .run_if(any_with_component::<Velocity>)
+                .in_set(IntegrateBodies)
                 .in_set(SubstepSet::Integrate),
         );
     }
 }
+
+/// The integration itself, as a label other stages can order against (continuous collision
+/// records where bodies start before it and sweeps after it).
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct IntegrateBodies;
 
 /// Flat arrays reused from step to step.
 #[derive(Resource, Default)]

@@ -13,6 +13,7 @@
 //! ```
 
 pub mod broad_phase;
+pub mod ccd;
 pub mod core;
 pub mod forces;
 pub mod hierarchy;
@@ -24,6 +25,7 @@ pub mod transform_sync;
 pub mod validation;
 
 pub use broad_phase::{BroadPhaseIndex, BroadPhasePairs, BroadPhasePlugin};
+pub use ccd::{CcdImpacts, CcdPlugin, CcdSettings};
 pub use core::{PhysicsCorePlugin, StepError, step};
 pub use forces::{ForcesPlugin, GatheredForces};
 pub use hierarchy::HierarchyPlugin;
@@ -66,6 +68,7 @@ impl PluginGroup for UrtoPlugins {
             .add(IntegrationPlugin)
             .add(HierarchyPlugin)
             .add(BroadPhasePlugin::default())
+            .add(CcdPlugin)
             .add(NarrowPhasePlugin)
             .add(ResponsePlugin)
             .add(TransformSyncPlugin)

@@ -34,6 +34,10 @@ use std::time::Instant;
 #[derive(Debug, Clone, Default)]
 pub struct NarrowPhasePlugin;
 
+/// The contact computation, as a label other stages can order against.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ComputeContacts;
+
 /// A contact between two bodies; the manifold's normal points from `a` to `b`.
 ///
 /// `a` and `b` are the root bodies that respond (a compound body moves as a whole);
@@ -107,6 +111,7 @@ impl Plugin for NarrowPhasePlugin {
                 SubstepSchedule,
                 compute_contacts
                     .run_if(any_with_component::<Collider>)
+                    .in_set(ComputeContacts)
                     .in_set(SubstepSet::NarrowPhase),
             );
     }

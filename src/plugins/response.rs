@@ -4,11 +4,11 @@
 
 use crate::components::*;
 use crate::dynamics::response::{
-    ContactConstraint, SupportGraph, correct_positions, solve_velocities,
+    ContactConstraint, SupportGraph, correct_positions, resting_displacements, solve_velocities,
 };
 use crate::plugins::narrow_phase::{ContactPair, Contacts};
 use crate::schedule::{SubstepSchedule, SubstepSet};
-use crate::settings::ContactSettings;
+use crate::settings::{ContactSettings, PhysicsTimestep};
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
 use bevy_ecs::entity::EntityHashMap;
@@ -66,6 +66,8 @@ struct ResponseBuffers {
     inverse_mass: Vec<f32>,
     constraints: Vec<ContactConstraint>,
     displacement: Vec<Vec3>,
+    velocities_before: Vec<Vec3>,
+    settle_scale: Vec<f32>,
     /// Contacts ordered from the ground up (shock propagation).
     support: SupportGraph,
     /// Each constraint's key (indexed by the constraint's tag): the pair of colliders that
@@ -88,6 +90,7 @@ fn resolve_contacts(
     restitution: Query<&Restitution>,
     friction: Query<&Friction>,
     settings: Res<ContactSettings>,
+    timestep: Res<PhysicsTimestep>,
     mut buffers: ResMut<ResponseBuffers>,
     mut stats: ResMut<PhysicsStats>,
 ) {
@@ -129,12 +132,21 @@ fn resolve_contacts(
         b.keys.push(key);
     }
     b.support.order(&mut b.constraints, &b.inverse_mass);
+    b.velocities_before.clone_from(&b.velocities);
     solve_velocities(
         &mut b.constraints,
         &mut b.velocities,
         &b.inverse_mass,
         Some(b.support.levels()),
         &settings.solver,
+    );
+    resting_displacements(
+        &b.constraints,
+        &b.velocities_before,
+        &b.velocities,
+        timestep.substep_dt(),
+        &mut b.displacement,
+        &mut b.settle_scale,
     );
     correct_positions(
         &b.constraints,

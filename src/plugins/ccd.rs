@@ -1,0 +1,277 @@
+//! Continuous collision in the step: fast bodies stop at thin walls instead of tunnelling.
+//!
+//! The slides' cure for tunnelling is to split `dt` into substeps (brute force: every body pays).
+//! Here only the bodies that need it pay: those marked [`Ccd`], and — when
+//! [`CcdSettings::auto_speed_ratio`] is set — those moving more than that many times their own
+//! size in one substep. For each, the motion the integrator just produced (start → end position)
+//! is swept against the static scenery its swept volume meets ([`crate::ccd`]: exact time of
+//! impact of the body's bounding sphere against spheres, boxes, planes and meshes). At the first
+//! impact the body is moved there, its velocity is reflected with the pair's restitution, and it
+//! spends the rest of the substep from there (up to [`CcdSettings::max_impacts`] impacts). Each
+//! impact also becomes a contact of the substep, so collision messages report it.
+//!
+//! Only static scenery is swept against; fast bodies meeting each other are left to the
+//! discrete step (and substeps). A body already touching a surface at the start of its motion
+//! is the contact solver's business, not an impact.
+
+use crate::bvh::QueryScratch;
+use crate::ccd::{InitialOverlap, SphereSweep, Toi, toi_sphere_shape};
+use crate::components::*;
+use crate::dynamics::response::reflect;
+use crate::geometry::ContactManifold;
+use crate::plugins::broad_phase::BroadPhaseIndex;
+use crate::plugins::integration::IntegrateBodies;
+use crate::plugins::narrow_phase::{ComputeContacts, ContactPair, Contacts};
+use crate::schedule::{SubstepSchedule, SubstepSet};
+use crate::settings::{ContactSettings, PhysicsTimestep};
+use crate::stats::{PhysicsStats, Stage};
+use bevy_app::prelude::*;
+use bevy_ecs::prelude::*;
+use glam::Vec3;
+use std::time::Instant;
+
+/// Sweeps fast bodies against static scenery each substep.
+#[derive(Debug, Clone, Default)]
+pub struct CcdPlugin;
+
+/// When continuous collision applies.
+#[derive(Resource, Clone, Copy, Debug, PartialEq)]
+pub struct CcdSettings {
+    /// Sweep any moving body whose motion in one substep exceeds this many times its bounding
+    /// radius, marked [`Ccd`] or not (`None`: only marked bodies). Default 1: a body that could
+    /// pass through an obstacle as thick as itself in one substep is swept.
+    pub auto_speed_ratio: Option<f32>,
+    /// Most impacts handled for one body in one substep (a ball in a narrow corridor).
+    pub max_impacts: u32,
+}
+
+impl Default for CcdSettings {
+    fn default() -> Self {
+        Self {
+            auto_speed_ratio: Some(1.0),
+            max_impacts: 4,
+        }
+    }
+}
+
+/// The impacts found by the sweeps of the current substep (also added to [`Contacts`]).
+#[derive(Resource, Debug, Default, Clone)]
+pub struct CcdImpacts {
+    /// Body `a` hit static collider `collider_b` of body `b`; depth 0, normal from `a` to `b`.
+    pub contacts: Vec<ContactPair>,
+}
+
+impl Plugin for CcdPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<CcdSettings>()
+            .init_resource::<CcdImpacts>()
+            .init_resource::<CcdScratch>()
+            .add_systems(
+                SubstepSchedule,
+                (
+                    (
+                        record_sweep_starts.before(IntegrateBodies),
+                        sweep_fast_bodies.after(IntegrateBodies),
+                    )
+                        .run_if(any_with_component::<Velocity>)
+                        .in_set(SubstepSet::Integrate),
+                    add_impacts_to_contacts
+                        .after(ComputeContacts)
+                        .in_set(SubstepSet::NarrowPhase),
+                ),
+            );
+    }
+}
+
+/// A body to sweep: where it started the substep and the radius of the sphere swept.
+#[derive(Clone, Copy, Debug)]
+struct SweepStart {
+    body: Entity,
+    from: Vec3,
+    radius: f32,
+}
+
+#[derive(Resource, Default)]
+struct CcdScratch {
+    starts: Vec<SweepStart>,
+    candidates: Vec<Entity>,
+    stack: Vec<Entity>,
+    query: QueryScratch,
+}
+
+type Mover<'a> = (
+    Entity,
+    &'a Position,
+    &'a Velocity,
+    &'a BoundingVolume,
+    Option<&'a Collider>,
+    Has<Ccd>,
+);
+type MovingRoot = (Without<Static>, Without<Quarantined>, Without<ChildOf>);
+
+/// Radius of the sphere swept for a body at `p`: exact for a ball, otherwise the sphere about
+/// `p` holding the body's whole volume (parts included).
+fn sweep_radius(p: Vec3, bv: &BoundingVolume, collider: Option<&Collider>) -> f32 {
+    match collider.map(|c| &c.shape) {
+        Some(crate::geometry::Shape::Sphere(s))
+            if bv.0.half_extents().max_element() <= s.radius =>
+        {
+            s.radius
+        }
+        _ => (bv.0.center() - p).length() + bv.0.half_extents().length(),
+    }
+}
+
+fn record_sweep_starts(
+    bodies: Query<Mover, MovingRoot>,
+    settings: Res<CcdSettings>,
+    timestep: Res<PhysicsTimestep>,
+    mut scratch: ResMut<CcdScratch>,
+) {
+    scratch.starts.clear();
+    let dt = timestep.substep_dt();
+    for (body, p, v, bv, collider, marked) in &bodies {
+        if !(bv.0.is_valid() && bv.0.is_finite()) {
+            continue;
+        }
+        let radius = sweep_radius(p.0, bv, collider);
+        let fast = settings
+            .auto_speed_ratio
+            .is_some_and(|k| v.0.length() * dt > k * radius);
+        if marked || fast {
+            scratch.starts.push(SweepStart {
+                body,
+                from: p.0,
+                radius,
+            });
+        }
+    }
+}
+
+type Obstacle<'a> = (
+    Option<&'a Collider>,
+    &'a GlobalPose,
+    &'a BoundingVolume,
+    Option<&'a Children>,
+    Option<&'a Restitution>,
+);
+
+/// Sweeps each recorded body from its start to where the integrator put it.
+#[allow(clippy::too_many_arguments)]
+fn sweep_fast_bodies(
+    mut bodies: Query<(&mut Position, &mut Velocity, Option<&Restitution>), MovingRoot>,
+    obstacles: Query<Obstacle, Without<Quarantined>>,
+    mut index: ResMut<BroadPhaseIndex>,
+    settings: Res<CcdSettings>,
+    contact_settings: Res<ContactSettings>,
+    timestep: Res<PhysicsTimestep>,
+    mut scratch: ResMut<CcdScratch>,
+    mut impacts: ResMut<CcdImpacts>,
+    mut stats: ResMut<PhysicsStats>,
+) {
+    impacts.contacts.clear();
+    if scratch.starts.is_empty() {
+        return;
+    }
+    let start = Instant::now();
+    let dt = timestep.substep_dt();
+    let s = &mut *scratch;
+    for i in 0..s.starts.len() {
+        let SweepStart { body, from, radius } = s.starts[i];
+        let Ok((mut p, mut v, e_body)) = bodies.get_mut(body) else {
+            continue;
+        };
+        let e_body = e_body.map_or(contact_settings.default_restitution, |r| r.0);
+        if !(p.0 - from).is_finite() {
+            // The integrator overflowed: leave the body where it is, for the refit to quarantine.
+            continue;
+        }
+        let (mut at, mut velocity, mut motion) = (from, v.0, p.0 - from);
+        for _ in 0..settings.max_impacts {
+            let Ok(sweep) = SphereSweep::new(at, radius, motion) else {
+                at += motion;
+                break;
+            };
+            let sweep = sweep.with_initial_overlap(InitialOverlap::ApproachingOnly);
+            let Some((hit, root, leaf, e_obstacle)) =
+                first_impact(&sweep, &obstacles, &mut index, s)
+            else {
+                at += motion;
+                motion = Vec3::ZERO;
+                break;
+            };
+            let e = 0.5 * (e_body + e_obstacle.unwrap_or(contact_settings.default_restitution));
+            at = sweep.position_at(hit.t);
+            velocity = reflect(velocity, hit.normal, e);
+            motion = velocity * dt * (1.0 - hit.t);
+            impacts.contacts.push(ContactPair {
+                a: body,
+                b: root,
+                collider_a: body,
+                collider_b: leaf,
+                manifold: ContactManifold::single(-hit.normal, hit.point, 0.0),
+            });
+        }
+        // Impacts left over (max_impacts reached): stay at the last impact point.
+        let _ = motion;
+        p.set_if_neq(Position(at));
+        v.set_if_neq(Velocity(velocity));
+    }
+    stats.set_counter("ccd/sweeps", s.starts.len() as f64);
+    stats.set_counter("ccd/impacts", impacts.contacts.len() as f64);
+    stats.add_time(Stage::Integrate, start.elapsed());
+    stats.count_run("ccd");
+}
+
+/// The earliest impact (`t > 0`) of `sweep` with the static scenery its swept volume meets:
+/// the hit, the obstacle's root, the collider hit, and that collider's restitution.
+fn first_impact(
+    sweep: &SphereSweep,
+    obstacles: &Query<Obstacle, Without<Quarantined>>,
+    index: &mut BroadPhaseIndex,
+    s: &mut CcdScratch,
+) -> Option<(Toi, Entity, Entity, Option<f32>)> {
+    let swept = sweep.swept_aabb();
+    s.candidates.clear();
+    index.statics_touching(&swept, &mut s.candidates);
+    let mut best: Option<(Toi, Entity, Entity, Option<f32>)> = None;
+    for &root in &s.candidates {
+        s.stack.clear();
+        s.stack.push(root);
+        while let Some(node) = s.stack.pop() {
+            let Ok((collider, global, bv, children, e)) = obstacles.get(node) else {
+                continue;
+            };
+            if !bv.0.intersects(&swept) {
+                continue;
+            }
+            s.stack.extend(children.into_iter().flat_map(|c| c.iter()));
+            let Some(c) = collider else {
+                continue;
+            };
+            let Some(hit) = toi_sphere_shape(sweep, &c.shape, &global.0, &mut s.query) else {
+                continue;
+            };
+            // A contact already there at t = 0 is the contact solver's, not an impact.
+            let earlier = best.as_ref().is_none_or(|(b, ..)| hit.t < b.t);
+            if hit.t > 0.0 && earlier {
+                best = Some((hit, root, node, e.map(|r| r.0)));
+            }
+        }
+    }
+    best
+}
+
+/// The substep's impacts join the narrow phase's contacts (once per pair), so the response and
+/// the collision messages see them; being separating already, they get no further impulse.
+fn add_impacts_to_contacts(impacts: Res<CcdImpacts>, mut contacts: ResMut<Contacts>) {
+    for impact in &impacts.contacts {
+        let known = contacts
+            .pairs
+            .iter()
+            .any(|c| (c.a, c.b) == (impact.a, impact.b));
+        if !known {
+            contacts.pairs.push(*impact);
+        }
+    }
+}

@@ -1,0 +1,155 @@
+//! Continuous collision through the plugin: fast balls never pass a 1 cm wall, while resting
+//! and sliding bodies are left to the contact solver.
+
+mod common;
+
+use bevy_app::App;
+use bevy_ecs::message::Messages;
+use bevy_ecs::prelude::*;
+use common::rng::Rng;
+use glam::{Quat, Vec3};
+use urto::geometry::TriMesh;
+use urto::plugins::CcdSettings;
+use urto::prelude::*;
+
+const WALL_HALF_THICKNESS: f32 = 0.005;
+
+/// A wall 1 cm thick, 20 m × 20 m, across the x axis at x = 5: a box or a mesh of a box.
+fn wall(app: &mut App, as_mesh: bool) {
+    let half = Vec3::new(WALL_HALF_THICKNESS, 10.0, 10.0);
+    let collider = if as_mesh {
+        Collider::trimesh(TriMesh::cuboid(half).unwrap()).unwrap()
+    } else {
+        Collider::cuboid(half.x, half.y, half.z)
+    };
+    app.world_mut().spawn((
+        collider,
+        Position::new(5.0, 0.0, 0.0),
+        Static,
+        Restitution(0.5),
+    ));
+}
+
+/// `n` balls of radius 5 cm from x = 0 towards the wall at 10–1000 m/s, up to 60° off its normal.
+fn bullets(app: &mut App, n: usize, marked: bool, rng: &mut Rng) -> Vec<Entity> {
+    (0..n)
+        .map(|_| {
+            let speed = 10f32.powf(rng.range(1.0, 3.0));
+            let dir = Quat::from_rotation_z(rng.range(-1.0, 1.0))
+                * Quat::from_rotation_y(rng.range(-0.5, 0.5))
+                * Vec3::X;
+            let at = Vec3::new(0.0, rng.range(-2.0, 2.0), rng.range(-2.0, 2.0));
+            let mut e = app.world_mut().spawn((
+                Collider::sphere(0.05),
+                Position(at),
+                Velocity(dir * speed),
+                Friction(0.0),
+            ));
+            if marked {
+                e.insert(Ccd);
+            }
+            e.id()
+        })
+        .collect()
+}
+
+fn passed(app: &App, balls: &[Entity]) -> usize {
+    balls
+        .iter()
+        .filter(|b| app.world().get::<Position>(**b).unwrap().0.x > 5.0)
+        .count()
+}
+
+/// With CCD (marked bodies, automatic sweeping off), none of 300 bullets at up to 1000 m/s
+/// passes a 1 cm box wall or a 1 cm mesh wall; without it most do.
+#[test]
+fn no_bullet_passes_a_1cm_wall_with_ccd_and_most_do_without() {
+    for as_mesh in [false, true] {
+        let run = |marked: bool| {
+            let mut app = common::app();
+            app.insert_resource(CcdSettings {
+                auto_speed_ratio: None,
+                ..Default::default()
+            });
+            wall(&mut app, as_mesh);
+            let balls = bullets(&mut app, 300, marked, &mut Rng::new(17));
+            urto::step(app.world_mut(), 30).unwrap();
+            passed(&app, &balls)
+        };
+        assert_eq!(run(true), 0, "mesh wall: {as_mesh}");
+        assert!(
+            run(false) > 200,
+            "without CCD the wall is porous (mesh: {as_mesh})"
+        );
+    }
+}
+
+/// Automatic CCD (the default) catches fast bodies that are not marked.
+#[test]
+fn automatic_ccd_catches_unmarked_fast_bodies() {
+    let mut app = common::app();
+    wall(&mut app, false);
+    let balls = bullets(&mut app, 100, false, &mut Rng::new(4));
+    urto::step(app.world_mut(), 30).unwrap();
+    assert_eq!(passed(&app, &balls), 0);
+    assert!(app.world().resource::<PhysicsStats>().runs("ccd") > 0);
+}
+
+/// An impact found only by the sweep is reported as a collision.
+#[test]
+fn a_swept_impact_starts_a_collision() {
+    let mut app = common::app();
+    wall(&mut app, false);
+    app.world_mut().spawn((
+        Collider::sphere(0.05),
+        Position::new(4.0, 0.0, 0.0),
+        Velocity::new(300.0, 0.0, 0.0),
+        Ccd,
+    ));
+    let mut cursor = app
+        .world()
+        .resource::<Messages<CollisionStarted>>()
+        .get_cursor();
+    urto::step(app.world_mut(), 1).unwrap();
+    let started = cursor
+        .read(app.world().resource::<Messages<CollisionStarted>>())
+        .count();
+    assert_eq!(started, 1);
+}
+
+/// A marked ball resting on the ground stays at rest, and one sliding along it keeps sliding:
+/// contacts present at the start of a motion belong to the solver, not to the sweep.
+#[test]
+fn resting_and_sliding_marked_bodies_are_not_stopped_by_their_support() {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    app.world_mut()
+        .spawn((Collider::half_space(Vec3::Z), Static, Friction(0.0)));
+    let resting = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(0.0, 0.0, 0.5),
+            Velocity::default(),
+            Ccd,
+        ))
+        .id();
+    let sliding = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(0.0, 5.0, 0.5),
+            Velocity::new(3.0, 0.0, 0.0),
+            Ccd,
+            Friction(0.0),
+        ))
+        .id();
+    urto::step(app.world_mut(), 120).unwrap();
+    let p = |e: Entity| app.world().get::<Position>(e).unwrap().0;
+    assert!(
+        (p(resting) - Vec3::new(0.0, 0.0, 0.5)).length() < 0.005,
+        "{}",
+        p(resting)
+    );
+    assert!((p(sliding).x - 6.0).abs() < 0.01, "slid to {}", p(sliding));
+}
