@@ -5,7 +5,7 @@
 //!    analytic projectile and spring over a range of `dt`, energy drift over a long run, wall time
 //!    per body and step, and the Pareto front of error against time;
 //! 2. `tunnelling` — fast balls shot at a thin wall through the full ECS plugin, pass-through
-//!    fraction and cost against substeps (and continuous collision, once it lands);
+//!    fraction and cost against substeps and with continuous collision;
 //! 3. `bounding_volumes` — sphere / AABB / OBB / k-DOP hierarchies on the same mesh pairs: the
 //!    slides' cost model `Tc = Nv*Cv + Nn*Cn + Ns*Cs` checked against the measured time;
 //! 4. `bounce` — apex heights of a bouncing ball through the ECS plugin against `h_k = e^(2k) h_0`.

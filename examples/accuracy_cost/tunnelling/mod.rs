@@ -20,6 +20,7 @@ use bevy_ecs::world::EntityWorldMut;
 use charts::{plot, record};
 use std::time::Instant;
 use text::section;
+use urto::plugins::CcdSettings;
 use urto::prelude::*;
 
 /// Ball speeds (m/s).
@@ -139,7 +140,7 @@ fn measure(ctx: &Context, shot: Shot, balls: usize) -> ShotResult {
         ctx.progress.tick();
     }
     ctx.progress.task("tunnelling: continuous collision");
-    let ccd = ccd_run(shot, balls);
+    let ccd = ccd_run(shot, balls, ctx.cfg.pick(3, 1));
     ctx.progress.tick();
     ShotResult {
         shot,
@@ -167,14 +168,13 @@ fn repeated(times: u32, shoot: impl Fn() -> TunnelRun) -> TunnelRun {
     })
 }
 
-/// The same shot with continuous collision instead of substeps.
-///
-/// CCD: filled when continuous collision lands — return
-/// `Some(shoot(shot, 1, balls, &|ball| { ball.insert(Ccd); }))` (or whatever switches it on);
-/// the table, the plot and the recording already print and draw the row.
-fn ccd_run(_shot: Shot, _balls: usize) -> Option<TunnelRun> {
-    // CCD: filled when continuous collision lands
-    None
+/// The same shot with continuous collision (every ball marked [`Ccd`]) instead of substeps.
+fn ccd_run(shot: Shot, balls: usize, times: u32) -> Option<TunnelRun> {
+    Some(repeated(times, || {
+        shoot(shot, 1, balls, &|ball| {
+            ball.insert(Ccd);
+        })
+    }))
 }
 
 /// Shoots `balls` balls at the wall with `substeps` substeps; `decorate` may add components to
@@ -186,6 +186,11 @@ fn shoot(
     decorate: &dyn Fn(&mut EntityWorldMut),
 ) -> TunnelRun {
     let mut app = app_with(DT, substeps);
+    // Only marked balls are swept: the substep rows measure substeps alone.
+    app.insert_resource(CcdSettings {
+        auto_speed_ratio: None,
+        ..Default::default()
+    });
     let world = app.world_mut();
     let side = (balls as f32).sqrt().ceil() as usize;
     let half = side as f32 * LANE;
