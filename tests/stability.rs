@@ -9,6 +9,7 @@ use bevy_ecs::prelude::*;
 use glam::Vec3;
 use urto::dynamics::forces::{ForceModel, Spring, SpringEnd};
 use urto::dynamics::{Integrator, IntegratorScratch, integrate};
+use urto::geometry::TriMesh;
 use urto::plugins::Contacts;
 use urto::prelude::*;
 
@@ -404,4 +405,143 @@ fn a_5cm_ball_on_a_50m_slab_rests_within_a_tenth_of_its_size() {
         z(&app, ball)
     );
     assert!(speed(&app, ball) < 1e-3);
+}
+
+/// The bouncing ball and the resting box of `far_scene`, with every coordinate offset by `d`;
+/// heights (relative to the offset) of ball and box after each of 600 steps.
+fn far_scene(d: f32) -> (Vec<(f32, f32)>, Vec3) {
+    let offset = Vec3::splat(d);
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    app.world_mut().spawn((
+        Collider::half_space(Vec3::Z),
+        Position(offset),
+        Static,
+        Restitution(0.8),
+    ));
+    let ball = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.5),
+            Position(offset + Vec3::new(0.0, 0.0, 3.0)),
+            Velocity::new(1.0, 0.0, 0.0),
+            Restitution(0.8),
+            Friction(0.0),
+        ))
+        .id();
+    let block = app
+        .world_mut()
+        .spawn((
+            Collider::cuboid(0.5, 0.5, 0.5),
+            Position(offset + Vec3::new(5.0, 0.0, 0.5)),
+            Velocity::default(),
+            Restitution(0.0),
+        ))
+        .id();
+    let mut heights = Vec::new();
+    for _ in 0..600 {
+        urto::step(app.world_mut(), 1).unwrap();
+        let at = |e: Entity| app.world().get::<Position>(e).unwrap().0 - offset;
+        heights.push((at(ball).z, at(block).z));
+    }
+    let end = app.world().get::<Position>(ball).unwrap().0 - offset;
+    (heights, end)
+}
+
+/// The same scene translated to 10³, 10⁴ and 10⁵ m from the origin: every height stays within
+/// two f32 spacings of the offset (1.2·10⁻⁷·d, so 2.4 cm at 10⁵ m) of the scene at the origin.
+#[test]
+fn a_scene_translated_to_1e5_matches_the_origin_within_two_f32_spacings() {
+    let (base, _) = far_scene(0.0);
+    for d in [1e3f32, 1e4, 1e5] {
+        let (far, _) = far_scene(d);
+        let spacing = d * f32::EPSILON;
+        for (step, (a, b)) in base.iter().zip(&far).enumerate() {
+            assert!(
+                (a.0 - b.0).abs() <= 2.0 * spacing,
+                "d {d}, step {step}: ball {a:?} vs {b:?}"
+            );
+            assert!(
+                (a.1 - b.1).abs() <= 2.0 * spacing,
+                "d {d}, step {step}: box {a:?} vs {b:?}"
+            );
+        }
+    }
+}
+
+/// The documented f32 limit: at 10⁶ m the coordinates are 6.25 cm apart, so a body moving
+/// 1 m/s (1.7 cm per step) cannot move at all; it stays finite and on the ground, within two
+/// spacings. Worlds that large need a floating origin (re-centre the world on the player).
+#[test]
+fn at_1e6_from_the_origin_f32_freezes_slow_motion_as_documented() {
+    let (heights, end) = far_scene(1e6);
+    assert_eq!(end.x, 0.0, "a 1 m/s body cannot move at 10⁶ m in f32");
+    let spacing = 1e6 * f32::EPSILON;
+    assert!(heights.iter().all(|h| h.0.is_finite() && h.1.is_finite()));
+    assert!((heights.last().unwrap().1 - 0.5).abs() <= 2.0 * spacing);
+}
+
+fn floor_with(extra: impl Fn(&TriMesh) -> (Vec<Vec3>, Vec<[u32; 3]>)) -> Collider {
+    let clean = TriMesh::grid_floor(20.0, 20).unwrap();
+    let (vertices, triangles) = extra(&clean);
+    Collider::trimesh(TriMesh::new(vertices, triangles).unwrap()).unwrap()
+}
+
+fn ball_on(floor: Collider) -> Vec3 {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    app.world_mut().spawn((floor, Static));
+    let ball = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(0.3, -0.7, 2.0),
+            Velocity::new(0.5, 0.2, 0.0),
+        ))
+        .id();
+    urto::step(app.world_mut(), 240).unwrap();
+    app.world().get::<Position>(ball).unwrap().0
+}
+
+/// Degenerate triangles (zero area: repeated indices, collinear corners) added to a mesh floor
+/// change nothing: the ball ends bit-for-bit where it ends on the clean floor.
+#[test]
+fn degenerate_triangles_give_the_same_result_as_without_them() {
+    let clean = ball_on(floor_with(|m| {
+        (m.vertices().to_vec(), m.triangles().to_vec())
+    }));
+    let dirty = ball_on(floor_with(|m| {
+        let mut v = m.vertices().to_vec();
+        let mut t = m.triangles().to_vec();
+        let n = v.len() as u32;
+        v.extend([Vec3::ZERO, Vec3::X, Vec3::X * 2.0]);
+        t.extend([
+            [n, n + 1, n + 2],
+            [0, 0, 1],
+            [5, 6, 5],
+            [n + 1, n + 1, n + 1],
+        ]);
+        (v, t)
+    }));
+    assert!(clean.is_finite());
+    assert_eq!(clean, dirty);
+}
+
+/// Coplanar duplicates (every floor triangle twice, the copy with its own vertices) leave a
+/// resting ball within 1 mm of where it rests on the clean floor, with no NaN.
+#[test]
+fn coplanar_duplicate_triangles_rest_a_ball_within_1mm_of_the_clean_floor() {
+    let clean = ball_on(floor_with(|m| {
+        (m.vertices().to_vec(), m.triangles().to_vec())
+    }));
+    let doubled = ball_on(floor_with(|m| {
+        let mut v = m.vertices().to_vec();
+        let n = v.len() as u32;
+        v.extend_from_slice(m.vertices());
+        let mut t = m.triangles().to_vec();
+        t.extend(m.triangles().iter().map(|tri| tri.map(|i| i + n)));
+        (v, t)
+    }));
+    assert!(doubled.is_finite());
+    assert!((clean - doubled).length() < 1e-3, "{clean} vs {doubled}");
 }
