@@ -105,21 +105,28 @@ type Mover<'a> = (
     &'a Velocity,
     &'a BoundingVolume,
     Option<&'a Collider>,
+    Has<Children>,
     Has<Ccd>,
 );
 type MovingRoot = (Without<Static>, Without<Quarantined>, Without<ChildOf>);
 
-/// Radius of the sphere swept for a body at `p`: exact for a ball, otherwise the sphere about
-/// `p` holding the body's whole volume (parts included).
-fn sweep_radius(p: Vec3, bv: &BoundingVolume, collider: Option<&Collider>) -> f32 {
-    match collider.map(|c| &c.shape) {
-        Some(crate::geometry::Shape::Sphere(s))
-            if bv.0.half_extents().max_element() <= s.radius =>
-        {
-            s.radius
-        }
-        _ => (bv.0.center() - p).length() + bv.0.half_extents().length(),
+/// Radius of the sphere swept for a body at `p`: its collider's bounding radius (exact for a
+/// ball); for a compound body, the sphere about `p` holding its whole volume (parts included).
+/// `None` for bodies with nothing to sweep (no collider, or an unbounded one).
+fn sweep_radius(
+    p: Vec3,
+    bv: &BoundingVolume,
+    collider: Option<&Collider>,
+    compound: bool,
+) -> Option<f32> {
+    if compound {
+        let b = bv.0;
+        return (b.is_valid() && b.is_finite())
+            .then(|| (b.center() - p).length() + b.half_extents().length());
     }
+    collider
+        .map(|c| c.shape.bounding_radius())
+        .filter(|r| r.is_finite())
 }
 
 fn record_sweep_starts(
@@ -130,11 +137,10 @@ fn record_sweep_starts(
 ) {
     scratch.starts.clear();
     let dt = timestep.substep_dt();
-    for (body, p, v, bv, collider, marked) in &bodies {
-        if !(bv.0.is_valid() && bv.0.is_finite()) {
+    for (body, p, v, bv, collider, compound, marked) in &bodies {
+        let Some(radius) = sweep_radius(p.0, bv, collider, compound) else {
             continue;
-        }
-        let radius = sweep_radius(p.0, bv, collider);
+        };
         let fast = settings
             .auto_speed_ratio
             .is_some_and(|k| v.0.length() * dt > k * radius);

@@ -23,6 +23,7 @@ use crate::schedule::{BroadPhaseSystems, PhysicsSchedule, PhysicsSet, SubstepSch
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
+use bevy_ecs::query::QueryFilter;
 use std::time::Instant;
 
 /// Propagates world poses down hierarchies and refits bounding volumes up them.
@@ -35,21 +36,24 @@ impl Plugin for HierarchyPlugin {
             .add_systems(
                 SubstepSchedule,
                 (
-                    propagate_poses.in_set(BroadPhaseSystems::Poses),
-                    refit_bounding_volumes.in_set(BroadPhaseSystems::Refit),
+                    propagate_poses::<()>.in_set(BroadPhaseSystems::Poses),
+                    refit_bounding_volumes::<()>.in_set(BroadPhaseSystems::Refit),
                 )
                     .run_if(any_with_component::<BoundingVolume>),
             )
             .add_systems(
                 PhysicsSchedule,
-                (propagate_poses, refit_bounding_volumes)
+                (propagate_poses::<()>, refit_bounding_volumes::<()>)
                     .chain()
                     .run_if(any_with_component::<BoundingVolume>)
                     .in_set(PhysicsSet::Finish),
             )
             .add_systems(
                 PhysicsSchedule,
-                (propagate_poses, refit_bounding_volumes)
+                (
+                    propagate_poses::<Without<Velocity>>,
+                    refit_bounding_volumes::<Without<Velocity>>,
+                )
                     .chain()
                     .run_if(any_with_component::<BoundingVolume>)
                     .in_set(PrepareIndex)
@@ -65,27 +69,50 @@ struct HierarchyScratch {
     order: Vec<(u32, Entity)>,
 }
 
+/// Bodies outside any hierarchy: their world pose is their own, their volume their collider's.
+type Flat = (Without<ChildOf>, Without<Children>);
+/// Parts and parents of compound bodies.
+type InHierarchy = Or<(With<ChildOf>, With<Children>)>;
+
 type LocalChanged = (
     Or<(Changed<Position>, Changed<Rotation>, Changed<ChildOf>)>,
     Without<Quarantined>,
 );
 
-/// World poses: roots copy their own pose; a subtree whose root moved, or whose local pose or
-/// parent changed, is recomposed top-down (shallowest first, each node once).
-fn propagate_poses(
-    changed: Query<Entity, LocalChanged>,
+type FlatPose<'a> = (&'a Position, &'a Rotation, &'a mut GlobalPose);
+type NodePose<'a> = (
+    &'a Position,
+    &'a Rotation,
+    Option<&'a Children>,
+    &'a mut GlobalPose,
+);
+
+/// World poses: a body outside any hierarchy copies its own pose (one linear pass); in a
+/// hierarchy, a subtree whose root moved, or whose local pose or parent changed, is recomposed
+/// top-down (shallowest first). `F` narrows which changed bodies are looked at (Prepare: only
+/// bodies without a velocity — scenery placed between steps).
+// A ParamSet of two queries (flat bodies, hierarchy nodes) aliases `GlobalPose`; a type alias
+// for it would have to fix the queries' lifetimes, which stops the function being a system.
+#[allow(clippy::type_complexity)]
+fn propagate_poses<F: QueryFilter + 'static>(
+    mut queries: ParamSet<(Query<FlatPose, (Flat, LocalChanged, F)>, Query<NodePose>)>,
+    changed: Query<Entity, (InHierarchy, LocalChanged, F)>,
     parents: Query<&ChildOf>,
-    mut nodes: Query<(&Position, &Rotation, Option<&Children>, &mut GlobalPose)>,
     mut scratch: ResMut<HierarchyScratch>,
     mut stats: ResMut<PhysicsStats>,
 ) {
     let start = Instant::now();
+    let mut updated = 0u32;
+    for (p, r, mut global) in &mut queries.p0() {
+        global.set_if_neq(GlobalPose(Isometry::new(p.0, r.0)));
+        updated += 1;
+    }
     let s = &mut *scratch;
     s.dirty.clear();
     s.dirty
         .extend(changed.iter().map(|e| (depth(e, &parents), e)));
     s.dirty.sort_unstable();
-    let mut updated = 0u32;
+    let mut nodes = queries.p1();
     for i in 0..s.dirty.len() {
         let (_, root) = s.dirty[i];
         let parent_pose = match parents.get(root) {
@@ -128,21 +155,32 @@ type RefitNode<'a> = (
     &'a mut BoundingVolume,
     Has<Quarantined>,
 );
-type OwnChanged = (Or<(Changed<GlobalPose>, Changed<Collider>, Changed<Children>)>,);
+type FlatRefit<'a> = (Entity, &'a Collider, &'a GlobalPose, &'a mut BoundingVolume);
+type OwnChanged = Or<(Changed<GlobalPose>, Changed<Collider>, Changed<Children>)>;
 
-/// Refits the volume of every node whose own collider moved or whose children changed, and of
-/// their ancestors, deepest first. A bounded collider whose volume is not finite is quarantined.
-#[allow(clippy::too_many_arguments)]
-fn refit_bounding_volumes(
-    changed: Query<Entity, OwnChanged>,
+/// Refits volumes: a collider outside any hierarchy from its own pose (one linear pass); in a
+/// hierarchy, every node whose own collider moved or whose children changed, and its ancestors,
+/// deepest first. A bounded collider whose volume is not finite is quarantined.
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn refit_bounding_volumes<F: QueryFilter + 'static>(
+    mut queries: ParamSet<(
+        Query<FlatRefit, (Flat, OwnChanged, Without<Quarantined>, F)>,
+        Query<RefitNode>,
+    )>,
+    changed: Query<Entity, (InHierarchy, OwnChanged, F)>,
     mut removed: RemovedComponents<Collider>,
     parents: Query<&ChildOf>,
-    mut nodes: Query<RefitNode>,
     mut scratch: ResMut<HierarchyScratch>,
     mut stats: ResMut<PhysicsStats>,
     mut commands: Commands,
 ) {
     let start = Instant::now();
+    let mut refits = 0usize;
+    for (e, collider, global, mut out) in &mut queries.p0() {
+        let bv = own_volume(e, Some(collider), global, false, &mut commands);
+        out.set_if_neq(BoundingVolume(bv));
+        refits += 1;
+    }
     let s = &mut *scratch;
     let dirty = changed.iter().chain(removed.read());
     refit_order(
@@ -150,22 +188,12 @@ fn refit_bounding_volumes(
         |e| parents.get(e).ok().map(|p| p.parent()),
         &mut s.order,
     );
+    let mut nodes = queries.p1();
     for &(_, e) in &s.order {
         let Ok((collider, global, children, _, quarantined)) = nodes.get(e) else {
             continue;
         };
-        let mut bv = match collider {
-            Some(c) if !quarantined => c.shape.world_aabb(&global.0),
-            _ => Aabb::EMPTY,
-        };
-        if collider.is_some_and(|c| !c.shape.is_unbounded()) && !quarantined && !bv.is_finite() {
-            quarantine(
-                &mut commands,
-                e,
-                format!("bounding volume is not finite: {bv:?}"),
-            );
-            bv = Aabb::EMPTY;
-        }
+        let mut bv = own_volume(e, collider, global, quarantined, &mut commands);
         for child in children.into_iter().flat_map(|c| c.iter()) {
             if let Ok((.., child_bv, _)) = nodes.get(child)
                 && child_bv.0.is_valid()
@@ -177,6 +205,31 @@ fn refit_bounding_volumes(
             out.set_if_neq(BoundingVolume(bv));
         }
     }
-    stats.set_counter("hierarchy/refits", s.order.len() as f64);
+    refits += s.order.len();
+    stats.set_counter("hierarchy/refits", refits as f64);
     stats.add_time(Stage::BroadPhase, start.elapsed());
+}
+
+/// The world volume of a node's own collider (empty without one or when quarantined); a bounded
+/// collider whose volume is not finite is quarantined and counts as empty.
+fn own_volume(
+    e: Entity,
+    collider: Option<&Collider>,
+    global: &GlobalPose,
+    quarantined: bool,
+    commands: &mut Commands,
+) -> Aabb {
+    let Some(c) = collider.filter(|_| !quarantined) else {
+        return Aabb::EMPTY;
+    };
+    let bv = c.shape.world_aabb(&global.0);
+    if !c.shape.is_unbounded() && !bv.is_finite() {
+        quarantine(
+            commands,
+            e,
+            format!("bounding volume is not finite: {bv:?}"),
+        );
+        return Aabb::EMPTY;
+    }
+    bv
 }

@@ -1,0 +1,138 @@
+//! "Simulate only the effects a scene calls for", measured: the same 10,000 bodies stepped
+//! with more and more effects switched on. Each row adds one effect to the previous one; a
+//! scene pays for an effect only from the row where it appears.
+//!
+//! Rows: bodies with a velocity only (integration), then gravity, then a user force on every
+//! body, then drag, then colliders (spheres, spread out: broad phase, no contacts), then a ground
+//! (every body in contact: narrow phase and response), then continuous collision on every body.
+//!
+//! Sizes: `URTO_BENCH_BODIES` (default `10000`). Quick run:
+//! `URTO_BENCH_BODIES=1000 cargo bench --bench effects -- --quick`.
+
+use bevy_app::App;
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use glam::Vec3;
+use urto::plugins::CcdSettings;
+use urto::prelude::*;
+
+/// The effects, cumulative.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+enum Effects {
+    Integration,
+    Gravity,
+    UserForces,
+    Drag,
+    Colliders,
+    Contacts,
+    Ccd,
+}
+
+const ALL: [Effects; 7] = [
+    Effects::Integration,
+    Effects::Gravity,
+    Effects::UserForces,
+    Effects::Drag,
+    Effects::Colliders,
+    Effects::Contacts,
+    Effects::Ccd,
+];
+
+fn name(e: Effects) -> &'static str {
+    match e {
+        Effects::Integration => "1 integration only",
+        Effects::Gravity => "2 + gravity",
+        Effects::UserForces => "3 + user forces",
+        Effects::Drag => "4 + drag",
+        Effects::Colliders => "5 + colliders, apart",
+        Effects::Contacts => "6 + ground contact",
+        Effects::Ccd => "7 + CCD on every body",
+    }
+}
+
+/// `n` bodies on a square lattice 2 m apart; with `e` and everything before it.
+fn scene(n: usize, e: Effects) -> App {
+    let mut app = App::new();
+    app.add_plugins(UrtoPlugins::default());
+    app.insert_resource(CcdSettings {
+        auto_speed_ratio: None,
+        ..Default::default()
+    });
+    if e >= Effects::Gravity {
+        app.insert_resource(Gravity::EARTH_Z_UP);
+    }
+    if e >= Effects::Contacts {
+        app.world_mut()
+            .spawn((Collider::half_space(Vec3::Z), Static));
+    }
+    let side = (n as f32).sqrt().ceil() as usize;
+    for i in 0..n {
+        let at = Vec3::new((i % side) as f32 * 2.0, (i / side) as f32 * 2.0, 0.5);
+        let mut body = app
+            .world_mut()
+            .spawn((Position(at), Velocity::new(0.0, 0.0, 0.0)));
+        if e >= Effects::UserForces {
+            body.insert(Force(Vec3::X));
+        }
+        if e >= Effects::Drag {
+            body.insert(LinearDrag(0.1));
+        }
+        if e >= Effects::Colliders {
+            body.insert(Collider::sphere(0.5));
+        }
+        if e >= Effects::Ccd {
+            body.insert(Ccd);
+        }
+    }
+    // Warm up: first-step registration and bulk inserts are not what a step costs.
+    urto::step(app.world_mut(), 3).expect("UrtoPlugins");
+    app
+}
+
+/// Re-arms the one-step user forces so every measured step has them.
+fn rearm_forces(app: &mut App) {
+    let mut q = app.world_mut().query::<&mut Force>();
+    for mut f in q.iter_mut(app.world_mut()) {
+        f.0 = Vec3::X;
+    }
+}
+
+fn bench_effects(c: &mut Criterion) {
+    let sizes: Vec<usize> = std::env::var("URTO_BENCH_BODIES")
+        .ok()
+        .map(|s| s.split(',').filter_map(|x| x.trim().parse().ok()).collect())
+        .unwrap_or_else(|| vec![10_000]);
+    for n in sizes {
+        let mut group = c.benchmark_group(format!("effects/{n}"));
+        group.throughput(Throughput::Elements(n as u64));
+        for e in ALL {
+            let mut app = scene(n, e);
+            let stats = app.world().resource::<PhysicsStats>();
+            let ran: Vec<&str> = [
+                "forces/gravity",
+                "forces/user",
+                "forces/drag",
+                "integrate",
+                "broad_phase",
+                "narrow_phase",
+                "response",
+                "ccd",
+            ]
+            .into_iter()
+            .filter(|s| stats.runs(s) > 0)
+            .collect();
+            eprintln!("[effects] {n} bodies, {}: runs {ran:?}", name(e));
+            group.bench_function(BenchmarkId::new(name(e), n), |b| {
+                b.iter(|| {
+                    if e >= Effects::UserForces {
+                        rearm_forces(&mut app);
+                    }
+                    urto::step(app.world_mut(), 1).expect("UrtoPlugins")
+                })
+            });
+        }
+        group.finish();
+    }
+}
+
+criterion_group!(benches, bench_effects);
+criterion_main!(benches);
