@@ -4,12 +4,12 @@
 
 mod common;
 
+use bevy_app::PluginGroup;
 use bevy_ecs::message::Messages;
 use bevy_ecs::prelude::*;
 use common::rng::Rng;
 use glam::Vec3;
 use std::collections::BTreeSet;
-use bevy_app::PluginGroup;
 use urto::plugins::{BroadPhasePairs, ResponsePlugin};
 use urto::prelude::*;
 
