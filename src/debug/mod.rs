@@ -3,4 +3,4 @@
 #[cfg(feature = "rerun")]
 pub mod rerun;
 #[cfg(feature = "rerun")]
-pub use self::rerun::{RecordingSink, RerunConfig, RerunDebugPlugin, RerunError};
+pub use self::rerun::{DebugColor, RecordingSink, RerunConfig, RerunDebugPlugin, RerunError};

@@ -16,19 +16,31 @@
 //! | `world/velocities` | velocity arrows (yellow) | `Arrows3D` |
 //! | `world/contacts` | contact points with their normals scaled by depth (magenta) | `Arrows3D` |
 //! | `broad_phase/pairs` | candidate pairs as segments between centres | `LineStrips3D` |
+//! | `broad_phase/grid_cells/occupied`, `…/empty` | the static grid's cells each moving body's volume touches (cyan: listing statics, dim blue: empty); only with [`RerunConfig::grid_cells`] | `Boxes3D` |
+//! | `broad_phase/candidates/listed`, `…/overlapping` | the statics those cells list, as the grid stores them (yellow: listed, red: their box also overlaps a moving body's, so the pair goes to the narrow phase) | `Boxes3D` |
+//! | `scene_graph/level_<k>` | the bounding volumes of depth `k` (root 0) of every body hierarchy (compound bodies), labelled with their [`Name`]; only with [`RerunConfig::scene_graph_levels`], each level in its own tab | `Boxes3D` |
+//! | `scene_graph/visited/entered`, `…/pruned` | the hierarchy nodes the narrow phase's descent entered (yellow) and tested but pruned (grey) in the last substep; only with [`RerunConfig::hierarchy_visits`] (see [`HierarchyVisits`]) | `Boxes3D` |
+//! | `scene_graph/visited/collider_pairs` | the collider pairs that descent handed to the exact test, as segments | `LineStrips3D` |
 //! | `timing/<stage>` | wall time of each stage in the step, ms | `Scalars` |
 //! | `counters/<name>` | the step's counters (pairs, contacts, refits, …) | `Scalars` |
 //! | `log` | quarantine warnings | `TextLog` |
 //!
+//! Bodies are coloured by kind (a part of a compound by its root's kind) unless they carry a
+//! [`DebugColor`], and labelled with their [`Name`] when they have one.
+//!
 //! Conversion to rerun's types happens here and only here: the rest of urto never sees rerun.
+
+mod grid_cells;
+mod scene_graph;
 
 use crate::components::*;
 use crate::geometry::{MeshCollider, Shape};
-use crate::plugins::narrow_phase::{NO_LEAF, OverlappingLeaves};
+use crate::plugins::narrow_phase::{HierarchyVisits, NO_LEAF, OverlappingLeaves};
 use crate::plugins::{BroadPhasePairs, Contacts};
 use crate::schedule::{PhysicsSchedule, PhysicsSet};
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
+use bevy_ecs::name::Name;
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
 use rerun::RecordingStream;
@@ -82,6 +94,19 @@ pub struct RerunConfig {
     /// narrow phase record them (see
     /// [`OverlappingLeaves`](crate::plugins::narrow_phase::OverlappingLeaves)).
     pub overlapping_leaves: bool,
+    /// Log, every recorded step, the static grid's cells each moving body's volume touches and
+    /// the statics those cells list (the candidates the grid hands on); the layout then adds a
+    /// close-up view of the moving bodies and their cells.
+    pub grid_cells: bool,
+    /// Log the bounding volumes of the first `scene_graph_levels` depths of every body hierarchy
+    /// (0: none); the layout then shows one tab per level.
+    pub scene_graph_levels: u32,
+    /// Log which hierarchy nodes the narrow phase's descent of compound pairs entered and
+    /// pruned. Makes the narrow phase record them (see [`HierarchyVisits`]).
+    pub hierarchy_visits: bool,
+    /// Open the viewer on the last recorded step (following new data as it arrives) instead of
+    /// playing from the first: for screenshots, and for live viewers.
+    pub open_at_end: bool,
 }
 
 impl RerunConfig {
@@ -98,6 +123,10 @@ impl RerunConfig {
             plane_half_size: 10.0,
             bvh_levels: 0,
             overlapping_leaves: false,
+            grid_cells: false,
+            scene_graph_levels: 0,
+            hierarchy_visits: false,
+            open_at_end: false,
         }
     }
 }
@@ -186,11 +215,17 @@ impl Plugin for RerunDebugPlugin {
             UpAxis::Y => rerun::ViewCoordinates::RIGHT_HAND_Y_UP(),
         };
         report(rec.log_static("world", &coordinates));
-        report(default_layout(self.config.bvh_levels).send(rec, Default::default()));
+        report(default_layout(&self.config).send(rec, Default::default()));
         if self.config.overlapping_leaves {
             app.insert_resource(OverlappingLeaves {
                 enabled: true,
                 pairs: Vec::new(),
+            });
+        }
+        if self.config.hierarchy_visits {
+            app.insert_resource(HierarchyVisits {
+                enabled: true,
+                ..Default::default()
             });
         }
         app.init_resource::<DebugClock>()
@@ -208,6 +243,9 @@ impl Plugin for RerunDebugPlugin {
                     record_meshes,
                     record_pairs,
                     record_overlapping_leaves,
+                    grid_cells::record_grid_cells,
+                    scene_graph::record_scene_graph_levels,
+                    scene_graph::record_hierarchy_visits,
                     record_stats,
                 )
                     .chain()
@@ -229,40 +267,84 @@ impl Drop for RerunRecording {
 
 /// The layout the viewer opens on: the 3D scene large on the left; on the right the wall time
 /// of each stage in one plot and the step's counters in another (instead of one plot each).
-/// With hierarchy levels recorded, a tab per level (the meshes and that level's boxes) sits on top
-/// of the right column, and the main scene leaves the boxes out.
-fn default_layout(bvh_levels: u32) -> rerun::blueprint::Blueprint {
-    use rerun::blueprint::components::PanelState;
+/// With per-level or close-up views asked for (hierarchy levels, scene-graph levels, grid cells),
+/// they sit as tabs on top of the right column, and the main scene leaves the level boxes out.
+/// The time panel starts collapsed (the scene gets the room); with
+/// [`RerunConfig::open_at_end`] the viewer shows the last recorded step.
+fn default_layout(config: &RerunConfig) -> rerun::blueprint::Blueprint {
+    use rerun::blueprint::components::{PanelState, PlayState};
     use rerun::blueprint::*;
-    let scene = Spatial3DView::new("scene")
-        .with_origin("/")
-        .with_contents(["+ /**", "- /hierarchy/**"]);
+    let scene = Spatial3DView::new("scene").with_origin("/").with_contents([
+        "+ /**",
+        "- /hierarchy/**",
+        "- /scene_graph/**",
+        "+ /scene_graph/visited/**",
+    ]);
     let timing = TimeSeriesView::new("time per stage (ms)").with_origin("/timing");
     let counters = TimeSeriesView::new("counters").with_origin("/counters");
     let log = TextLogView::new("log").with_origin("/log");
-    let side = if bvh_levels == 0 {
+    let tabs = detail_views(config);
+    let side = if tabs.is_empty() {
         Vertical::new([timing.into(), counters.into(), log.into()]).with_row_shares([0.4, 0.4, 0.2])
     } else {
-        let levels = (0..bvh_levels).map(|k| {
-            Spatial3DView::new(format!("BVH level {k}"))
-                .with_origin("/")
-                .with_contents([
-                    "+ /world/meshes/**".to_owned(),
-                    format!("+ /hierarchy/level_{k}/**"),
-                ])
-                .into()
-        });
         Vertical::new([
-            Tabs::new(levels).into(),
+            Tabs::new(tabs).into(),
             timing.into(),
             counters.into(),
             log.into(),
         ])
         .with_row_shares([0.45, 0.22, 0.23, 0.1])
     };
+    let mut time_panel = TimePanel::new().with_state(PanelState::Collapsed);
+    if config.open_at_end {
+        time_panel = time_panel.with_play_state(PlayState::Following);
+    }
     Blueprint::new(Horizontal::new([scene.into(), side.into()]).with_column_shares([0.6, 0.4]))
         .with_blueprint_panel(BlueprintPanel::new().with_state(PanelState::Collapsed))
         .with_selection_panel(SelectionPanel::new().with_state(PanelState::Collapsed))
+        .with_time_panel(time_panel)
+}
+
+/// The tabbed views of the right column: a close-up of the moving bodies and their grid cells,
+/// then one view per scene-graph level, then one per mesh-hierarchy level.
+fn detail_views(config: &RerunConfig) -> Vec<rerun::blueprint::ContainerLike> {
+    use rerun::blueprint::Spatial3DView;
+    let mut views = Vec::new();
+    if config.grid_cells {
+        // Only the moving bodies and what the grid says about them: the viewer frames the view
+        // on them, not on the whole static scene.
+        let close_up = Spatial3DView::new("grid cells")
+            .with_origin("/")
+            .with_contents([
+                "+ /world",
+                "+ /world/bodies/**",
+                "+ /world/contacts",
+                "+ /broad_phase/grid_cells/**",
+                "+ /broad_phase/candidates/**",
+            ]);
+        views.push(close_up.into());
+    }
+    for k in 0..config.scene_graph_levels {
+        let level = Spatial3DView::new(format!("scene graph level {k}"))
+            .with_origin("/")
+            .with_contents([
+                "+ /world/**".to_owned(),
+                "- /world/bounding_volumes".to_owned(),
+                "- /world/velocities".to_owned(),
+                format!("+ /scene_graph/level_{k}/**"),
+            ]);
+        views.push(level.into());
+    }
+    for k in 0..config.bvh_levels {
+        let level = Spatial3DView::new(format!("BVH level {k}"))
+            .with_origin("/")
+            .with_contents([
+                "+ /world/meshes/**".to_owned(),
+                format!("+ /hierarchy/level_{k}/**"),
+            ]);
+        views.push(level.into());
+    }
+    views
 }
 
 const DYNAMIC: [u8; 3] = [230, 126, 34];
@@ -312,101 +394,167 @@ fn quat(q: Quat) -> rerun::Quaternion {
     rerun::Quaternion::from_xyzw(q.to_array())
 }
 
-/// Spheres and boxes of one group of bodies, ready to log.
+/// The colour a body is drawn in, instead of the colour of its kind (dynamic, kinematic,
+/// static); e.g. to tell a game's targets from its walls. Only the recording reads it.
+#[derive(Component, Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DebugColor(pub [u8; 3]);
+
+/// Spheres and boxes of one group of bodies, ready to log, with their labels (empty for
+/// unnamed bodies; none at all when no body is named).
 #[derive(Default)]
 struct ShapeBatch {
     sphere_centers: Vec<[f32; 3]>,
     sphere_radii: Vec<f32>,
     sphere_colors: Vec<rerun::Color>,
+    sphere_labels: Vec<String>,
     box_centers: Vec<[f32; 3]>,
     box_half_sizes: Vec<[f32; 3]>,
     box_rotations: Vec<rerun::Quaternion>,
     box_colors: Vec<rerun::Color>,
+    box_labels: Vec<String>,
+    named: bool,
 }
 
 impl ShapeBatch {
-    fn push(&mut self, shape: &Shape, p: Vec3, r: Quat, color: [u8; 3], plane_half_size: f32) {
+    #[allow(clippy::too_many_arguments)]
+    fn push(
+        &mut self,
+        shape: &Shape,
+        p: Vec3,
+        r: Quat,
+        color: [u8; 3],
+        label: Option<&Name>,
+        plane_half_size: f32,
+    ) {
         let color = rerun::Color::from_rgb(color[0], color[1], color[2]);
+        let label = label.map_or(String::new(), |n| n.as_str().to_owned());
+        self.named |= !label.is_empty();
         match shape {
             Shape::Sphere(s) => {
                 self.sphere_centers.push(arr(p));
                 self.sphere_radii.push(s.radius);
                 self.sphere_colors.push(color);
+                self.sphere_labels.push(label);
             }
-            Shape::Cuboid(c) => self.push_box(p, c.half_extents, r, color),
+            Shape::Cuboid(c) => self.push_box(p, c.half_extents, r, color, label),
             Shape::HalfSpace(h) => {
                 // A thin square slab just below the plane, facing along the normal.
                 let normal = r * h.normal;
                 let facing = Quat::from_rotation_arc(Vec3::Z, normal);
                 let half = Vec3::new(plane_half_size, plane_half_size, 0.005);
-                self.push_box(p - normal * 0.005, half, facing, color);
+                self.push_box(p - normal * 0.005, half, facing, color, label);
             }
             // Meshes have their own entities (`record_meshes`).
             Shape::TriMesh(_) => {}
         }
     }
 
-    fn push_box(&mut self, p: Vec3, half: Vec3, r: Quat, color: rerun::Color) {
+    fn push_box(&mut self, p: Vec3, half: Vec3, r: Quat, color: rerun::Color, label: String) {
         self.box_centers.push(arr(p));
         self.box_half_sizes.push(arr(half));
         self.box_rotations.push(quat(r));
         self.box_colors.push(color);
+        self.box_labels.push(label);
     }
 
     fn log(self, rec: &RecordingStream, path: &str) {
-        let spheres =
+        let mut spheres =
             rerun::Ellipsoids3D::from_centers_and_radii(self.sphere_centers, self.sphere_radii)
                 .with_colors(self.sphere_colors)
                 .with_fill_mode(rerun::FillMode::Solid);
-        report(rec.log(format!("{path}/spheres"), &spheres));
-        let boxes =
+        let mut boxes =
             rerun::Boxes3D::from_centers_and_half_sizes(self.box_centers, self.box_half_sizes)
                 .with_quaternions(self.box_rotations)
                 .with_colors(self.box_colors)
                 .with_fill_mode(rerun::FillMode::Solid);
+        if self.named {
+            spheres = spheres
+                .with_labels(self.sphere_labels)
+                .with_show_labels(true);
+            boxes = boxes.with_labels(self.box_labels).with_show_labels(true);
+        }
+        report(rec.log(format!("{path}/spheres"), &spheres));
         report(rec.log(format!("{path}/boxes"), &boxes));
     }
 }
 
 type StaticChanged = (
     With<Static>,
-    Or<(Added<Collider>, Changed<GlobalPose>, Changed<Collider>)>,
+    Or<(
+        Added<Collider>,
+        Changed<GlobalPose>,
+        Changed<Collider>,
+        Changed<DebugColor>,
+    )>,
 );
 
-/// Static scenery, re-logged only on the steps where some of it was added, moved or removed.
+type StaticView<'a> = (
+    &'a Collider,
+    &'a GlobalPose,
+    Option<&'a DebugColor>,
+    Option<&'a Name>,
+);
+
+/// Static scenery, re-logged only on the steps where some of it was added, moved, recoloured
+/// or removed.
 fn record_statics(
     rec: Res<RerunRecording>,
     stats: Res<PhysicsStats>,
     changed: Query<(), StaticChanged>,
     removed: RemovedComponents<Static>,
-    statics: Query<(&Collider, &GlobalPose), With<Static>>,
+    statics: Query<StaticView, With<Static>>,
 ) {
     if changed.is_empty() && removed.is_empty() {
         return;
     }
     set_time(&rec.stream, &stats);
     let mut batch = ShapeBatch::default();
-    for (c, g) in &statics {
+    for (c, g, tint, name) in &statics {
         let (p, r) = (g.0.translation, g.0.rotation);
-        batch.push(&c.shape, p, r, STATIC, rec.config.plane_half_size);
+        let color = tint.map_or(STATIC, |t| t.0);
+        batch.push(&c.shape, p, r, color, name, rec.config.plane_half_size);
     }
     batch.log(&rec.stream, "world/static");
 }
 
 type BodyView<'a> = (
+    Entity,
     &'a Collider,
     &'a GlobalPose,
     &'a BoundingVolume,
     Option<&'a Velocity>,
-    Option<&'a Mass>,
-    Option<&'a Quarantined>,
+    Option<&'a DebugColor>,
+    Option<&'a Name>,
 );
+
+/// What decides a body's colour: whether it (or, for a part, its root) is static, its mass, and
+/// whether it is quarantined.
+type KindView<'a> = (Has<Static>, Option<&'a Mass>, Has<Quarantined>);
+
+/// The colour of `e`'s kind: quarantined red, else its root's kind (a wheel is drawn like its
+/// car).
+fn kind_color(e: Entity, parents: &Query<&ChildOf>, kinds: &Query<KindView>) -> [u8; 3] {
+    if matches!(kinds.get(e), Ok((_, _, true))) {
+        return QUARANTINED;
+    }
+    let mut root = e;
+    while let Ok(p) = parents.get(root) {
+        root = p.parent();
+    }
+    match kinds.get(root) {
+        Ok((true, ..)) => STATIC,
+        Ok((_, Some(m), _)) if m.inverse() == 0.0 => KINEMATIC,
+        _ => DYNAMIC,
+    }
+}
 
 /// Moving bodies, their bounding volumes and velocities.
 fn record_bodies(
     rec: Res<RerunRecording>,
     stats: Res<PhysicsStats>,
     bodies: Query<BodyView, Without<Static>>,
+    parents: Query<&ChildOf>,
+    kinds: Query<KindView>,
     mut log_lines: Query<(Entity, &Quarantined), Added<Quarantined>>,
 ) {
     let stream = &rec.stream;
@@ -414,14 +562,13 @@ fn record_bodies(
     let mut batch = ShapeBatch::default();
     let (mut bv_centers, mut bv_half) = (Vec::new(), Vec::new());
     let (mut origins, mut vectors) = (Vec::new(), Vec::new());
-    for (c, g, bv, v, m, q) in &bodies {
+    for (e, c, g, bv, v, tint, name) in &bodies {
         let (p, r) = (g.0.translation, g.0.rotation);
-        let color = match (q, m) {
-            (Some(_), _) => QUARANTINED,
-            (None, Some(m)) if m.inverse() == 0.0 => KINEMATIC,
-            _ => DYNAMIC,
+        let color = match tint {
+            Some(t) if !kinds.get(e).is_ok_and(|k| k.2) => t.0,
+            _ => kind_color(e, &parents, &kinds),
         };
-        batch.push(&c.shape, p, r, color, rec.config.plane_half_size);
+        batch.push(&c.shape, p, r, color, name, rec.config.plane_half_size);
         if bv.0.is_finite() {
             bv_centers.push(arr(bv.0.center()));
             bv_half.push(arr(bv.0.half_extents()));
@@ -506,6 +653,7 @@ type MeshBody<'a> = (
     Ref<'a, GlobalPose>,
     Has<Static>,
     Option<&'a Mass>,
+    Option<&'a DebugColor>,
 );
 
 /// Mesh bodies: the triangles once per body (again only if its collider changes), the pose on
@@ -527,7 +675,7 @@ fn record_meshes(
             statics_changed = true;
         }
     }
-    for (entity, collider, g, is_static, mass) in &bodies {
+    for (entity, collider, g, is_static, mass, own_tint) in &bodies {
         let Shape::TriMesh(mesh) = &collider.shape else {
             if let Some(path) = logged.0.remove(&entity) {
                 report(stream.log(path, &rerun::Clear::recursive()));
@@ -541,9 +689,10 @@ fn record_meshes(
             .entry(entity)
             .or_insert_with(|| mesh_path(mesh, entity));
         if fresh {
-            let tint = match (is_static, mass) {
-                (true, _) => STATIC,
-                (false, Some(m)) if m.inverse() == 0.0 => KINEMATIC,
+            let tint = match (own_tint, is_static, mass) {
+                (Some(t), ..) => t.0,
+                (None, true, _) => STATIC,
+                (None, false, Some(m)) if m.inverse() == 0.0 => KINEMATIC,
                 _ => DYNAMIC,
             };
             log_mesh(stream, path, mesh, tint);
@@ -562,7 +711,7 @@ fn record_meshes(
     if levels > 0 {
         let mut moving = LevelBoxes::new(levels);
         let mut fixed = LevelBoxes::new(levels);
-        for (_, collider, g, is_static, _) in &bodies {
+        for (_, collider, g, is_static, ..) in &bodies {
             if let Shape::TriMesh(mesh) = &collider.shape {
                 let batch = if is_static { &mut fixed } else { &mut moving };
                 batch.add(mesh, &g.0);

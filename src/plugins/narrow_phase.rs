@@ -14,8 +14,9 @@
 //! (with `narrow_phase/mesh_pairs`, the mesh queries run) once a mesh pair has been tested.
 //!
 //! For debugging, [`OverlappingLeaves`] can list, per mesh pair in contact, the leaves of the
-//! hierarchies whose triangles touched; it is filled only while enabled (the rerun recording
-//! enables it on request), so the narrow phase pays nothing for it otherwise.
+//! hierarchies whose triangles touched, and [`HierarchyVisits`] the scene-graph nodes the descent
+//! of compound pairs tested, entered and pruned; each is filled only while enabled (the rerun
+//! recording enables them on request), so the narrow phase pays nothing for them otherwise.
 
 use crate::bounding::Aabb;
 use crate::bvh::QueryStats;
@@ -29,6 +30,11 @@ use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
 use std::time::Instant;
+
+mod visits;
+
+pub use visits::HierarchyVisits;
+use visits::VisitRecorder;
 
 /// Turns candidate pairs into contacts.
 #[derive(Debug, Clone, Default)]
@@ -95,6 +101,8 @@ struct NarrowPhaseScratch {
     contact: ContactScratch,
     pairs: PairScratch<Entity, Entity>,
     leaf_pairs: Vec<(Entity, Entity)>,
+    /// Nodes whose volume the descent read, while [`HierarchyVisits`] is enabled.
+    tested_nodes: Vec<(Entity, crate::bounding::Aabb)>,
     hierarchy: HierarchyStats,
     /// The step the sums below belong to.
     step: u64,
@@ -107,6 +115,7 @@ impl Plugin for NarrowPhasePlugin {
         app.init_resource::<Contacts>()
             .init_resource::<NarrowPhaseScratch>()
             .init_resource::<OverlappingLeaves>()
+            .init_resource::<HierarchyVisits>()
             .add_systems(
                 SubstepSchedule,
                 compute_contacts
@@ -155,6 +164,7 @@ fn compute_contacts(
     mut contacts: ResMut<Contacts>,
     mut scratch: ResMut<NarrowPhaseScratch>,
     mut debug: ResMut<OverlappingLeaves>,
+    mut visits: ResMut<HierarchyVisits>,
     mut stats: ResMut<PhysicsStats>,
 ) {
     let scratch = &mut *scratch;
@@ -167,6 +177,7 @@ fn compute_contacts(
     let record = debug.enabled;
     scratch.contact.set_record_hits(record);
     debug.pairs.clear();
+    visits.clear();
     let tree = EcsTree { nodes: &nodes };
     let start = Instant::now();
     contacts.pairs.clear();
@@ -179,17 +190,29 @@ fn compute_contacts(
         let NarrowPhaseScratch {
             pairs: stack,
             leaf_pairs,
+            tested_nodes,
             hierarchy,
             ..
         } = &mut *scratch;
         leaf_pairs.clear();
-        *hierarchy += descend_pairs(&tree, a, &tree, b, stack, |la, lb| {
-            leaf_pairs.push((la, lb))
-        });
+        let found = |la, lb| leaf_pairs.push((la, lb));
+        *hierarchy += if visits.enabled {
+            let visits = &mut *visits;
+            let recorder = VisitRecorder::new(&tree, tested_nodes, &mut visits.entered);
+            descend_pairs(&recorder, a, &recorder, b, stack, found)
+        } else {
+            descend_pairs(&tree, a, &tree, b, stack, found)
+        };
+        if visits.enabled {
+            visits.collider_pairs.extend_from_slice(&scratch.leaf_pairs);
+        }
         for i in 0..scratch.leaf_pairs.len() {
             let leaves = scratch.leaf_pairs[i];
             scratch.test_leaves(&nodes, (a, b), leaves, &mut contacts, &mut debug);
         }
+    }
+    if visits.enabled {
+        visits.finish(&mut scratch.tested_nodes);
     }
     stats.add_time(Stage::NarrowPhase, start.elapsed());
     stats.count_run("narrow_phase");
