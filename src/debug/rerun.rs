@@ -267,8 +267,10 @@ impl Drop for RerunRecording {
 
 /// The layout the viewer opens on: the 3D scene large on the left; on the right the wall time
 /// of each stage in one plot and the step's counters in another (instead of one plot each).
-/// With per-level or close-up views asked for (hierarchy levels, scene-graph levels, grid cells),
-/// they sit as tabs on top of the right column, and the main scene leaves the level boxes out.
+/// With per-level views asked for (hierarchy levels, scene-graph levels) they sit as tabs on top
+/// of the right column, and the main scene leaves the level boxes out; with grid cells asked
+/// for, the close-up of the moving bodies and their cells takes the main view's place and the
+/// whole scene becomes the first tab.
 /// The time panel starts collapsed (the scene gets the room); with
 /// [`RerunConfig::open_at_end`] the viewer shows the last recorded step.
 fn default_layout(config: &RerunConfig) -> rerun::blueprint::Blueprint {
@@ -283,7 +285,14 @@ fn default_layout(config: &RerunConfig) -> rerun::blueprint::Blueprint {
     let timing = TimeSeriesView::new("time per stage (ms)").with_origin("/timing");
     let counters = TimeSeriesView::new("counters").with_origin("/counters");
     let log = TextLogView::new("log").with_origin("/log");
-    let tabs = detail_views(config);
+    let mut tabs = detail_views(config);
+    // With grid cells asked for, the close-up of the moving bodies is the main view and the
+    // whole scene (a town is mostly far from its cars) the first tab.
+    let main = if config.grid_cells {
+        std::mem::replace(&mut tabs[0], scene.into())
+    } else {
+        scene.into()
+    };
     let side = if tabs.is_empty() {
         Vertical::new([timing.into(), counters.into(), log.into()]).with_row_shares([0.4, 0.4, 0.2])
     } else {
@@ -299,7 +308,7 @@ fn default_layout(config: &RerunConfig) -> rerun::blueprint::Blueprint {
     if config.open_at_end {
         time_panel = time_panel.with_play_state(PlayState::Following);
     }
-    Blueprint::new(Horizontal::new([scene.into(), side.into()]).with_column_shares([0.6, 0.4]))
+    Blueprint::new(Horizontal::new([main, side.into()]).with_column_shares([0.6, 0.4]))
         .with_blueprint_panel(BlueprintPanel::new().with_state(PanelState::Collapsed))
         .with_selection_panel(SelectionPanel::new().with_state(PanelState::Collapsed))
         .with_time_panel(time_panel)
