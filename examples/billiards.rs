@@ -33,6 +33,9 @@ struct Args {
     /// Where to write the recording.
     #[arg(long, default_value = "billiards.rrd")]
     out: PathBuf,
+    /// Open the viewer on the last recorded step (for screenshots).
+    #[arg(long)]
+    open_at_end: bool,
 }
 
 const RADIUS: f32 = 0.0286;
@@ -49,6 +52,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         velocities: false,
         bounding_volumes: false,
         plane_half_size: 2.0,
+        open_at_end: args.open_at_end,
         ..RerunConfig::file(&args.out)
     })?;
     let mut app = App::new();

@@ -30,6 +30,9 @@ struct Args {
     /// Record every k-th step.
     #[arg(long, default_value_t = 1)]
     every: u64,
+    /// Open the viewer on the last recorded step (for screenshots).
+    #[arg(long)]
+    open_at_end: bool,
 }
 
 /// A small deterministic generator (same scene on every run, no extra dependency).
@@ -50,6 +53,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     let recording = RerunDebugPlugin::new(RerunConfig {
         app_id: "urto bouncing_balls".into(),
         every_k_steps: args.every,
+        open_at_end: args.open_at_end,
         ..RerunConfig::file(&args.out)
     })?;
 

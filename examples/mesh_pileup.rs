@@ -42,6 +42,9 @@ struct Args {
     /// Hierarchy levels drawn per mesh (0: none).
     #[arg(long, default_value_t = 4)]
     bvh_levels: u32,
+    /// Open the viewer on the last recorded step (for screenshots).
+    #[arg(long)]
+    open_at_end: bool,
 }
 
 /// A mesh moved so its box is centred on the origin and scaled so its largest side is `size`.
@@ -94,6 +97,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         bvh_levels: args.bvh_levels,
         overlapping_leaves: true,
         velocities: false,
+        open_at_end: args.open_at_end,
         ..RerunConfig::file(&args.out)
     })?;
 
