@@ -53,3 +53,8 @@ pub mod prelude {
     pub use crate::settings::*;
     pub use crate::stats::{PhysicsStats, Stage};
 }
+
+/// The README's code blocks, compiled and run as doctests so that the README stays true.
+#[cfg(all(doctest, feature = "rerun"))]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

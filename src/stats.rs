@@ -61,12 +61,19 @@ pub struct PhysicsStats {
     stage_time: [Duration; 7],
     runs: Vec<(&'static str, u64)>,
     counters: Vec<(&'static str, f64)>,
+    /// Counters that sum the work of the step's substeps (see [`PhysicsStats::add_counter`]).
+    summed: Vec<&'static str>,
 }
 
 impl PhysicsStats {
     /// Clears the per-step timings (called at the start of a step).
     pub fn begin_step(&mut self) {
         self.stage_time = Default::default();
+        for (name, value) in &mut self.counters {
+            if self.summed.contains(name) {
+                *value = 0.0;
+            }
+        }
     }
 
     /// Wall time spent in `stage` during the last step.
@@ -104,11 +111,24 @@ impl PhysicsStats {
             .map_or(0, |(_, c)| *c)
     }
 
-    /// Sets a named counter of the last step (e.g. `"broad_phase/pairs"`).
+    /// Sets a named counter of the last step (e.g. `"broad_phase/pairs"`): with substeps, the
+    /// last substep's value.
     pub fn set_counter(&mut self, name: &'static str, value: f64) {
         match self.counters.iter_mut().find(|(n, _)| *n == name) {
             Some((_, v)) => *v = value,
             None => self.counters.push((name, value)),
+        }
+    }
+
+    /// Adds to a named counter that sums the work of all the step's substeps (e.g.
+    /// `"ccd/impacts"`); it restarts from zero each step, so a step without that work reads 0.
+    pub fn add_counter(&mut self, name: &'static str, value: f64) {
+        match self.counters.iter_mut().find(|(n, _)| *n == name) {
+            Some((_, v)) => *v += value,
+            None => {
+                self.counters.push((name, value));
+                self.summed.push(name);
+            }
         }
     }
 
@@ -123,5 +143,26 @@ impl PhysicsStats {
     /// All counters, in the order they were first set (deterministic).
     pub fn counters(&self) -> &[(&'static str, f64)] {
         &self.counters
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn summed_counters_add_over_substeps_and_restart_each_step() {
+        let mut stats = PhysicsStats::default();
+        stats.set_counter("pairs", 7.0);
+        stats.add_counter("impacts", 2.0);
+        stats.add_counter("impacts", 3.0);
+        assert_eq!(stats.counter("impacts"), Some(5.0));
+        stats.begin_step();
+        assert_eq!(stats.counter("impacts"), Some(0.0));
+        assert_eq!(
+            stats.counter("pairs"),
+            Some(7.0),
+            "a set counter keeps its last value"
+        );
     }
 }

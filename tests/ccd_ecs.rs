@@ -117,6 +117,37 @@ fn a_swept_impact_starts_a_collision() {
     assert_eq!(started, 1);
 }
 
+/// A marked ball already touching the 1 cm wall (1 mm gap, touching, 1 mm into it) and moving
+/// into it at 10 or 30 m/s is stopped: the sweep takes a contact present at its start when the
+/// motion goes into it, instead of leaving it to the solver, which sees only the substep's end.
+#[test]
+fn a_ball_touching_the_wall_and_moving_into_it_does_not_pass() {
+    for gap in [0.001, 0.0, -0.001] {
+        for speed in [10.0, 30.0] {
+            let mut app = common::app();
+            app.insert_resource(CcdSettings {
+                auto_speed_ratio: None,
+                ..Default::default()
+            });
+            wall(&mut app, false);
+            let x = 5.0 - WALL_HALF_THICKNESS - 0.05 - gap;
+            let ball = app
+                .world_mut()
+                .spawn((
+                    Collider::sphere(0.05),
+                    Position::new(x, 0.0, 0.0),
+                    Velocity::new(speed, 0.0, 0.0),
+                    Ccd,
+                ))
+                .id();
+            urto::step(app.world_mut(), 3).unwrap();
+            assert_eq!(passed(&app, &[ball]), 0, "gap {gap} m at {speed} m/s");
+            let v = app.world().get::<Velocity>(ball).unwrap().0;
+            assert!(v.x < 0.0, "bounced back: {v}");
+        }
+    }
+}
+
 /// A marked ball resting on the ground stays at rest, and one sliding along it keeps sliding:
 /// contacts present at the start of a motion belong to the solver, not to the sweep.
 #[test]

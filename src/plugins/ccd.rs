@@ -207,6 +207,14 @@ fn sweep_fast_bodies(
                 break;
             };
             let e = 0.5 * (e_body + e_obstacle.unwrap_or(contact_settings.default_restitution));
+            let approach = -velocity.dot(hit.normal);
+            // As in the contact solver: slow approaches (a body resting or sliding on its
+            // support, which gravity pushes in every substep) stop without a bounce.
+            let e = if approach < contact_settings.solver.restitution_threshold {
+                0.0
+            } else {
+                e
+            };
             at = sweep.position_at(hit.t);
             velocity = reflect(velocity, hit.normal, e);
             motion = velocity * dt * (1.0 - hit.t);
@@ -223,13 +231,17 @@ fn sweep_fast_bodies(
         p.set_if_neq(Position(at));
         v.set_if_neq(Velocity(velocity));
     }
-    stats.set_counter("ccd/sweeps", s.starts.len() as f64);
-    stats.set_counter("ccd/impacts", impacts.contacts.len() as f64);
+    stats.add_counter("ccd/sweeps", s.starts.len() as f64);
+    stats.add_counter("ccd/impacts", impacts.contacts.len() as f64);
     stats.add_time(Stage::Integrate, start.elapsed());
     stats.count_run("ccd");
 }
 
-/// The earliest impact (`t > 0`) of `sweep` with the static scenery its swept volume meets:
+/// Motion into a surface already touched at the start of a sweep, as a fraction of the radius,
+/// below which it is rounding (a body sliding along its support), not an impact.
+const TOUCHING_TOLERANCE: f32 = 1e-4;
+
+/// The earliest impact of `sweep` with the static scenery its swept volume meets:
 /// the hit, the obstacle's root, the collider hit, and that collider's restitution.
 fn first_impact(
     sweep: &SphereSweep,
@@ -258,9 +270,13 @@ fn first_impact(
             let Some(hit) = toi_sphere_shape(sweep, &c.shape, &global.0, &mut s.query) else {
                 continue;
             };
-            // A contact already there at t = 0 is the contact solver's, not an impact.
+            // A contact already there at t = 0 counts when the motion goes into it by more than
+            // rounding: left to the solver, which sees only the end of the substep, a body
+            // touching a thin wall would pass it. Motion along the surface is no impact.
+            let into = -sweep.displacement().dot(hit.normal);
+            let real = hit.t > 0.0 || into > TOUCHING_TOLERANCE * sweep.radius();
             let earlier = best.as_ref().is_none_or(|(b, ..)| hit.t < b.t);
-            if hit.t > 0.0 && earlier {
+            if real && earlier {
                 best = Some((hit, root, node, e.map(|r| r.0)));
             }
         }
