@@ -286,13 +286,28 @@ fn first_impact(
 
 /// The substep's impacts join the narrow phase's contacts (once per pair), so the response and
 /// the collision messages see them; being separating already, they get no further impulse.
-fn add_impacts_to_contacts(impacts: Res<CcdImpacts>, mut contacts: ResMut<Contacts>) {
+/// Sorted keys keep this linear-logarithmic: a pile of marked bodies resting on the ground
+/// makes as many impacts as contacts.
+fn add_impacts_to_contacts(
+    impacts: Res<CcdImpacts>,
+    mut contacts: ResMut<Contacts>,
+    mut known: Local<Vec<(Entity, Entity)>>,
+) {
+    if impacts.contacts.is_empty() {
+        return;
+    }
+    known.clear();
+    known.extend(contacts.pairs.iter().map(|c| (c.a, c.b)));
+    known.sort_unstable();
+    let added_from = contacts.pairs.len();
     for impact in &impacts.contacts {
-        let known = contacts
-            .pairs
+        // A body's impacts are consecutive: one hitting the same body twice is found among them.
+        let repeated = contacts.pairs[added_from..]
             .iter()
-            .any(|c| (c.a, c.b) == (impact.a, impact.b));
-        if !known {
+            .rev()
+            .take_while(|c| c.a == impact.a)
+            .any(|c| c.b == impact.b);
+        if !repeated && known.binary_search(&(impact.a, impact.b)).is_err() {
             contacts.pairs.push(*impact);
         }
     }
