@@ -6,12 +6,15 @@
 //! rerun bouncing_balls.rrd
 //! ```
 
+mod support;
+
 use bevy_app::App;
+use bevy_ecs::entity::Entity;
 use clap::Parser;
 use glam::Vec3;
 use std::error::Error;
 use std::path::PathBuf;
-use std::time::Instant;
+use support::{Collisions, Lcg, StepTimer};
 use urto::debug::{RerunConfig, RerunDebugPlugin};
 use urto::prelude::*;
 
@@ -35,19 +38,6 @@ struct Args {
     open_at_end: bool,
 }
 
-/// A small deterministic generator (same scene on every run, no extra dependency).
-struct Lcg(u64);
-
-impl Lcg {
-    fn next(&mut self) -> f32 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
-
 fn main() -> Result<(), Box<dyn Error>> {
     let args = Args::parse();
     let recording = RerunDebugPlugin::new(RerunConfig {
@@ -62,51 +52,81 @@ fn main() -> Result<(), Box<dyn Error>> {
         .add_plugins(recording)
         .insert_resource(Gravity::EARTH_Z_UP);
     let world = app.world_mut();
-    world.spawn((Collider::half_space(Vec3::Z), Static, Restitution(0.9)));
-    let mut rng = Lcg(7);
+    let ground = world
+        .spawn((Collider::half_space(Vec3::Z), Static, Restitution(0.9)))
+        .id();
+    let mut rng = Lcg::new(7);
     let side = (args.balls as f32).sqrt().ceil() as u32;
+    let mut balls = Vec::new();
     for i in 0..args.balls {
         let (gx, gy) = ((i % side) as f32, (i / side) as f32);
         let radius = 0.2 + 0.25 * rng.next();
-        world.spawn((
-            Collider::sphere(radius),
-            Position::new(
-                gx * 1.1 - side as f32 * 0.5,
-                gy * 1.1 - side as f32 * 0.5,
-                1.0 + 4.0 * rng.next(),
-            ),
-            Velocity::new(rng.next() - 0.5, rng.next() - 0.5, 0.0),
-            Mass(radius.powi(3) * 4.19 * 1000.0),
-            Restitution(0.5 + 0.45 * rng.next()),
-        ));
+        balls.push(
+            world
+                .spawn((
+                    Collider::sphere(radius),
+                    Position::new(
+                        gx * 1.1 - side as f32 * 0.5,
+                        gy * 1.1 - side as f32 * 0.5,
+                        1.0 + 4.0 * rng.next(),
+                    ),
+                    Velocity::new(rng.next() - 0.5, rng.next() - 0.5, 0.0),
+                    Mass(radius.powi(3) * 4.19 * 1000.0),
+                    Restitution(0.5 + 0.45 * rng.next()),
+                ))
+                .id(),
+        );
     }
 
-    let start = Instant::now();
-    let mut physics_time = 0.0;
+    let mut timer = StepTimer::start();
+    let mut collisions = Collisions::new(&app);
+    let (mut bounces, mut ball_hits) = (0, 0);
     for _ in 0..args.steps {
         urto::step(app.world_mut(), 1)?;
-        let stats = app.world().resource::<PhysicsStats>();
-        physics_time += Stage::ALL
-            .iter()
-            .filter(|s| **s != Stage::Debug)
-            .map(|s| stats.stage_time(*s).as_secs_f64())
-            .sum::<f64>();
+        timer.add(&app);
+        for (a, b) in collisions.read(&app) {
+            if a == ground || b == ground {
+                bounces += 1;
+            } else {
+                ball_hits += 1;
+            }
+        }
     }
-    let wall = start.elapsed().as_secs_f64();
     let stats = app.world().resource::<PhysicsStats>();
     println!(
         "bouncing_balls: {} balls, {} steps ({:.1} s simulated)",
         args.balls, stats.step, stats.sim_time
     );
+    println!("  bounces on the ground: {bounces}; collisions between two balls: {ball_hits}");
+    let (resting, deepest) = at_rest(&app, &balls);
     println!(
-        "  time per step: {:.1} µs physics, {:.1} µs with recording",
-        physics_time / args.steps as f64 * 1e6,
-        wall / args.steps as f64 * 1e6
+        "  at the end {resting} of {} balls rest on the ground (speed < 5 cm/s); deepest below the surface: {:.1} mm",
+        balls.len(),
+        deepest * 1e3
     );
-    println!(
-        "  recording: {}  (open it with `rerun {}`)",
-        args.out.display(),
-        args.out.display()
-    );
+    println!("  {}", timer.summary());
+    support::print_recording(&args.out);
     Ok(())
+}
+
+/// How many balls rest on the ground (slow, touching it) and how deep the deepest sinks (m).
+fn at_rest(app: &App, balls: &[Entity]) -> (usize, f32) {
+    let world = app.world();
+    let mut resting = 0;
+    let mut deepest = 0.0f32;
+    for &ball in balls {
+        let (Some(p), Some(v), Some(c)) = (
+            world.get::<Position>(ball),
+            world.get::<Velocity>(ball),
+            world.get::<Collider>(ball),
+        ) else {
+            continue;
+        };
+        let gap = p.0.z - c.shape.bounding_radius();
+        deepest = deepest.max(-gap);
+        if v.0.length() < 0.05 && gap < 0.01 {
+            resting += 1;
+        }
+    }
+    (resting, deepest)
 }
