@@ -32,7 +32,6 @@ use clap::Parser;
 use glam::{EulerRot, Quat, Vec2, Vec3};
 use std::error::Error;
 use std::f32::consts::{PI, TAU};
-use std::path::PathBuf;
 use support::{Lcg, StepTimer};
 use urto::debug::{DebugColor, RerunConfig, RerunDebugPlugin};
 use urto::geometry::{MeshCollider, TriMesh};
@@ -61,15 +60,8 @@ struct Args {
     /// Give each body a mass by its volume (600 kg/m³) instead of 1 kg.
     #[arg(long)]
     mass_by_volume: bool,
-    /// Where to write the recording.
-    #[arg(long, default_value = "avalanche.rrd")]
-    out: PathBuf,
-    /// Record every k-th step (keeps the file small).
-    #[arg(long, default_value_t = 2)]
-    every: u64,
-    /// Open the viewer on the last recorded step (for screenshots).
-    #[arg(long)]
-    open_at_end: bool,
+    #[command(flatten)]
+    recording: support::RecordingArgs,
 }
 
 /// Radius of the bowl's paraboloid, where the flat rim starts (m).
@@ -200,26 +192,21 @@ fn sphere(r: f32) -> Body {
 fn main() -> Result<(), Box<dyn Error>> {
     let args = Args::parse();
     let recording = RerunDebugPlugin::new(RerunConfig {
-        app_id: "urto avalanche".into(),
-        every_k_steps: args.every,
         bounding_volumes: false,
         velocities: false,
         contacts: false,
-        open_at_end: args.open_at_end,
-        ..RerunConfig::file(&args.out)
+        ..args.recording.config("avalanche", 2)
     })?;
-    let mut app = App::new();
-    app.add_plugins(UrtoPlugins::with_timestep(PhysicsTimestep::new(
-        1.0 / 60.0,
+    let mut app = support::game_app(
         args.substeps.max(1),
-    )?))
-    .add_plugins(recording)
-    .insert_resource(Gravity::EARTH_Z_UP)
-    .insert_resource(ContactSettings {
-        default_restitution: 0.1,
-        default_friction: 0.4,
-        ..Default::default()
-    });
+        Gravity::EARTH_Z_UP,
+        ContactSettings {
+            default_restitution: 0.1,
+            default_friction: 0.4,
+            ..Default::default()
+        },
+    )?;
+    app.add_plugins(recording);
     let bowl = bowl_mesh()?;
     let triangles = bowl.mesh().triangle_count();
     let bowl = app
@@ -417,7 +404,7 @@ impl Tally {
             stats.counter("broad_phase/static_bodies").unwrap_or(0.0)
         );
         println!("  {}", timer.summary());
-        support::print_recording(&args.out);
+        support::print_recording(&args.recording.path("avalanche"));
     }
 }
 

@@ -33,7 +33,6 @@ use clap::Parser;
 use glam::{Quat, Vec2, Vec3};
 use std::collections::BTreeMap;
 use std::error::Error;
-use std::path::PathBuf;
 use support::{Collisions, Lcg, StepTimer};
 use urto::debug::rerun::RerunRecording;
 use urto::debug::{DebugColor, RerunConfig, RerunDebugPlugin};
@@ -55,15 +54,8 @@ struct Args {
     /// Record the run without continuous collision instead (to watch balls tunnel).
     #[arg(long)]
     no_ccd: bool,
-    /// Where to write the recording.
-    #[arg(long, default_value = "pinball.rrd")]
-    out: PathBuf,
-    /// Record every k-th step.
-    #[arg(long, default_value_t = 1)]
-    every: u64,
-    /// Open the viewer on the last recorded step (for screenshots).
-    #[arg(long)]
-    open_at_end: bool,
+    #[command(flatten)]
+    recording: support::RecordingArgs,
 }
 
 const RADIUS: f32 = 0.12;
@@ -126,12 +118,9 @@ struct Table {
 fn main() -> Result<(), Box<dyn Error>> {
     let args = Args::parse();
     let recording = RerunDebugPlugin::new(RerunConfig {
-        app_id: "urto pinball".into(),
-        every_k_steps: args.every,
         contacts: false,
         bounding_volumes: false,
-        open_at_end: args.open_at_end,
-        ..RerunConfig::file(&args.out)
+        ..args.recording.config("pinball", 1)
     })?;
     let (mut with, mut without) = (Some(recording), None);
     if args.no_ccd {
@@ -154,23 +143,23 @@ fn tally_impacts(impacts: Res<CcdImpacts>, mut tally: ResMut<ImpactTally>) {
 /// The app of one run. Automatic sweeping of fast unmarked bodies is off, so only the balls
 /// marked [`Ccd`] (in the continuous run) are swept.
 fn build_app(args: &Args, recording: Option<RerunDebugPlugin>) -> Result<App, Box<dyn Error>> {
-    let mut app = App::new();
-    let timestep = PhysicsTimestep::new(1.0 / 60.0, args.substeps)?;
-    app.add_plugins(UrtoPlugins::with_timestep(timestep))
-        .insert_resource(Gravity::new(to_world(Vec2::NEG_Y * TABLE_GRAVITY))?)
-        .insert_resource(CcdSettings {
-            auto_speed_ratio: None,
-            ..Default::default()
-        })
-        .insert_resource(ContactSettings {
+    let mut app = support::game_app(
+        args.substeps,
+        Gravity::new(to_world(Vec2::NEG_Y * TABLE_GRAVITY))?,
+        ContactSettings {
             default_friction: 0.0,
             ..Default::default()
-        })
-        .init_resource::<ImpactTally>()
-        .add_systems(
-            SubstepSchedule,
-            tally_impacts.in_set(SubstepSet::BroadPhase),
-        );
+        },
+    )?;
+    app.insert_resource(CcdSettings {
+        auto_speed_ratio: None,
+        ..Default::default()
+    })
+    .init_resource::<ImpactTally>()
+    .add_systems(
+        SubstepSchedule,
+        tally_impacts.in_set(SubstepSet::BroadPhase),
+    );
     if let Some(recording) = recording {
         app.add_plugins(recording);
     }
@@ -475,5 +464,5 @@ fn print_report(args: &Args, discrete: &RunReport, continuous: &RunReport) {
     }
     let recorded = if args.no_ccd { "without" } else { "with" };
     println!("  the recording shows the run {recorded} CCD");
-    support::print_recording(&args.out);
+    support::print_recording(&args.recording.path("pinball"));
 }

@@ -37,7 +37,6 @@ use glam::{Quat, Vec2, Vec3};
 use std::collections::BTreeMap;
 use std::error::Error;
 use std::f32::consts::{PI, TAU};
-use std::path::PathBuf;
 use support::{Collisions, Lcg, StepTimer};
 use urto::debug::{DebugColor, RerunConfig, RerunDebugPlugin};
 use urto::plugins::narrow_phase::HierarchyVisits;
@@ -60,15 +59,8 @@ struct Args {
     /// Depths of the scene graph shown, one tab each.
     #[arg(long, default_value_t = 6)]
     levels: u32,
-    /// Where to write the recording.
-    #[arg(long, default_value = "robot_arm.rrd")]
-    out: PathBuf,
-    /// Record every k-th step.
-    #[arg(long, default_value_t = 1)]
-    every: u64,
-    /// Open the viewer on the last recorded step (for screenshots).
-    #[arg(long)]
-    open_at_end: bool,
+    #[command(flatten)]
+    recording: support::RecordingArgs,
 }
 
 /// Height of the bench's top (m) and half its length and width.
@@ -92,27 +84,22 @@ const BALLS: [[u8; 3]; 3] = [[46, 204, 113], [231, 76, 60], [155, 89, 182]];
 fn main() -> Result<(), Box<dyn Error>> {
     let args = Args::parse();
     let recording = RerunDebugPlugin::new(RerunConfig {
-        app_id: "urto robot_arm".into(),
-        every_k_steps: args.every,
         velocities: false,
         bounding_volumes: false,
         scene_graph_levels: args.levels,
         hierarchy_visits: true,
-        open_at_end: args.open_at_end,
-        ..RerunConfig::file(&args.out)
+        ..args.recording.config("robot_arm", 1)
     })?;
-    let mut app = App::new();
-    app.add_plugins(UrtoPlugins::with_timestep(PhysicsTimestep::new(
-        1.0 / 60.0,
+    let mut app = support::game_app(
         2,
-    )?))
-    .add_plugins(recording)
-    .insert_resource(Gravity::EARTH_Z_UP)
-    .insert_resource(ContactSettings {
-        default_restitution: 0.3,
-        default_friction: 0.5,
-        ..Default::default()
-    });
+        Gravity::EARTH_Z_UP,
+        ContactSettings {
+            default_restitution: 0.3,
+            default_friction: 0.5,
+            ..Default::default()
+        },
+    )?;
+    app.add_plugins(recording);
     let obstacles = build_bench(&mut app, &args);
     let arm = spawn_arm(&mut app);
     let report = run(&mut app, &args, &arm, &obstacles)?;
@@ -472,6 +459,6 @@ impl Report {
             w.bv_tests / w.steps.max(1) as f64,
         );
         println!("  {}", self.timer.summary());
-        support::print_recording(&args.out);
+        support::print_recording(&args.recording.path("robot_arm"));
     }
 }

@@ -22,7 +22,6 @@ use bevy_ecs::prelude::*;
 use clap::Parser;
 use glam::{Quat, Vec2, Vec3};
 use std::error::Error;
-use std::path::PathBuf;
 use support::{Collisions, Lcg, StepTimer};
 use urto::debug::{DebugColor, RerunConfig, RerunDebugPlugin};
 use urto::plugins::{BroadPhaseIndex, BroadPhasePairs};
@@ -43,15 +42,8 @@ struct Args {
     /// Cruising speed of the car (m/s).
     #[arg(long, default_value_t = 12.0)]
     speed: f32,
-    /// Where to write the recording.
-    #[arg(long, default_value = "town_drive.rrd")]
-    out: PathBuf,
-    /// Record every k-th step.
-    #[arg(long, default_value_t = 1)]
-    every: u64,
-    /// Open the viewer on the last recorded step (for screenshots).
-    #[arg(long)]
-    open_at_end: bool,
+    #[command(flatten)]
+    recording: support::RecordingArgs,
 }
 
 /// Width of a lot (m); a building fills most of it.
@@ -97,27 +89,22 @@ fn main() -> Result<(), Box<dyn Error>> {
         lots: args.lots.max(1),
     };
     let recording = RerunDebugPlugin::new(RerunConfig {
-        app_id: "urto town_drive".into(),
-        every_k_steps: args.every,
         grid_cells: true,
         velocities: false,
         bounding_volumes: false,
         plane_half_size: town.half_size() + 20.0,
-        open_at_end: args.open_at_end,
-        ..RerunConfig::file(&args.out)
+        ..args.recording.config("town_drive", 1)
     })?;
-    let mut app = App::new();
-    app.add_plugins(UrtoPlugins::with_timestep(PhysicsTimestep::new(
-        1.0 / 60.0,
+    let mut app = support::game_app(
         2,
-    )?))
-    .add_plugins(recording)
-    .insert_resource(Gravity::EARTH_Z_UP)
-    .insert_resource(ContactSettings {
-        default_restitution: 0.45,
-        default_friction: 0.0,
-        ..Default::default()
-    });
+        Gravity::EARTH_Z_UP,
+        ContactSettings {
+            default_restitution: 0.45,
+            default_friction: 0.0,
+            ..Default::default()
+        },
+    )?;
+    app.add_plugins(recording);
     let (ground, buildings) = build_town(&mut app, town);
     let start = town.crossing(town.blocks as i32 / 2, town.blocks as i32 / 2);
     let car = spawn_car(&mut app, start);
@@ -446,6 +433,6 @@ impl DriveReport {
             }
         );
         println!("  {}", self.timer.summary());
-        support::print_recording(&args.out);
+        support::print_recording(&args.recording.path("town_drive"));
     }
 }

@@ -1,14 +1,63 @@
-//! Helpers shared by the example games: a seeded generator, a per-step timer, and a reader of
-//! the collision messages. Included by each game with `mod support;` (not an example itself:
+//! Helpers shared by the example games: their app and recording options, a seeded generator, a
+//! per-step timer, and a reader of the collision messages. Included by each game with `mod support;` (not an example itself:
 //! the directory has no `main.rs`).
 #![allow(dead_code)]
 
 use bevy_app::App;
 use bevy_ecs::message::{MessageCursor, Messages};
 use bevy_ecs::prelude::*;
-use std::path::Path;
+use std::error::Error;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
+use urto::debug::RerunConfig;
 use urto::prelude::*;
+
+/// A game's app: urto at 60 steps per second with `substeps`, gravity and contact settings.
+pub fn game_app(
+    substeps: u32,
+    gravity: Gravity,
+    contacts: ContactSettings,
+) -> Result<App, Box<dyn Error>> {
+    let mut app = App::new();
+    let timestep = PhysicsTimestep::new(1.0 / 60.0, substeps)?;
+    app.add_plugins(UrtoPlugins::with_timestep(timestep))
+        .insert_resource(gravity)
+        .insert_resource(contacts);
+    Ok(app)
+}
+
+/// The recording options every game takes.
+#[derive(clap::Args, Debug)]
+pub struct RecordingArgs {
+    /// Where to write the recording [default: <game>.rrd]
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Record every k-th step [default: the game's, 1 for most]
+    #[arg(long)]
+    pub every: Option<u64>,
+    /// Open the viewer on the last recorded step (for screenshots).
+    #[arg(long)]
+    pub open_at_end: bool,
+}
+
+impl RecordingArgs {
+    /// The recording's path: `--out`, else `<game>.rrd`.
+    pub fn path(&self, game: &str) -> PathBuf {
+        self.out
+            .clone()
+            .unwrap_or_else(|| PathBuf::from(format!("{game}.rrd")))
+    }
+
+    /// A recording of `game` to its file, every `--every` (else `every`) steps.
+    pub fn config(&self, game: &str, every: u64) -> RerunConfig {
+        RerunConfig {
+            app_id: format!("urto {game}"),
+            every_k_steps: self.every.unwrap_or(every),
+            open_at_end: self.open_at_end,
+            ..RerunConfig::file(self.path(game))
+        }
+    }
+}
 
 /// A small deterministic generator (the same scene on every run, no extra dependency).
 pub struct Lcg(u64);
