@@ -16,11 +16,11 @@
 //! the main view, which nodes the descent entered (yellow) or pruned (grey) and the collider
 //! pairs it handed to the exact test (red segments).
 //!
-//! The base is kinematic (`Mass::INFINITE`): contacts push the obstacles, never the arm. urto's
-//! bodies only translate, and the contact response sees a part of a compound moving at its
-//! root's velocity (zero for the standing base), not at the speed its turning joints give it; so
-//! the links shove the obstacles out of their way (position correction) rather than bat them,
-//! and what they push over the bench's edge falls to the floor.
+//! The base is kinematic (`Mass::INFINITE`): contacts push the obstacles, never the arm. A link
+//! hits with the velocity its turning joints give the point of contact (how the link moved
+//! relative to the base this step, `StepStartPose`), so it bats what it meets; bodies only
+//! translate (urto has no angular dynamics), and what leaves the bench's edge falls to the floor.
+//! A crate pushed along keeps bumping into the link that chases it, so hits count every bump.
 //!
 //! ```text
 //! cargo run --release --example robot_arm -- --help

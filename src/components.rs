@@ -196,6 +196,14 @@ pub struct BoundingVolume(pub Aabb);
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 pub struct GlobalPose(pub Isometry);
 
+/// Where a node of a compound body was at the start of the step (its [`GlobalPose`] then). A
+/// game turns a robot's joints by setting the parts' local poses; how a part moved relative to
+/// its root this step, divided by the step, is the velocity with which it pushes what it
+/// touches when its root is immovable. Kept by the physics for every node of a hierarchy; read
+/// it, don't write it.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepStartPose(pub Isometry);
+
 /// Continuous collision for a fast body: instead of testing only where the step ends (where a
 /// bullet may already be past a thin wall: tunnelling), the body's motion during the step is
 /// swept against static scenery and it stops at the first impact, then spends the rest of the

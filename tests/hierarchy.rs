@@ -220,3 +220,50 @@ fn a_part_with_its_own_velocity_is_quarantined() {
     assert!(q.reason.contains("compound"), "{}", q.reason);
     assert!(app.world().get::<Quarantined>(chassis).is_none());
 }
+
+/// A kinematic arm whose joint the game turns at 3 rad/s bats a ball at the speed of the point
+/// that hits it (1.5 m from the joint: 4.5 m/s), sending it off faster than that along the
+/// link's motion; without the part's own velocity it would only be pushed aside.
+#[test]
+fn a_turning_kinematic_link_bats_a_ball_at_its_own_speed() {
+    let mut app = common::app();
+    let base = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.1),
+            Position::default(),
+            Velocity::default(),
+            Mass::INFINITE,
+        ))
+        .id();
+    let joint = app
+        .world_mut()
+        .spawn((Position::default(), ChildOf(base)))
+        .id();
+    app.world_mut().spawn((
+        Collider::cuboid(0.9, 0.1, 0.1),
+        Position::new(1.0, 0.0, 0.0),
+        ChildOf(joint),
+    ));
+    let ball = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.1),
+            Position::new(1.5, 0.35, 0.0),
+            Velocity::default(),
+        ))
+        .id();
+    let (omega, dt) = (3.0, 1.0 / 60.0);
+    for step in 1..=20 {
+        app.world_mut().get_mut::<Rotation>(joint).unwrap().0 =
+            Quat::from_rotation_z(omega * step as f32 * dt);
+        urto::step(app.world_mut(), 1).unwrap();
+    }
+    let v = app.world().get::<Velocity>(ball).unwrap().0;
+    let tip_speed = omega * 1.5;
+    assert!(
+        v.length() > tip_speed,
+        "batted at {v} (point speed {tip_speed})"
+    );
+    assert!(v.y > 0.8 * v.length(), "along the link's motion: {v}");
+}

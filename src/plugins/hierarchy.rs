@@ -43,7 +43,11 @@ impl Plugin for HierarchyPlugin {
             )
             .add_systems(
                 PhysicsSchedule,
-                (propagate_poses::<()>, refit_bounding_volumes::<()>)
+                (
+                    propagate_poses::<()>,
+                    refit_bounding_volumes::<()>,
+                    remember_part_poses.run_if(any_with_component::<ChildOf>),
+                )
                     .chain()
                     .run_if(any_with_component::<BoundingVolume>)
                     .in_set(PhysicsSet::Finish),
@@ -136,6 +140,26 @@ fn propagate_poses<F: QueryFilter + 'static>(
     stats.set_counter("hierarchy/poses", updated as f64);
     stats.add_time(Stage::BroadPhase, start.elapsed());
 }
+
+/// Keeps each hierarchy node's world pose at the end of the step, which is where the next step
+/// starts ([`StepStartPose`]), before the game moves the parts between steps. Only nodes whose
+/// pose changed during the step are copied; a new part gets one at the end of its first step (during
+/// that step its contacts treat it as still).
+fn remember_part_poses(
+    mut parts: Query<(Entity, &GlobalPose, Option<&mut StepStartPose>), PartMoved>,
+    mut commands: Commands,
+) {
+    for (e, pose, start) in &mut parts {
+        match start {
+            Some(mut start) => start.0 = pose.0,
+            None => {
+                commands.entity(e).insert(StepStartPose(pose.0));
+            }
+        }
+    }
+}
+
+type PartMoved = (InHierarchy, Changed<GlobalPose>);
 
 /// Number of ancestors of `e`.
 fn depth(e: Entity, parents: &Query<&ChildOf>) -> u32 {

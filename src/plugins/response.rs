@@ -89,6 +89,7 @@ fn resolve_contacts(
     mut bodies: Query<Movable, MovableFilter>,
     restitution: Query<&Restitution>,
     friction: Query<&Friction>,
+    poses: Query<(&GlobalPose, Option<&StepStartPose>)>,
     settings: Res<ContactSettings>,
     timestep: Res<PhysicsTimestep>,
     mut buffers: ResMut<ResponseBuffers>,
@@ -99,6 +100,7 @@ fn resolve_contacts(
         return;
     }
     let start = Instant::now();
+    let step_dt = timestep.dt();
     let b = &mut *buffers;
     b.clear();
     let e_of = |e: Entity| {
@@ -118,8 +120,11 @@ fn resolve_contacts(
             0
         };
         let key = (c.collider_a, c.collider_b, rank);
-        let (ia, ib) = (b.slot(c.a, &bodies), b.slot(c.b, &bodies));
         let m = &c.manifold;
+        let (ia, ib) = (b.slot(c.a, &bodies), b.slot(c.b, &bodies));
+        let at = m.points().iter().map(|p| p.point).sum::<Vec3>() / m.len().max(1) as f32;
+        let ia = b.moving_part_slot(ia, (c.a, c.collider_a), at, &poses, step_dt);
+        let ib = b.moving_part_slot(ib, (c.b, c.collider_b), at, &poses, step_dt);
         let mu = (mu_of(c.a).max(0.0) * mu_of(c.b).max(0.0)).sqrt();
         let e = 0.5 * (e_of(c.a) + e_of(c.b));
         let (jn, jt) = b.warm.get(&key).copied().unwrap_or_default();
@@ -194,6 +199,34 @@ impl ResponseBuffers {
         }
     }
 
+    /// The slot for a contact on `part` of `body`'s hierarchy: `slot` itself, unless the body is
+    /// immovable and the game moved the part relative to it this step (a robot's joint turned):
+    /// then a slot of its own, immovable, moving at the velocity of the contact point `at`, so
+    /// the part bats what it hits instead of only pushing it aside.
+    fn moving_part_slot(
+        &mut self,
+        slot: usize,
+        (body, part): (Entity, Entity),
+        at: Vec3,
+        poses: &Query<(&GlobalPose, Option<&StepStartPose>)>,
+        step_dt: f32,
+    ) -> usize {
+        if part == body || self.inverse_mass[slot] > 0.0 {
+            return slot;
+        }
+        let Some(v) = part_velocity(body, part, at, poses, step_dt) else {
+            return slot;
+        };
+        if v == Vec3::ZERO {
+            return slot;
+        }
+        self.entities.push(Entity::PLACEHOLDER);
+        self.positions.push(at);
+        self.velocities.push(self.velocities[slot] + v);
+        self.inverse_mass.push(0.0);
+        self.entities.len() - 1
+    }
+
     /// The solver index of `e`, adding it on first sight; statics share slot 0.
     fn slot(&mut self, e: Entity, bodies: &Query<Movable, MovableFilter>) -> usize {
         if let Some(&i) = self.index.get(&e) {
@@ -210,6 +243,28 @@ impl ResponseBuffers {
         self.inverse_mass.push(m.inverse());
         i
     }
+}
+
+/// The velocity of the point `at` of `part` relative to its root `body`, from how the part moved
+/// in the root's frame since the step began; `None` until both have a [`StepStartPose`].
+fn part_velocity(
+    body: Entity,
+    part: Entity,
+    at: Vec3,
+    poses: &Query<(&GlobalPose, Option<&StepStartPose>)>,
+    step_dt: f32,
+) -> Option<Vec3> {
+    let pose = |e: Entity| {
+        let (now, start) = poses.get(e).ok()?;
+        Some((now.0, start?.0))
+    };
+    let (root_now, root_start) = pose(body)?;
+    let (part_now, part_start) = pose(part)?;
+    let local = part_now.inverse_transform_point(at);
+    let in_root_now = root_now.inv_mul(&part_now).transform_point(local);
+    let in_root_start = root_start.inv_mul(&part_start).transform_point(local);
+    let v = root_now.transform_vector(in_root_now - in_root_start) / step_dt;
+    v.is_finite().then_some(v)
 }
 
 /// The sorted set of touching pairs at the end of the previous substep.
