@@ -9,7 +9,7 @@ mod common;
 use bevy_app::App;
 use bevy_ecs::entity::Entity;
 use glam::Vec3;
-use rerun::{ChunkStore, ChunkStoreConfig, StoreKind};
+use rerun::ChunkStore;
 use std::collections::BTreeSet;
 use urto::debug::{RerunConfig, RerunDebugPlugin};
 use urto::geometry::TriMesh;
@@ -56,17 +56,11 @@ fn recorded(config: RerunConfig) -> (ChunkStore, Vec<Vec3>, App, Entity, Vec<Ent
     app.add_plugins(RerunDebugPlugin::from_stream(rec.clone(), config));
     let (floor, bodies) = scene(&mut app);
     urto::step(app.world_mut(), STEPS).unwrap();
-    rec.flush_blocking().unwrap();
     let positions = bodies
         .iter()
         .map(|b| app.world().get::<Position>(*b).unwrap().0)
         .collect();
-    let stores = ChunkStore::from_log_msgs(&ChunkStoreConfig::ALL_DISABLED, storage.take())
-        .expect("decodable recording");
-    let store = stores
-        .into_values()
-        .find(|s| s.id().kind() == StoreKind::Recording)
-        .expect("a recording store");
+    let store = common::recording::read_back(&rec, &storage);
     (store, positions, app, floor, bodies)
 }
 

@@ -10,7 +10,7 @@ use bevy_app::App;
 use bevy_ecs::name::Name;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
-use rerun::{ChunkStore, ChunkStoreConfig, StoreKind};
+use rerun::ChunkStore;
 use std::collections::BTreeSet;
 use urto::bounding::Aabb;
 use urto::debug::{RerunConfig, RerunDebugPlugin};
@@ -124,13 +124,7 @@ fn recorded(config: RerunConfig) -> (ChunkStore, App, Scene) {
     app.add_plugins(RerunDebugPlugin::from_stream(rec.clone(), config));
     let scene = build_scene(&mut app);
     urto::step(app.world_mut(), STEPS).unwrap();
-    rec.flush_blocking().unwrap();
-    let stores = ChunkStore::from_log_msgs(&ChunkStoreConfig::ALL_DISABLED, storage.take())
-        .expect("decodable recording");
-    let store = stores
-        .into_values()
-        .find(|s| s.id().kind() == StoreKind::Recording)
-        .expect("a recording store");
+    let store = common::recording::read_back(&rec, &storage);
     (store, app, scene)
 }
 

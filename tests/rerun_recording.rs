@@ -6,7 +6,7 @@ mod common;
 
 use bevy_app::App;
 use glam::Vec3;
-use rerun::{ChunkStore, ChunkStoreConfig, StoreKind};
+use rerun::ChunkStore;
 use std::collections::BTreeSet;
 use urto::debug::{RerunConfig, RerunDebugPlugin};
 use urto::prelude::*;
@@ -41,17 +41,11 @@ fn recorded_store(every_k: u64, steps: u32) -> (ChunkStore, Vec<Vec3>) {
     app.add_plugins(RerunDebugPlugin::from_stream(rec.clone(), config));
     let balls = scene(&mut app);
     urto::step(app.world_mut(), steps).unwrap();
-    rec.flush_blocking().unwrap();
     let positions = balls
         .iter()
         .map(|b| app.world().get::<Position>(*b).unwrap().0)
         .collect();
-    let stores = ChunkStore::from_log_msgs(&ChunkStoreConfig::ALL_DISABLED, storage.take())
-        .expect("decodable recording");
-    let store = stores
-        .into_values()
-        .find(|s| s.id().kind() == StoreKind::Recording)
-        .expect("a recording store");
+    let store = common::recording::read_back(&rec, &storage);
     (store, positions)
 }
 

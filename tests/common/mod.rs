@@ -4,6 +4,8 @@
 #![allow(dead_code)]
 
 pub mod meshes;
+#[cfg(feature = "rerun")]
+pub mod recording;
 pub mod rng;
 pub mod timing;
 pub mod tri_tri_sat;
