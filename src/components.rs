@@ -51,7 +51,7 @@ pub struct Rotation(pub Quat);
 
 /// Linear velocity (m/s).
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
-#[require(Position, Rotation, Mass)]
+#[require(Position, Rotation, Mass, SleepState)]
 pub struct Velocity(pub Vec3);
 
 impl Velocity {
@@ -203,6 +203,29 @@ pub struct GlobalPose(pub Isometry);
 /// it, don't write it.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 pub struct StepStartPose(pub Isometry);
+
+/// Whether a dynamic body sleeps, with [`SleepSettings`](crate::settings::SleepSettings) on: a
+/// body slower than the settings' speed for their time falls asleep; it is then neither
+/// integrated nor tested against other sleeping or static bodies, and it wakes when something
+/// awake hits it, when the game moves it, sets its velocity or pushes it with a [`Force`], or
+/// when gravity changes.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct SleepState {
+    /// Asleep: not simulated until woken.
+    pub asleep: bool,
+    /// Seconds the body has been slower than the sleep speed (awake bodies).
+    pub still_for: f32,
+    /// Where it fell asleep: moving it elsewhere wakes it.
+    pub at: Vec3,
+}
+
+impl SleepState {
+    /// Awake, with the stillness count restarted.
+    pub fn wake(&mut self) {
+        self.asleep = false;
+        self.still_for = 0.0;
+    }
+}
 
 /// Continuous collision for a fast body: instead of testing only where the step ends (where a
 /// bullet may already be past a thin wall: tunnelling), the body's motion during the step is

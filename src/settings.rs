@@ -173,3 +173,26 @@ impl Default for ContactSettings {
         }
     }
 }
+
+/// Sleeping (off by default): bodies that stay slower than `speed` for `time` seconds stop being
+/// simulated until something wakes them (see [`SleepState`](crate::components::SleepState)). A
+/// settled pile then costs almost nothing per step.
+#[derive(Resource, Clone, Copy, Debug, PartialEq)]
+pub struct SleepSettings {
+    /// Whether bodies may fall asleep.
+    pub enabled: bool,
+    /// Speed below which a body counts as still (m/s).
+    pub speed: f32,
+    /// How long a body must stay still before it sleeps (s).
+    pub time: f32,
+}
+
+impl Default for SleepSettings {
+    fn default() -> Self {
+        Self {
+            enabled: false,
+            speed: 0.05,
+            time: 0.5,
+        }
+    }
+}

@@ -573,6 +573,19 @@ fn bench_resting(c: &mut Criterion) {
             });
             drop(app);
 
+            // urto with its (opt-in) sleeping: the balls are asleep after the settling steps.
+            let (mut app, balls) = urto_app(&scene);
+            app.insert_resource(SleepSettings {
+                enabled: true,
+                ..Default::default()
+            });
+            urto_step(&mut app, settle);
+            sanity(&name, "urto (sleeping)", &scene, settle, urto_state(&app, &balls));
+            group.bench_function(BenchmarkId::new("urto (sleeping)", n), |b| {
+                b.iter(|| urto_step(&mut app, 1))
+            });
+            drop(app);
+
             for (label, can_sleep) in RAPIER_SLEEP_VARIANTS {
                 let mut r = Rapier::new(&scene, can_sleep);
                 r.step(settle);

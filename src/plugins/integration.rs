@@ -48,7 +48,13 @@ struct IntegrationBuffers {
     scratch: IntegratorScratch,
 }
 
-type Moving<'a> = (Entity, &'a mut Position, &'a mut Velocity, &'a Mass);
+type Moving<'a> = (
+    Entity,
+    &'a mut Position,
+    &'a mut Velocity,
+    &'a Mass,
+    Option<&'a SleepState>,
+);
 type MovingFilter = (Without<Static>, Without<Quarantined>, Without<ChildOf>);
 
 fn integrate_bodies(
@@ -73,13 +79,20 @@ fn integrate_bodies(
         &b.model,
         &mut b.scratch,
     );
-    for (i, (_, mut p, mut v, _)) in queries.p0().iter_mut().enumerate() {
+    let mut bodies = queries.p0();
+    let awake = bodies.iter_mut().filter(|(.., s)| !is_asleep(*s));
+    for (i, (_, mut p, mut v, ..)) in awake.enumerate() {
         p.set_if_neq(Position(b.positions[i]));
         v.set_if_neq(Velocity(b.velocities[i]));
     }
     stats.set_counter("integrate/bodies", b.positions.len() as f64);
     stats.add_time(Stage::Integrate, start.elapsed());
     stats.count_run("integrate");
+}
+
+/// Sleeping bodies are not integrated (query order minus them = array order).
+fn is_asleep(sleep: Option<&SleepState>) -> bool {
+    sleep.is_some_and(|s| s.asleep)
 }
 
 /// Copies the moving bodies into the flat arrays and the model (query order = array order).
@@ -94,7 +107,8 @@ fn gather_state(
     b.model.gravity = gathered.gravity;
     let needs_index = !gathered.only_gravity();
     b.index.clear();
-    for (i, (entity, p, v, m)) in bodies.iter().enumerate() {
+    let awake = bodies.iter().filter(|(.., s)| !is_asleep(*s));
+    for (i, (entity, p, v, m, _)) in awake.enumerate() {
         b.positions.push(p.0);
         b.velocities.push(v.0);
         b.model.inverse_mass.push(m.inverse());

@@ -21,6 +21,7 @@ pub mod integration;
 pub mod narrow_phase;
 mod proxy_table;
 pub mod response;
+pub mod sleep;
 pub mod transform_sync;
 pub mod validation;
 
@@ -32,6 +33,7 @@ pub use hierarchy::HierarchyPlugin;
 pub use integration::IntegrationPlugin;
 pub use narrow_phase::{ContactPair, Contacts, NarrowPhasePlugin};
 pub use response::{CollisionEnded, CollisionStarted, ResponsePlugin};
+pub use sleep::SleepPlugin;
 pub use transform_sync::TransformSyncPlugin;
 pub use validation::ValidationPlugin;
 
@@ -71,6 +73,7 @@ impl PluginGroup for UrtoPlugins {
             .add(CcdPlugin)
             .add(NarrowPhasePlugin)
             .add(ResponsePlugin)
+            .add(SleepPlugin)
             .add(TransformSyncPlugin)
     }
 }

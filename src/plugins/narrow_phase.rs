@@ -25,6 +25,7 @@ use crate::geometry::contacts::{ContactScratch, NO_TRIANGLE, contact_with_scratc
 use crate::geometry::{ContactManifold, Shape};
 use crate::hierarchy::{BvTree, HierarchyStats, PairScratch, descend_pairs};
 use crate::plugins::broad_phase::BroadPhasePairs;
+use crate::plugins::sleep::dormant;
 use crate::schedule::{SubstepSchedule, SubstepSet};
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
@@ -157,10 +158,14 @@ impl BvTree for EcsTree<'_, '_, '_, '_> {
     }
 }
 
+/// Whether a body is static or asleep (see [`crate::plugins::sleep`]).
+pub(crate) type Dormancy<'a> = (Has<Static>, Option<&'a SleepState>);
+
 #[allow(clippy::too_many_arguments)]
 fn compute_contacts(
     pairs: Res<BroadPhasePairs>,
     nodes: Query<Node, Without<Quarantined>>,
+    dormancy: Query<Dormancy>,
     mut contacts: ResMut<Contacts>,
     mut scratch: ResMut<NarrowPhaseScratch>,
     mut debug: ResMut<OverlappingLeaves>,
@@ -181,7 +186,11 @@ fn compute_contacts(
     let tree = EcsTree { nodes: &nodes };
     let start = Instant::now();
     contacts.pairs.clear();
+    let dormant = |e: Entity| dormant(dormancy.get(e).ok());
     for &(a, b) in &pairs.pairs {
+        if dormant(a) && dormant(b) {
+            continue; // at rest against each other: nothing to compute until one wakes
+        }
         let compound = |e: Entity| matches!(nodes.get(e), Ok((.., Some(_))));
         if !compound(a) && !compound(b) {
             scratch.test_leaves(&nodes, (a, b), (a, b), &mut contacts, &mut debug);

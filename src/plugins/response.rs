@@ -7,8 +7,9 @@ use crate::dynamics::response::{
     ContactConstraint, SupportGraph, correct_positions, resting_displacements, solve_velocities,
 };
 use crate::plugins::narrow_phase::{ContactPair, Contacts};
+use crate::plugins::sleep::dormant;
 use crate::schedule::{SubstepSchedule, SubstepSet};
-use crate::settings::{ContactSettings, PhysicsTimestep};
+use crate::settings::{ContactSettings, PhysicsTimestep, SleepSettings};
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
 use bevy_ecs::entity::EntityHashMap;
@@ -80,7 +81,12 @@ struct ResponseBuffers {
 
 type ContactKey = (Entity, Entity, u16);
 
-type Movable<'a> = (&'a mut Position, &'a mut Velocity, &'a Mass);
+type Movable<'a> = (
+    &'a mut Position,
+    &'a mut Velocity,
+    &'a Mass,
+    Option<&'a mut SleepState>,
+);
 type MovableFilter = (Without<Static>, Without<Quarantined>);
 
 #[allow(clippy::too_many_arguments)]
@@ -91,6 +97,7 @@ fn resolve_contacts(
     friction: Query<&Friction>,
     poses: Query<(&GlobalPose, Option<&StepStartPose>)>,
     settings: Res<ContactSettings>,
+    sleep: Option<Res<SleepSettings>>,
     timestep: Res<PhysicsTimestep>,
     mut buffers: ResMut<ResponseBuffers>,
     mut stats: ResMut<PhysicsStats>,
@@ -162,10 +169,18 @@ fn resolve_contacts(
         &mut b.displacement,
     );
     b.remember_impulses();
+    let wake_speed = sleep.map_or(0.0, |s| s.speed);
     for i in 1..b.entities.len() {
         if b.inverse_mass[i] > 0.0
-            && let Ok((mut p, mut v, _)) = bodies.get_mut(b.entities[i])
+            && let Ok((mut p, mut v, _, state)) = bodies.get_mut(b.entities[i])
         {
+            // A sleeping body stays put unless the contact sets it moving.
+            if let Some(mut state) = state.filter(|s| s.asleep) {
+                if b.velocities[i].length() <= wake_speed {
+                    continue;
+                }
+                state.wake();
+            }
             p.set_if_neq(Position(b.positions[i]));
             v.set_if_neq(Velocity(b.velocities[i]));
         }
@@ -232,7 +247,7 @@ impl ResponseBuffers {
         if let Some(&i) = self.index.get(&e) {
             return i;
         }
-        let Ok((p, v, m)) = bodies.get(e) else {
+        let Ok((p, v, m, _)) = bodies.get(e) else {
             return 0;
         };
         let i = self.entities.len();
@@ -271,27 +286,54 @@ fn part_velocity(
 #[derive(Resource, Default)]
 struct TouchingPairs(Vec<(Entity, Entity)>);
 
+/// Compares this substep's touching pairs with the last one's. Pairs of sleeping or static
+/// bodies were not tested (nothing moved) and still touch; when a pair ends, a sleeping body in
+/// it wakes (what it rested on moved away or vanished).
 fn report_collisions(
     contacts: Res<Contacts>,
     mut touching: ResMut<TouchingPairs>,
+    mut bodies: Query<(Has<Static>, Option<&mut SleepState>)>,
+    mut fresh: Local<Vec<(Entity, Entity)>>,
+    mut kept: Local<Vec<(Entity, Entity)>>,
     mut started: MessageWriter<CollisionStarted>,
     mut ended: MessageWriter<CollisionEnded>,
 ) {
-    let mut now: Vec<(Entity, Entity)> = contacts
-        .pairs
-        .iter()
-        .map(|c| (c.a.min(c.b), c.a.max(c.b)))
-        .collect();
-    now.sort_unstable();
-    now.dedup();
-    let before = &touching.0;
-    for &(a, b) in now.iter().filter(|p| before.binary_search(p).is_err()) {
-        started.write(CollisionStarted { a, b });
-    }
-    for &(a, b) in before.iter().filter(|p| now.binary_search(p).is_err()) {
+    fresh.clear();
+    fresh.extend(contacts.pairs.iter().map(|c| (c.a.min(c.b), c.a.max(c.b))));
+    fresh.sort_unstable();
+    fresh.dedup();
+    // Each pair touching before is touching still, kept (asleep or static on both sides: not
+    // tested, nothing moved), or ended. Both lists are sorted, and so is their merge.
+    kept.clear();
+    for &(a, b) in &touching.0 {
+        if fresh.binary_search(&(a, b)).is_ok() {
+            continue;
+        }
+        if dormant(bodies.get(a).ok()) && dormant(bodies.get(b).ok()) {
+            kept.push((a, b));
+            continue;
+        }
         ended.write(CollisionEnded { a, b });
+        for e in [a, b] {
+            if let Ok((_, Some(mut s))) = bodies.get_mut(e)
+                && s.asleep
+            {
+                s.wake();
+            }
+        }
     }
-    touching.0 = now;
+    for &(a, b) in fresh.iter() {
+        if touching.0.binary_search(&(a, b)).is_err() {
+            started.write(CollisionStarted { a, b });
+        }
+    }
+    let now = &mut touching.0;
+    now.clear();
+    now.extend_from_slice(&fresh);
+    now.extend_from_slice(&kept);
+    if !kept.is_empty() && !fresh.is_empty() {
+        now.sort_unstable();
+    }
 }
 
 /// Advances the collision message buffers once per standalone step (an `App` does this itself

@@ -1,0 +1,109 @@
+//! Sleeping: bodies that have come to rest stop costing time until something wakes them (the
+//! usual engine technique; Box2D and rapier do the same with islands).
+//!
+//! At the end of each step a dynamic body slower than [`SleepSettings::speed`] for
+//! [`SleepSettings::time`] falls asleep: its velocity becomes exactly zero, integration skips
+//! it, and the narrow phase skips its pairs with static and other sleeping bodies (their contact
+//! is kept for the collision messages). It wakes when an awake body's contact moves it faster
+//! than the sleep speed (see the response), when game code moves it, sets its velocity or
+//! pushes it with a [`Force`], when gravity changes, or when a body it touched disappears.
+//! Without islands a body sleeps on its own stillness alone, which is enough for piles and
+//! stacks: a body kept moving by its neighbours never stays still long enough.
+
+use crate::components::*;
+use crate::plugins::core::PrepareStart;
+use crate::schedule::{PhysicsSchedule, PhysicsSet};
+use crate::settings::{Gravity, PhysicsTimestep, SleepSettings};
+use bevy_app::prelude::*;
+use bevy_ecs::prelude::*;
+use glam::Vec3;
+
+/// Puts still bodies to sleep and wakes them when game code touches them.
+#[derive(Debug, Clone, Default)]
+pub struct SleepPlugin;
+
+impl Plugin for SleepPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<SleepSettings>()
+            .add_systems(
+                PhysicsSchedule,
+                wake_on_game_changes
+                    .run_if(sleep_enabled)
+                    .in_set(PrepareStart),
+            )
+            .add_systems(
+                PhysicsSchedule,
+                fall_asleep.run_if(sleep_enabled).in_set(PhysicsSet::Finish),
+            );
+    }
+}
+
+fn sleep_enabled(settings: Res<SleepSettings>) -> bool {
+    settings.enabled
+}
+
+/// Whether `e` takes part in no simulation this substep: static scenery or a sleeping body.
+pub(crate) fn dormant(state: Option<(bool, Option<&SleepState>)>) -> bool {
+    match state {
+        Some((is_static, sleep)) => is_static || sleep.is_some_and(|s| s.asleep),
+        None => false,
+    }
+}
+
+type Sleeper<'a> = (
+    &'a mut SleepState,
+    &'a Position,
+    &'a Velocity,
+    Option<&'a Force>,
+);
+
+/// Wakes sleeping bodies that game code moved, set moving or pushed since the last step, and
+/// every body when gravity changed.
+fn wake_on_game_changes(mut bodies: Query<Sleeper>, gravity: Option<Res<Gravity>>) {
+    let gravity_changed = gravity.is_some_and(|g| g.is_changed());
+    for (mut sleep, p, v, force) in &mut bodies {
+        if !sleep.asleep {
+            continue;
+        }
+        let pushed = force.is_some_and(|f| f.0 != Vec3::ZERO);
+        if gravity_changed || pushed || v.0 != Vec3::ZERO || p.0 != sleep.at {
+            sleep.wake();
+        }
+    }
+}
+
+type Candidate<'a> = (&'a mut SleepState, &'a Position, &'a mut Velocity, &'a Mass);
+type CandidateFilter = (
+    Without<Static>,
+    Without<Quarantined>,
+    Without<ChildOf>,
+    Without<Spring>,
+);
+
+/// Counts how long each awake dynamic body has been still, and puts it to sleep after
+/// [`SleepSettings::time`] with its velocity set to exactly zero.
+fn fall_asleep(
+    mut bodies: Query<Candidate, CandidateFilter>,
+    settings: Res<SleepSettings>,
+    timestep: Res<PhysicsTimestep>,
+) {
+    let dt = timestep.dt();
+    for (mut sleep, p, mut v, m) in &mut bodies {
+        if sleep.asleep || m.inverse() == 0.0 {
+            continue;
+        }
+        if v.0.length() >= settings.speed {
+            if sleep.still_for != 0.0 {
+                sleep.still_for = 0.0;
+            }
+            continue;
+        }
+        sleep.still_for += dt;
+        if sleep.still_for >= settings.time {
+            sleep.asleep = true;
+            sleep.at = p.0;
+            // Not a change by game code: the wake-up check compares values, not change ticks.
+            v.bypass_change_detection().0 = Vec3::ZERO;
+        }
+    }
+}
