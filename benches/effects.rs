@@ -57,6 +57,12 @@ fn scene(n: usize, e: Effects) -> App {
         auto_speed_ratio: None,
         ..Default::default()
     });
+    // Every row measures the work of its effects; asleep, resting bodies would do none (the
+    // peers bench measures sleeping).
+    app.insert_resource(SleepSettings {
+        enabled: false,
+        ..Default::default()
+    });
     if e >= Effects::Gravity {
         app.insert_resource(Gravity::EARTH_Z_UP);
     }

@@ -14,8 +14,8 @@
 //! unbounded, so both engines pair every ball with every plane) and `slabs` (a 1 m thick box
 //! behind each face: urto `Collider::cuboid`, rapier `SharedShape::cuboid`).
 //! - `resting_*`: N = 1,000 and 10,000 balls on a ground, apart on a grid; time per step after
-//!   120 settling steps. Rapier twice: with its default sleeping (the bodies are asleep by then)
-//!   and with `can_sleep(false)` (the work urto does: urto has no sleeping).
+//!   120 settling steps. Each engine twice: with its default sleeping (the bodies are asleep by
+//!   then) and without (urto `SleepSettings { enabled: false, .. }`, rapier `can_sleep(false)`).
 //! - `falling_pile_*`: 1,000 balls dropped in a grid, with small random horizontal velocities,
 //!   into an open box (a ground and four walls); one criterion iteration is the first 300 steps
 //!   of a fresh scene (the build is not timed), so divide by 300 for a step. Rapier with and
@@ -326,7 +326,11 @@ fn urto_state(app: &App, balls: &[bevy_ecs::entity::Entity]) -> (Vec<Ball>, usiz
             vel: world.get::<Velocity>(e).expect("ball").0,
         })
         .collect();
-    (state, world.resource::<Contacts>().pairs.len(), 0)
+    let sleeping = balls
+        .iter()
+        .filter(|&&e| world.get::<SleepState>(e).is_some_and(|s| s.asleep))
+        .count();
+    (state, world.resource::<Contacts>().pairs.len(), sleeping)
 }
 
 /// Steps `n` times and returns urto's own per-stage times averaged over those steps (µs), for
@@ -563,25 +567,32 @@ fn bench_resting(c: &mut Criterion) {
                 .sample_size(if n > 1000 { 10 } else { 30 })
                 .throughput(Throughput::Elements(n as u64));
 
+            // urto with its default sleeping: the balls are asleep after the settling steps.
             let (mut app, balls) = urto_app(&scene);
-            urto_step(&mut app, settle - 60);
-            let stages = urto_step_staged(&mut app, 60);
+            urto_step(&mut app, settle);
             sanity(&name, "urto", &scene, settle, urto_state(&app, &balls));
-            eprintln!("[urto stages] µs per step, mean of the last 60: {stages}");
             group.bench_function(BenchmarkId::new("urto", n), |b| {
                 b.iter(|| urto_step(&mut app, 1))
             });
             drop(app);
 
-            // urto with its (opt-in) sleeping: the balls are asleep after the settling steps.
+            // urto with sleeping off: the work of every step.
             let (mut app, balls) = urto_app(&scene);
             app.insert_resource(SleepSettings {
-                enabled: true,
+                enabled: false,
                 ..Default::default()
             });
-            urto_step(&mut app, settle);
-            sanity(&name, "urto (sleeping)", &scene, settle, urto_state(&app, &balls));
-            group.bench_function(BenchmarkId::new("urto (sleeping)", n), |b| {
+            urto_step(&mut app, settle - 60);
+            let stages = urto_step_staged(&mut app, 60);
+            sanity(
+                &name,
+                "urto (no sleep)",
+                &scene,
+                settle,
+                urto_state(&app, &balls),
+            );
+            eprintln!("[urto stages] µs per step, mean of the last 60: {stages}");
+            group.bench_function(BenchmarkId::new("urto (no sleep)", n), |b| {
                 b.iter(|| urto_step(&mut app, 1))
             });
             drop(app);
