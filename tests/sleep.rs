@@ -68,16 +68,12 @@ fn resting_balls_fall_asleep_and_cost_nothing() {
     assert_eq!(ended, 0, "falling asleep ends no collision");
 }
 
-/// Sleeping is on by default, and with `SleepSettings::enabled` off nothing sleeps.
+/// Sleeping is opt-in: by default nothing sleeps.
 #[test]
-fn sleeping_is_on_by_default_and_can_be_switched_off() {
-    assert!(SleepSettings::default().enabled);
+fn sleeping_is_off_by_default() {
+    assert!(!SleepSettings::default().enabled);
     let mut app = common::app();
-    app.insert_resource(Gravity::EARTH_Z_UP)
-        .insert_resource(SleepSettings {
-            enabled: false,
-            ..Default::default()
-        });
+    app.insert_resource(Gravity::EARTH_Z_UP);
     app.world_mut()
         .spawn((Collider::half_space(Vec3::Z), Static));
     let b = ball(&mut app, Vec3::new(0.0, 0.0, 0.6));

@@ -27,6 +27,7 @@ use crate::hierarchy::{BvTree, HierarchyStats, PairScratch, descend_pairs};
 use crate::plugins::broad_phase::BroadPhasePairs;
 use crate::plugins::sleep::dormant;
 use crate::schedule::{SubstepSchedule, SubstepSet};
+use crate::settings::SleepSettings;
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
@@ -166,6 +167,7 @@ fn compute_contacts(
     pairs: Res<BroadPhasePairs>,
     nodes: Query<Node, Without<Quarantined>>,
     dormancy: Query<Dormancy>,
+    sleep: Option<Res<SleepSettings>>,
     mut contacts: ResMut<Contacts>,
     mut scratch: ResMut<NarrowPhaseScratch>,
     mut debug: ResMut<OverlappingLeaves>,
@@ -186,9 +188,10 @@ fn compute_contacts(
     let tree = EcsTree { nodes: &nodes };
     let start = Instant::now();
     contacts.pairs.clear();
+    let sleeping = sleep.is_some_and(|s| s.enabled);
     let dormant = |e: Entity| dormant(dormancy.get(e).ok());
     for &(a, b) in &pairs.pairs {
-        if dormant(a) && dormant(b) {
+        if sleeping && dormant(a) && dormant(b) {
             continue; // at rest against each other: nothing to compute until one wakes
         }
         let compound = |e: Entity| matches!(nodes.get(e), Ok((.., Some(_))));

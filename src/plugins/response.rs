@@ -61,6 +61,8 @@ impl Plugin for ResponsePlugin {
 #[derive(Resource, Default)]
 struct ResponseBuffers {
     index: EntityHashMap<usize>,
+    /// Sleeping bodies an awake body approaches fast enough to wake them this substep.
+    waking: Vec<Entity>,
     entities: Vec<Entity>,
     positions: Vec<Vec3>,
     velocities: Vec<Vec3>,
@@ -116,6 +118,10 @@ fn resolve_contacts(
             .map_or(settings.default_restitution, |r| r.0)
     };
     let mu_of = |e: Entity| friction.get(e).map_or(settings.default_friction, |f| f.0);
+    b.waking.clear();
+    if let Some(sleep) = sleep.filter(|s| s.enabled) {
+        b.find_waking(&contacts.pairs, &bodies, sleep.speed);
+    }
     let mut rank = 0u16;
     for (i, c) in contacts.pairs.iter().enumerate() {
         // The k-th manifold of a pair in this list is the same contact as last substep's k-th.
@@ -169,17 +175,12 @@ fn resolve_contacts(
         &mut b.displacement,
     );
     b.remember_impulses();
-    let wake_speed = sleep.map_or(0.0, |s| s.speed);
     for i in 1..b.entities.len() {
         if b.inverse_mass[i] > 0.0
             && let Ok((mut p, mut v, _, state)) = bodies.get_mut(b.entities[i])
         {
-            // A sleeping body stays put unless the contact sets it moving.
             if let Some(mut state) = state.filter(|s| s.asleep) {
-                if b.velocities[i].length() <= wake_speed {
-                    continue;
-                }
-                state.wake();
+                state.wake(); // one of `waking`: the others were held immovable
             }
             p.set_if_neq(Position(b.positions[i]));
             v.set_if_neq(Velocity(b.velocities[i]));
@@ -242,20 +243,56 @@ impl ResponseBuffers {
         self.entities.len() - 1
     }
 
+    /// The sleeping bodies of `contacts` that an awake body approaches faster than `wake_speed`
+    /// (gravity's pull on a body resting on a sleeper counts: a stack sleeps as a whole, as with
+    /// islands). The others are held immovable, so a pile's awake bodies rest on its sleeping
+    /// ones as on the ground.
+    fn find_waking(
+        &mut self,
+        contacts: &[ContactPair],
+        bodies: &Query<Movable, MovableFilter>,
+        wake_speed: f32,
+    ) {
+        let state = |e: Entity| {
+            bodies
+                .get(e)
+                .ok()
+                .map(|(_, v, m, s)| (v.0, m.inverse() > 0.0, s.is_some_and(|s| s.asleep)))
+        };
+        for c in contacts {
+            let (Some(a), Some(b)) = (state(c.a), state(c.b)) else {
+                continue;
+            };
+            // The normal points from a to b. A kinematic body (its parts may move on their own)
+            // always wakes what it touches; a dynamic one when it approaches fast enough.
+            let n = c.manifold.normal;
+            if a.2 && !b.2 && (!b.1 || -b.0.dot(n) > wake_speed) {
+                self.waking.push(c.a);
+            }
+            if b.2 && !a.2 && (!a.1 || a.0.dot(n) > wake_speed) {
+                self.waking.push(c.b);
+            }
+        }
+        self.waking.sort_unstable();
+        self.waking.dedup();
+    }
+
     /// The solver index of `e`, adding it on first sight; statics share slot 0.
     fn slot(&mut self, e: Entity, bodies: &Query<Movable, MovableFilter>) -> usize {
         if let Some(&i) = self.index.get(&e) {
             return i;
         }
-        let Ok((p, v, m, _)) = bodies.get(e) else {
+        let Ok((p, v, m, sleep)) = bodies.get(e) else {
             return 0;
         };
+        // A sleeping body holds still like scenery unless it is being woken.
+        let held = sleep.is_some_and(|s| s.asleep) && self.waking.binary_search(&e).is_err();
         let i = self.entities.len();
         self.index.insert(e, i);
         self.entities.push(e);
         self.positions.push(p.0);
         self.velocities.push(v.0);
-        self.inverse_mass.push(m.inverse());
+        self.inverse_mass.push(if held { 0.0 } else { m.inverse() });
         i
     }
 }
