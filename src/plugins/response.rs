@@ -6,6 +6,7 @@ use crate::components::*;
 use crate::dynamics::response::{
     ContactConstraint, SupportGraph, correct_positions, resting_displacements, solve_velocities,
 };
+use crate::geometry::ContactManifold;
 use crate::plugins::narrow_phase::{ContactPair, Contacts};
 use crate::plugins::sleep::dormant;
 use crate::schedule::{SubstepSchedule, SubstepSet};
@@ -135,9 +136,8 @@ fn resolve_contacts(
         let key = (c.collider_a, c.collider_b, rank);
         let m = &c.manifold;
         let (ia, ib) = (b.slot(c.a, &bodies), b.slot(c.b, &bodies));
-        let at = m.points().iter().map(|p| p.point).sum::<Vec3>() / m.len().max(1) as f32;
-        let ia = b.moving_part_slot(ia, (c.a, c.collider_a), at, &poses, step_dt);
-        let ib = b.moving_part_slot(ib, (c.b, c.collider_b), at, &poses, step_dt);
+        let ia = b.moving_part_slot(ia, (c.a, c.collider_a), m, &poses, step_dt);
+        let ib = b.moving_part_slot(ib, (c.b, c.collider_b), m, &poses, step_dt);
         let mu = (mu_of(c.a).max(0.0) * mu_of(c.b).max(0.0)).sqrt();
         let e = 0.5 * (e_of(c.a) + e_of(c.b));
         let (jn, jt) = b.warm.get(&key).copied().unwrap_or_default();
@@ -217,19 +217,21 @@ impl ResponseBuffers {
 
     /// The slot for a contact on `part` of `body`'s hierarchy: `slot` itself, unless the body is
     /// immovable and the game moved the part relative to it this step (a robot's joint turned):
-    /// then a slot of its own, immovable, moving at the velocity of the contact point `at`, so
+    /// then a slot of its own, immovable, moving at the velocity of the manifold's centre, so
     /// the part bats what it hits instead of only pushing it aside.
     fn moving_part_slot(
         &mut self,
         slot: usize,
         (body, part): (Entity, Entity),
-        at: Vec3,
+        manifold: &ContactManifold,
         poses: &Query<(&GlobalPose, Option<&StepStartPose>)>,
         step_dt: f32,
     ) -> usize {
         if part == body || self.inverse_mass[slot] > 0.0 {
             return slot;
         }
+        let points = manifold.points();
+        let at = points.iter().map(|p| p.point).sum::<Vec3>() / points.len().max(1) as f32;
         let Some(v) = part_velocity(body, part, at, poses, step_dt) else {
             return slot;
         };

@@ -95,11 +95,7 @@ fn canonical_order(pose_a: &Isometry, a: &Cuboid, pose_b: &Isometry, b: &Cuboid)
         ]
     };
     let (ka, kb) = (key(pose_a, a), key(pose_b, b));
-    ka.iter()
-        .zip(&kb)
-        .map(|(x, y)| x.total_cmp(y))
-        .find(|o| o.is_ne())
-        .unwrap_or(Ordering::Equal)
+    super::total_order(&ka, &kb)
 }
 
 /// A box seen from A's frame: centre, axes as the columns of `axes`, half extents.

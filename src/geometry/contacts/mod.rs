@@ -79,6 +79,17 @@ use glam::Vec3;
 /// every run.
 pub const FALLBACK_NORMAL: Vec3 = Vec3::Z;
 
+/// Lexicographic total order of two equally long float keys (a shape's size and pose): pair
+/// queries use it to pick one argument order for a symmetric pair, so swapping the arguments
+/// gives the same contact.
+pub(crate) fn total_order(a: &[f32], b: &[f32]) -> std::cmp::Ordering {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| x.total_cmp(y))
+        .find(|o| o.is_ne())
+        .unwrap_or(std::cmp::Ordering::Equal)
+}
+
 /// Tie-break between two candidate normals of *equal* depth: true when the candidate whose
 /// normal has component `candidate_up` along [`FALLBACK_NORMAL`] beats the incumbent's
 /// `best_up`.

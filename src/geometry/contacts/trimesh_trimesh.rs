@@ -111,11 +111,7 @@ fn canonical_order(
         ]
     };
     let (ka, kb) = (key(pose_a, a), key(pose_b, b));
-    ka.iter()
-        .zip(&kb)
-        .map(|(x, y)| x.total_cmp(y))
-        .find(|o| o.is_ne())
-        .unwrap_or(Ordering::Equal)
+    super::total_order(&ka, &kb)
 }
 
 fn contact_in_order(
