@@ -21,7 +21,7 @@ mod kdop;
 mod obb;
 mod relative_pose;
 mod sphere;
-mod symmetric_eigen;
+pub(crate) mod symmetric_eigen;
 
 pub use aabb::Aabb;
 pub use kdop::{Kdop, Kdop14, Kdop18, Kdop26, KdopRelative};

@@ -4,6 +4,7 @@
 mod contact;
 pub mod contacts;
 mod isometry;
+mod mass_properties;
 mod mesh_collider;
 pub mod mesh_io;
 pub(crate) mod predicates;
@@ -16,6 +17,7 @@ mod weld;
 
 pub use contact::{ContactManifold, ContactPoint, MAX_MANIFOLD_POINTS};
 pub use isometry::Isometry;
+pub use mass_properties::MassProperties;
 pub use mesh_collider::{MeshCollider, MeshColliderError};
 pub use primitives_mesh::MAX_PROCEDURAL_VERTICES;
 pub use shapes::{Cuboid, HalfSpace, Shape, ShapeError, Sphere};
