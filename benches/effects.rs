@@ -6,13 +6,19 @@
 //! body, then drag, then colliders (spheres, spread out: broad phase, no contacts), then a ground
 //! (every body in contact: narrow phase and response), then continuous collision on every body.
 //!
+//! A second group, `rotation/N`, measures what turning costs on the same bodies without
+//! colliders: no rotation stage at all (the floor), rotation locked on every body, every body free to turn but none
+//! turning (what a scene that never spins pays: one look per body), and every body tumbling
+//! with and without the gyroscopic term.
+//!
 //! Sizes: `URTO_BENCH_BODIES` (default `10000`). Quick run:
 //! `URTO_BENCH_BODIES=1000 cargo bench --bench effects -- --quick`.
 
 use bevy_app::App;
+use bevy_app::PluginGroup;
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec3;
-use urto::plugins::CcdSettings;
+use urto::plugins::{CcdSettings, RotationPlugin};
 use urto::prelude::*;
 
 /// The effects, cumulative.
@@ -140,5 +146,92 @@ fn bench_effects(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, bench_effects);
+/// How the bodies of the rotation group turn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Turning {
+    PluginOff,
+    Locked,
+    FreeButStill,
+    Tumbling { gyroscopic: bool },
+}
+
+const TURNING: [(Turning, &str); 5] = [
+    (
+        Turning::PluginOff,
+        "0 no rotation stage (RotationPlugin disabled)",
+    ),
+    (Turning::Locked, "a rotation locked"),
+    (Turning::FreeButStill, "b free to turn, none turning"),
+    (
+        Turning::Tumbling { gyroscopic: false },
+        "c all tumbling, no gyroscopic term",
+    ),
+    (
+        Turning::Tumbling { gyroscopic: true },
+        "d all tumbling, gyroscopic",
+    ),
+];
+
+/// `n` bodies drifting apart (integration only), turning as `t` says.
+fn turning_scene(n: usize, t: Turning) -> App {
+    let mut app = App::new();
+    if t == Turning::PluginOff {
+        app.add_plugins(UrtoPlugins::default().build().disable::<RotationPlugin>());
+    } else {
+        app.add_plugins(UrtoPlugins::default());
+    }
+    if let Turning::Tumbling { gyroscopic } = t {
+        app.insert_resource(RotationSettings { gyroscopic });
+    }
+    for i in 0..n {
+        let mut body = app.world_mut().spawn((
+            Position(Vec3::new(i as f32 * 2.0, 0.0, 0.0)),
+            Velocity::new(0.0, 0.0, 0.1),
+            Inertia::custom(Vec3::new(1.0, 2.0, 3.0), glam::Quat::IDENTITY),
+        ));
+        match t {
+            Turning::Locked => {
+                body.insert(LockedAxes::ROTATION_LOCKED);
+            }
+            Turning::FreeButStill => {}
+            Turning::Tumbling { .. } => {
+                body.insert(AngularVelocity::new(1.0, 2.0, 0.5));
+            }
+        }
+    }
+    urto::step(app.world_mut(), 3).expect("UrtoPlugins");
+    app
+}
+
+fn bench_rotation(c: &mut Criterion) {
+    let sizes: Vec<usize> = std::env::var("URTO_BENCH_BODIES")
+        .ok()
+        .map(|s| s.split(',').filter_map(|x| x.trim().parse().ok()).collect())
+        .unwrap_or_else(|| vec![10_000]);
+    for n in sizes {
+        let mut group = c.benchmark_group(format!("rotation/{n}"));
+        group.throughput(Throughput::Elements(n as u64));
+        for (t, label) in TURNING {
+            let mut app = scene_turning_checked(n, t);
+            group.bench_function(BenchmarkId::new(label, n), |b| {
+                b.iter(|| urto::step(app.world_mut(), 1).expect("UrtoPlugins"))
+            });
+        }
+        group.finish();
+    }
+}
+
+/// The scene, with the number of bodies the rotation stage turned printed as a check.
+fn scene_turning_checked(n: usize, t: Turning) -> App {
+    let app = turning_scene(n, t);
+    let turned = app
+        .world()
+        .resource::<PhysicsStats>()
+        .counter("integrate/turning")
+        .unwrap_or(0.0);
+    eprintln!("[rotation] {n} bodies, {t:?}: {turned} turned per step");
+    app
+}
+
+criterion_group!(benches, bench_effects, bench_rotation);
 criterion_main!(benches);

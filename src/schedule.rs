@@ -8,7 +8,8 @@
 //!    force model (each only when the world has it).
 //! 3. [`PhysicsSet::Substeps`] — run [`SubstepSchedule`] `substeps` times with `dt / substeps`
 //!    (the slides' brute-force cure for late contacts and tunnelling):
-//!    1. [`SubstepSet::Integrate`] — advance positions and velocities.
+//!    1. [`SubstepSet::Integrate`] — advance positions and velocities, then orientations and
+//!       angular velocities.
 //!    2. [`SubstepSet::BroadPhase`] — propagate world poses down hierarchies, refit bounding
 //!       volumes up them (only where something moved), update the broad-phase structures, list
 //!       candidate pairs ([`BroadPhaseSystems`]).

@@ -153,6 +153,23 @@ impl Gravity {
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Integration(pub Integrator);
 
+/// How bodies turn. With `gyroscopic` on (the default) a free body keeps its angular
+/// *momentum* — a box spun about its intermediate axis flips (the Dzhanibekov effect) — and
+/// with it off it keeps its angular *velocity*, which is cheaper and is what engines that leave
+/// the term out (rapier and Jolt by default) do. The integrator is the step's [`Integration`];
+/// see [`crate::dynamics::rotation`] for how each method treats rotation.
+#[derive(Resource, Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RotationSettings {
+    /// Include the gyroscopic term `ω × Iω`.
+    pub gyroscopic: bool,
+}
+
+impl Default for RotationSettings {
+    fn default() -> Self {
+        Self { gyroscopic: true }
+    }
+}
+
 /// Contact response settings.
 #[derive(Resource, Clone, Copy, Debug, PartialEq)]
 pub struct ContactSettings {

@@ -7,7 +7,8 @@
 //! # use bevy_ecs::prelude::*;
 //! # use urto::prelude::*;
 //! # let mut world = World::new();
-//! // A dynamic ball: Velocity, Mass (1 kg), Rotation and BoundingVolume come by default.
+//! // A dynamic ball: Velocity, Mass (1 kg), Rotation, AngularVelocity, Inertia and
+//! // BoundingVolume come by default.
 //! world.spawn((Collider::sphere(0.5), Position::new(0.0, 0.0, 3.0), Velocity::default()));
 //! // Static scenery: never moves, collides as infinitely heavy.
 //! world.spawn((Collider::half_space(glam::Vec3::Z), Static));
@@ -23,6 +24,10 @@
 //! Bodies whose numbers are unusable (NaN, zero or negative mass, a bad shape) are set aside with
 //! a [`Quarantined`] marker and a logged warning: they stop taking part, and nothing they hold can
 //! spread to their neighbours.
+
+mod angular;
+
+pub use angular::{AngularDrag, AngularVelocity, ForceAtPoint, Inertia, LockedAxes, Torque};
 
 use crate::bounding::Aabb;
 use crate::geometry::{Isometry, MeshCollider, MeshColliderError, Shape, TriMesh};
@@ -43,15 +48,17 @@ impl Position {
     }
 }
 
-/// Orientation of a body's collider in its parent's frame (see [`Position`]); identity when
-/// absent. Bodies do not spin by themselves
-/// (contacts act through the centre of mass); set it to place boxes and planes.
+/// Orientation of a body in its parent's frame (see [`Position`]); identity when absent. A
+/// dynamic body turns with its [`AngularVelocity`] (and the torques that change it); set it to
+/// place boxes and planes. Contacts still act through the centre of mass: they do not yet turn
+/// bodies (the rigid-body solver of issue 10, stage 4).
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 pub struct Rotation(pub Quat);
 
-/// Linear velocity (m/s).
+/// Linear velocity of the centre of mass (m/s). Brings what a dynamic body needs, including an
+/// [`AngularVelocity`] and a computed [`Inertia`]: dynamic bodies turn by default.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
-#[require(Position, Rotation, Mass, SleepState)]
+#[require(Position, Rotation, Mass, SleepState, AngularVelocity, Inertia)]
 pub struct Velocity(pub Vec3);
 
 impl Velocity {

@@ -1,8 +1,12 @@
-//! Dynamics: integrators, forces and collision response (plain Rust, no ECS).
+//! Dynamics: integrators (linear and rotational), forces and collision response (plain Rust,
+//! no ECS).
 
 pub mod forces;
+pub mod free_rotation;
 pub mod integrators;
 pub mod response;
+pub mod rotation;
 
 pub use forces::{ForceModel, Spring, SpringEnd};
 pub use integrators::{AccelerationField, Integrator, IntegratorScratch, integrate};
+pub use rotation::{AngularBody, RotationOptions, integrate_rotations};

@@ -1,4 +1,4 @@
-//! The Forces stage: gathers the step's forces, one system per kind of force, each running only
+//! The Forces stage: gathers the step's forces and torques, one system per kind of force, each running only
 //! when the world has that kind (no `Gravity` resource: no gravity system; no `Force`
 //! component anywhere: no force system). What they gather is evaluated by the integrator at every
 //! intermediate state it needs.
@@ -27,6 +27,8 @@ pub struct GatheredForces {
     pub drag: Vec<(Entity, f32)>,
     /// Springs, by the entity that carries them.
     pub springs: Vec<(Entity, Spring)>,
+    /// Torques (N·m, world axes) consumed from [`Torque`] and [`ForceAtPoint`] this step.
+    pub torques: Vec<(Entity, Vec3)>,
 }
 
 impl GatheredForces {
@@ -46,6 +48,8 @@ impl Plugin for ForcesPlugin {
                 gather_user_forces.run_if(any_with_component::<Force>),
                 gather_drag.run_if(any_with_component::<LinearDrag>),
                 gather_springs.run_if(any_with_component::<Spring>),
+                gather_torques.run_if(any_with_component::<Torque>),
+                gather_point_forces.run_if(any_with_component::<ForceAtPoint>),
             )
                 .chain()
                 .in_set(PhysicsSet::Forces),
@@ -59,6 +63,7 @@ fn clear_gathered_forces(mut gathered: ResMut<GatheredForces>) {
     g.forces.clear();
     g.drag.clear();
     g.springs.clear();
+    g.torques.clear();
 }
 
 fn gather_gravity(
@@ -109,5 +114,52 @@ fn gather_springs(
 ) {
     stats.time(Stage::Forces, "forces/springs", || {
         gathered.springs.extend(bodies.iter().map(|(e, s)| (e, *s)));
+    });
+}
+
+/// Consumes every [`Torque`], as [`gather_user_forces`] does forces.
+fn gather_torques(
+    mut bodies: Query<(Entity, &mut Torque), Without<Quarantined>>,
+    mut gathered: ResMut<GatheredForces>,
+    mut stats: ResMut<PhysicsStats>,
+) {
+    stats.time(Stage::Forces, "forces/torques", || {
+        for (entity, mut torque) in &mut bodies {
+            if torque.0 != Vec3::ZERO {
+                gathered.torques.push((entity, torque.0));
+                torque.0 = Vec3::ZERO;
+            }
+        }
+    });
+}
+
+type PointForced<'a> = (
+    Entity,
+    &'a mut ForceAtPoint,
+    &'a Position,
+    Option<&'a Rotation>,
+    Option<&'a Inertia>,
+);
+
+/// Consumes every [`ForceAtPoint`]: its sum pushes the body, its moment about the body's centre
+/// of mass (where it is at the step's start) turns it.
+fn gather_point_forces(
+    mut bodies: Query<PointForced, Without<Quarantined>>,
+    mut gathered: ResMut<GatheredForces>,
+    mut stats: ResMut<PhysicsStats>,
+) {
+    stats.time(Stage::Forces, "forces/at_point", || {
+        for (entity, mut at_point, p, r, inertia) in &mut bodies {
+            if at_point.is_empty() {
+                continue;
+            }
+            let offset = inertia.map_or(Vec3::ZERO, |i| i.local_center_of_mass);
+            let center = p.0 + r.map_or(offset, |r| r.0 * offset);
+            gathered.forces.push((entity, at_point.force()));
+            gathered
+                .torques
+                .push((entity, at_point.torque_about(center)));
+            *at_point = ForceAtPoint::default();
+        }
     });
 }

@@ -21,6 +21,7 @@ pub mod integration;
 pub mod narrow_phase;
 mod proxy_table;
 pub mod response;
+pub mod rotation;
 pub mod sleep;
 pub mod transform_sync;
 pub mod validation;
@@ -33,6 +34,7 @@ pub use hierarchy::HierarchyPlugin;
 pub use integration::IntegrationPlugin;
 pub use narrow_phase::{ContactPair, Contacts, NarrowPhasePlugin};
 pub use response::{CollisionEnded, CollisionStarted, ResponsePlugin};
+pub use rotation::RotationPlugin;
 pub use sleep::SleepPlugin;
 pub use transform_sync::TransformSyncPlugin;
 pub use validation::ValidationPlugin;
@@ -68,6 +70,7 @@ impl PluginGroup for UrtoPlugins {
             .add(ValidationPlugin)
             .add(ForcesPlugin)
             .add(IntegrationPlugin)
+            .add(RotationPlugin)
             .add(HierarchyPlugin)
             .add(BroadPhasePlugin::default())
             .add(CcdPlugin)

@@ -2,11 +2,12 @@
 //! usual engine technique; Box2D and rapier do the same with islands).
 //!
 //! At the end of each step a dynamic body slower than [`SleepSettings::speed`] for
-//! [`SleepSettings::time`] falls asleep: its velocity becomes exactly zero, integration skips
+//! [`SleepSettings::time`] (its centre, and its surface turning at `|ω|` times its reach) falls
+//! asleep: its velocity and angular velocity become exactly zero, integration skips
 //! it, and the narrow phase skips its pairs with static and other sleeping bodies (their contact
 //! is kept for the collision messages). It wakes when an awake body's contact moves it faster
 //! than the sleep speed (see the response), when game code moves it, sets its velocity or
-//! pushes it with a [`Force`], when gravity changes, or when a body it touched disappears.
+//! angular velocity or pushes it with a [`Force`], [`Torque`] or [`ForceAtPoint`], when gravity changes, or when a body it touched disappears.
 //! Without islands a body sleeps on its own stillness alone, which is enough for piles and
 //! stacks: a body kept moving by its neighbours never stays still long enough.
 
@@ -55,24 +56,37 @@ type Sleeper<'a> = (
     &'a Position,
     &'a Velocity,
     Option<&'a Force>,
+    Option<&'a AngularVelocity>,
+    Option<&'a Torque>,
+    Option<&'a ForceAtPoint>,
 );
 
 /// Wakes sleeping bodies that game code moved, set moving or pushed since the last step, and
 /// every body when gravity changed.
 fn wake_on_game_changes(mut bodies: Query<Sleeper>, gravity: Option<Res<Gravity>>) {
     let gravity_changed = gravity.is_some_and(|g| g.is_changed());
-    for (mut sleep, p, v, force) in &mut bodies {
+    for (mut sleep, p, v, force, w, torque, at_point) in &mut bodies {
         if !sleep.asleep {
             continue;
         }
-        let pushed = force.is_some_and(|f| f.0 != Vec3::ZERO);
-        if gravity_changed || pushed || v.0 != Vec3::ZERO || p.0 != sleep.at {
+        let pushed = force.is_some_and(|f| f.0 != Vec3::ZERO)
+            || torque.is_some_and(|t| t.0 != Vec3::ZERO)
+            || at_point.is_some_and(|f| !f.is_empty());
+        let spun = w.is_some_and(|w| w.0 != Vec3::ZERO);
+        if gravity_changed || pushed || spun || v.0 != Vec3::ZERO || p.0 != sleep.at {
             sleep.wake();
         }
     }
 }
 
-type Candidate<'a> = (&'a mut SleepState, &'a Position, &'a mut Velocity, &'a Mass);
+type Candidate<'a> = (
+    &'a mut SleepState,
+    &'a Position,
+    &'a mut Velocity,
+    &'a Mass,
+    Option<&'a mut AngularVelocity>,
+    &'a BoundingVolume,
+);
 type CandidateFilter = (
     Without<Static>,
     Without<Quarantined>,
@@ -88,11 +102,13 @@ fn fall_asleep(
     timestep: Res<PhysicsTimestep>,
 ) {
     let dt = timestep.dt();
-    for (mut sleep, p, mut v, m) in &mut bodies {
+    for (mut sleep, p, mut v, m, mut w, volume) in &mut bodies {
         if sleep.asleep || m.inverse() == 0.0 {
             continue;
         }
-        if v.0.length() >= settings.speed {
+        // A turning body's surface moves at up to |ω| times its reach (Box2D's sleep test).
+        let turning = w.as_ref().map_or(0.0, |w| w.0.length()) * reach(volume);
+        if v.0.length().max(turning) >= settings.speed {
             if sleep.still_for != 0.0 {
                 sleep.still_for = 0.0;
             }
@@ -104,6 +120,19 @@ fn fall_asleep(
             sleep.at = p.0;
             // Not a change by game code: the wake-up check compares values, not change ticks.
             v.bypass_change_detection().0 = Vec3::ZERO;
+            if let Some(w) = w.as_mut() {
+                w.bypass_change_detection().0 = Vec3::ZERO;
+            }
         }
+    }
+}
+
+/// Half the diagonal of a body's bounding volume (0 when it has none).
+fn reach(volume: &BoundingVolume) -> f32 {
+    let half = volume.0.half_extents();
+    if half.is_finite() && half.cmpge(Vec3::ZERO).all() {
+        half.length()
+    } else {
+        0.0
     }
 }

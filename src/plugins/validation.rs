@@ -1,6 +1,7 @@
 //! The Prepare stage: bad input is set aside before it can spread.
 //!
-//! A body whose state is unusable — a NaN or infinite position, velocity, force or rotation, a
+//! A body whose state is unusable — a NaN or infinite position, velocity, force, rotation,
+//! angular velocity or torque, a negative angular drag, an inertia that is not positive, a
 //! zero, negative or NaN mass, a shape with impossible numbers, a part of a compound body with a
 //! velocity of its own — gets a
 //! [`Quarantined`] marker and a logged warning. Every other stage filters quarantined
@@ -23,7 +24,7 @@ impl Plugin for ValidationPlugin {
     fn build(&self, app: &mut App) {
         app.add_systems(
             PhysicsSchedule,
-            quarantine_invalid_bodies.in_set(PrepareStart),
+            (quarantine_invalid_bodies, quarantine_invalid_rotation).in_set(PrepareStart),
         );
     }
 }
@@ -71,6 +72,72 @@ fn quarantine_invalid_bodies(
             }
         }
     });
+}
+
+type AngularData<'a> = (
+    Entity,
+    Option<&'a AngularVelocity>,
+    Option<&'a Torque>,
+    Option<&'a ForceAtPoint>,
+    Option<&'a AngularDrag>,
+    Option<&'a Inertia>,
+);
+
+type ChangedAngular = (
+    Without<Quarantined>,
+    Or<(
+        Changed<AngularVelocity>,
+        Changed<Torque>,
+        Changed<ForceAtPoint>,
+        Changed<AngularDrag>,
+        Changed<Inertia>,
+    )>,
+);
+
+/// The rotational state's share of the checks: finite spin and torques, a drag rate `>= 0`, a
+/// real inertia.
+fn quarantine_invalid_rotation(
+    bodies: Query<AngularData, ChangedAngular>,
+    mut stats: ResMut<PhysicsStats>,
+    mut commands: Commands,
+) {
+    stats.time(Stage::Prepare, "prepare/validate_rotation", || {
+        for (entity, w, t, at_point, drag, inertia) in &bodies {
+            if let Some(reason) = why_invalid_rotation(w, t, at_point, drag, inertia) {
+                quarantine(&mut commands, entity, reason);
+            }
+        }
+    });
+}
+
+fn why_invalid_rotation(
+    w: Option<&AngularVelocity>,
+    t: Option<&Torque>,
+    at_point: Option<&ForceAtPoint>,
+    drag: Option<&AngularDrag>,
+    inertia: Option<&Inertia>,
+) -> Option<String> {
+    let finite = |name: &str, x: Vec3| (!x.is_finite()).then(|| format!("{name} is {x}"));
+    w.and_then(|w| finite("angular velocity", w.0))
+        .or_else(|| t.and_then(|t| finite("torque", t.0)))
+        .or_else(|| {
+            at_point.and_then(|f| {
+                finite("force at a point", f.force())
+                    .or_else(|| finite("moment of a force at a point", f.torque_about(Vec3::ZERO)))
+            })
+        })
+        .or_else(|| {
+            drag.filter(|d| !(d.0.is_finite() && d.0 >= 0.0))
+                .map(|d| format!("angular drag must be finite and >= 0, got {}", d.0))
+        })
+        .or_else(|| {
+            inertia.filter(|i| !i.is_valid()).map(|i| {
+                format!(
+                    "inertia must have moments > 0 (or infinite) and a finite frame and \
+                     centre, got {i:?}"
+                )
+            })
+        })
 }
 
 /// Marks `entity` as quarantined and says why in the log.
