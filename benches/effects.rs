@@ -193,7 +193,7 @@ fn turning_scene(n: usize, t: Turning) -> App {
             Turning::Locked => {
                 body.insert(LockedAxes::ROTATION_LOCKED);
             }
-            Turning::FreeButStill => {}
+            Turning::PluginOff | Turning::FreeButStill => {}
             Turning::Tumbling { .. } => {
                 body.insert(AngularVelocity::new(1.0, 2.0, 0.5));
             }

@@ -6,6 +6,7 @@ pub mod free_rotation;
 pub mod integrators;
 pub mod response;
 pub mod rotation;
+pub mod solver;
 
 pub use forces::{ForceModel, Spring, SpringEnd};
 pub use integrators::{AccelerationField, Integrator, IntegratorScratch, integrate};

@@ -1,0 +1,178 @@
+//! Solver bodies: the dense per-body arrays the solver stages sweep (Box2D v3's `b2BodyState`
+//! and Avian's `SolverBody`). Each body sits in a stable slot given by the caller's order; the
+//! stages touch only [`BodyState`] (velocities and the motion since the step began), so the
+//! poses at the step's start stay fixed and contact anchors can be kept relative to them.
+
+use glam::{Mat3, Quat, Vec3};
+
+/// What the substeps change: velocities and the motion since the step's start.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BodyState {
+    /// Velocity of the centre of mass (m/s).
+    pub linear_velocity: Vec3,
+    /// Angular velocity in world axes (rad/s).
+    pub angular_velocity: Vec3,
+    /// How far the centre of mass moved since the step's start.
+    pub delta_position: Vec3,
+    /// How the body turned since the step's start (world frame, applied on the left).
+    pub delta_rotation: Quat,
+}
+
+impl Default for BodyState {
+    fn default() -> Self {
+        Self {
+            linear_velocity: Vec3::ZERO,
+            angular_velocity: Vec3::ZERO,
+            delta_position: Vec3::ZERO,
+            delta_rotation: Quat::IDENTITY,
+        }
+    }
+}
+
+/// What stays fixed over a step: masses, the world inverse inertia at the step's start, and the
+/// accelerations of the step's external forces.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BodyParams {
+    /// `1/m`; 0 for static and kinematic bodies.
+    pub inverse_mass: f32,
+    /// World inverse inertia `R I⁻¹ Rᵀ` at the step's start, locked axes zeroed.
+    pub inverse_inertia: Mat3,
+    /// Gravity plus force over mass (m/s²).
+    pub linear_acceleration: Vec3,
+    /// `I⁻¹ τ` (rad/s²).
+    pub angular_acceleration: Vec3,
+    /// Linear damping rate (1/s).
+    pub linear_damping: f32,
+    /// Angular damping rate (1/s).
+    pub angular_damping: f32,
+    /// True for bodies the solver may move (dynamic); kinematic and static bodies keep their
+    /// velocities.
+    pub dynamic: bool,
+}
+
+/// One body as the caller describes it at the step's start.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BodyInput {
+    /// World position of the centre of mass.
+    pub center: Vec3,
+    /// World orientation.
+    pub orientation: Quat,
+    /// Velocity of the centre of mass.
+    pub linear_velocity: Vec3,
+    /// Angular velocity in world axes.
+    pub angular_velocity: Vec3,
+    /// `1/m` (0: immovable).
+    pub inverse_mass: f32,
+    /// `1/I` per principal axis (0: infinite about it).
+    pub inverse_principal_inertia: Vec3,
+    /// Rotation from principal axes to the body frame.
+    pub inertia_frame: Quat,
+    /// Gravity plus force over mass.
+    pub linear_acceleration: Vec3,
+    /// Torque (N·m, world).
+    pub torque: Vec3,
+    /// Linear damping rate (1/s).
+    pub linear_damping: f32,
+    /// Angular damping rate (1/s).
+    pub angular_damping: f32,
+    /// 1 per world axis the body may turn about, 0 where locked.
+    pub free_axes: Vec3,
+}
+
+impl Default for BodyInput {
+    /// A static body at the origin.
+    fn default() -> Self {
+        Self {
+            center: Vec3::ZERO,
+            orientation: Quat::IDENTITY,
+            linear_velocity: Vec3::ZERO,
+            angular_velocity: Vec3::ZERO,
+            inverse_mass: 0.0,
+            inverse_principal_inertia: Vec3::ZERO,
+            inertia_frame: Quat::IDENTITY,
+            linear_acceleration: Vec3::ZERO,
+            torque: Vec3::ZERO,
+            linear_damping: 0.0,
+            angular_damping: 0.0,
+            free_axes: Vec3::ONE,
+        }
+    }
+}
+
+/// The solver's bodies, one slot each, in the caller's (stable) order.
+#[derive(Clone, Debug, Default)]
+pub struct SolverBodies {
+    /// Per-substep state.
+    pub states: Vec<BodyState>,
+    /// Per-step parameters.
+    pub params: Vec<BodyParams>,
+    /// Centres of mass at the step's start.
+    pub centers: Vec<Vec3>,
+    /// Orientations at the step's start.
+    pub orientations: Vec<Quat>,
+}
+
+impl SolverBodies {
+    /// Empties the arrays (keeping their memory).
+    pub fn clear(&mut self) {
+        self.states.clear();
+        self.params.clear();
+        self.centers.clear();
+        self.orientations.clear();
+    }
+
+    /// Number of bodies.
+    pub fn len(&self) -> usize {
+        self.states.len()
+    }
+
+    /// True when there is none.
+    pub fn is_empty(&self) -> bool {
+        self.states.is_empty()
+    }
+
+    /// Adds a body; returns its slot.
+    pub fn push(&mut self, b: BodyInput) -> u32 {
+        let slot = self.states.len() as u32;
+        let r = Mat3::from_quat(b.orientation * b.inertia_frame);
+        let lock = Mat3::from_diagonal(b.free_axes);
+        let inverse_inertia =
+            lock * r * Mat3::from_diagonal(b.inverse_principal_inertia) * r.transpose() * lock;
+        let dynamic = b.inverse_mass > 0.0;
+        self.states.push(BodyState {
+            linear_velocity: b.linear_velocity,
+            angular_velocity: b.angular_velocity * b.free_axes,
+            ..Default::default()
+        });
+        self.params.push(BodyParams {
+            inverse_mass: b.inverse_mass,
+            inverse_inertia: if dynamic { inverse_inertia } else { Mat3::ZERO },
+            linear_acceleration: if dynamic {
+                b.linear_acceleration
+            } else {
+                Vec3::ZERO
+            },
+            angular_acceleration: if dynamic {
+                inverse_inertia * b.torque
+            } else {
+                Vec3::ZERO
+            },
+            linear_damping: b.linear_damping,
+            angular_damping: b.angular_damping,
+            dynamic,
+        });
+        self.centers.push(b.center);
+        self.orientations.push(b.orientation);
+        slot
+    }
+
+    /// Where body `i`'s centre of mass is now.
+    pub fn center(&self, i: usize) -> Vec3 {
+        self.centers[i] + self.states[i].delta_position
+    }
+
+    /// Body `i`'s orientation now.
+    pub fn orientation(&self, i: usize) -> Quat {
+        (self.states[i].delta_rotation * self.orientations[i]).normalize()
+    }
+}

@@ -1,0 +1,125 @@
+//! Impulses kept from one step to the next (warm starting across steps; Catto, GDC 2005 and
+//! Box2D v3's `b2StoreImpulses`).
+//!
+//! A resting stack needs the same impulses every step; starting each step from zero would make
+//! the substeps rebuild the support of every box from scratch. The impulses of each contact are
+//! kept under the caller's pair key, in key order (a merge, never a hash: the same input gives
+//! the same result on every run), with each point's anchor in A's body frame. A new point takes
+//! the impulses of the nearest old point of the same pair within `match_distance` — the
+//! persistent-manifold rule of Bullet — since the shape tests here report no feature ids; the
+//! friction impulse is kept as a world vector and projected on the new tangents.
+
+use super::contact::ContactConstraint;
+use crate::geometry::MAX_MANIFOLD_POINTS;
+use glam::{Quat, Vec3};
+
+/// One point's impulses.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct StoredPoint {
+    /// Anchor in A's body frame.
+    local_anchor: Vec3,
+    normal_impulse: f32,
+    friction_impulse: Vec3,
+}
+
+/// One contact's impulses.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct StoredContact {
+    key: u64,
+    points: [StoredPoint; MAX_MANIFOLD_POINTS],
+    count: u8,
+}
+
+/// The impulses of the last step, by pair key.
+#[derive(Clone, Debug, Default)]
+pub struct WarmStartCache {
+    contacts: Vec<StoredContact>,
+    /// Substep length they were computed with (impulses scale with it).
+    h: f32,
+}
+
+impl WarmStartCache {
+    /// Number of contacts remembered.
+    pub fn len(&self) -> usize {
+        self.contacts.len()
+    }
+
+    /// True when nothing is remembered.
+    pub fn is_empty(&self) -> bool {
+        self.contacts.is_empty()
+    }
+
+    /// Forgets everything.
+    pub fn clear(&mut self) {
+        self.contacts.clear();
+    }
+
+    /// Seeds `constraints` (sorted by key) with the remembered impulses; `orientation_a` gives
+    /// each constraint's body A orientation at the step's start.
+    pub fn seed(
+        &self,
+        constraints: &mut [ContactConstraint],
+        orientation_a: impl Fn(u32) -> Quat,
+        h: f32,
+        match_distance: f32,
+    ) {
+        if self.contacts.is_empty() || self.h <= 0.0 {
+            return;
+        }
+        let scale = h / self.h;
+        let mut cursor = 0;
+        for c in constraints.iter_mut() {
+            while cursor < self.contacts.len() && self.contacts[cursor].key < c.key {
+                cursor += 1;
+            }
+            let Some(old) = self.contacts.get(cursor).filter(|o| o.key == c.key) else {
+                continue;
+            };
+            let to_local = orientation_a(c.a).inverse();
+            let old_points = &old.points[..old.count as usize];
+            let (normal, tangents) = (c.normal, c.tangents);
+            for cp in &mut c.points[..c.count as usize] {
+                let local = to_local * cp.anchor_a;
+                let nearest = old_points
+                    .iter()
+                    .map(|p| (p.local_anchor.distance_squared(local), p))
+                    .min_by(|x, y| x.0.total_cmp(&y.0));
+                let close = nearest.filter(|(d2, _)| *d2 <= match_distance * match_distance);
+                if let Some((_, p)) = close {
+                    cp.normal_impulse = p.normal_impulse.max(0.0) * scale;
+                    cp.max_normal_impulse = cp.normal_impulse;
+                    let f = p.friction_impulse - normal * p.friction_impulse.dot(normal);
+                    cp.tangent_impulse = tangents.map(|t| f.dot(t) * scale);
+                }
+            }
+        }
+    }
+
+    /// Remembers the impulses of `constraints` (sorted by key), replacing the last step's.
+    pub fn store(
+        &mut self,
+        constraints: &[ContactConstraint],
+        orientation_a: impl Fn(u32) -> Quat,
+        h: f32,
+    ) {
+        self.contacts.clear();
+        self.h = h;
+        for c in constraints {
+            let to_local = orientation_a(c.a).inverse();
+            let mut points = [StoredPoint::default(); MAX_MANIFOLD_POINTS];
+            for (stored, cp) in points.iter_mut().zip(c.points()) {
+                *stored = StoredPoint {
+                    local_anchor: to_local * cp.anchor_a,
+                    normal_impulse: cp.normal_impulse,
+                    friction_impulse: c.tangents[0] * cp.tangent_impulse[0]
+                        + c.tangents[1] * cp.tangent_impulse[1],
+                };
+            }
+            self.contacts.push(StoredContact {
+                key: c.key,
+                points,
+                count: c.count,
+            });
+        }
+    }
+}
