@@ -8,6 +8,7 @@ use crate::components::*;
 use crate::dynamics::forces::Spring as CoreSpring;
 use crate::dynamics::{ForceModel, IntegratorScratch, SpringEnd, integrate};
 use crate::plugins::forces::GatheredForces;
+use crate::plugins::soft_step::legacy_solver;
 use crate::schedule::{SubstepSchedule, SubstepSet};
 use crate::settings::{Integration, PhysicsTimestep};
 use crate::stats::{PhysicsStats, Stage};
@@ -27,6 +28,7 @@ impl Plugin for IntegrationPlugin {
             SubstepSchedule,
             integrate_bodies
                 .run_if(any_with_component::<Velocity>)
+                .run_if(legacy_solver)
                 .in_set(IntegrateBodies)
                 .in_set(SubstepSet::Integrate),
         );

@@ -23,6 +23,7 @@ mod proxy_table;
 pub mod response;
 pub mod rotation;
 pub mod sleep;
+pub mod soft_step;
 pub mod transform_sync;
 pub mod validation;
 
@@ -36,6 +37,7 @@ pub use narrow_phase::{ContactPair, Contacts, NarrowPhasePlugin};
 pub use response::{CollisionEnded, CollisionStarted, ResponsePlugin};
 pub use rotation::RotationPlugin;
 pub use sleep::SleepPlugin;
+pub use soft_step::{SoftStepPlugin, SoftStepSolver};
 pub use transform_sync::TransformSyncPlugin;
 pub use validation::ValidationPlugin;
 

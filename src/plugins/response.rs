@@ -9,6 +9,7 @@ use crate::dynamics::response::{
 use crate::geometry::ContactManifold;
 use crate::plugins::narrow_phase::{ContactPair, Contacts};
 use crate::plugins::sleep::dormant;
+use crate::plugins::soft_step::legacy_solver;
 use crate::schedule::{SubstepSchedule, SubstepSet};
 use crate::settings::{ContactSettings, PhysicsTimestep, SleepSettings};
 use crate::stats::{PhysicsStats, Stage};
@@ -50,7 +51,7 @@ impl Plugin for ResponsePlugin {
             .add_message::<CollisionEnded>()
             .add_systems(
                 SubstepSchedule,
-                (resolve_contacts, report_collisions)
+                (resolve_contacts.run_if(legacy_solver), report_collisions)
                     .chain()
                     .run_if(any_with_component::<Collider>)
                     .in_set(SubstepSet::Response),

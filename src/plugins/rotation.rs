@@ -19,6 +19,7 @@ use crate::geometry::{Isometry, MassProperties};
 use crate::plugins::core::PrepareIndex;
 use crate::plugins::forces::GatheredForces;
 use crate::plugins::integration::IntegrateBodies;
+use crate::plugins::soft_step::legacy_solver;
 use crate::schedule::{PhysicsSchedule, SubstepSchedule, SubstepSet};
 use crate::settings::{Integration, PhysicsTimestep, RotationSettings};
 use crate::stats::{PhysicsStats, Stage};
@@ -46,6 +47,7 @@ impl Plugin for RotationPlugin {
                 SubstepSchedule,
                 integrate_turning_bodies
                     .run_if(any_with_component::<AngularVelocity>)
+                    .run_if(legacy_solver)
                     .after(IntegrateBodies)
                     .in_set(SubstepSet::Integrate),
             );

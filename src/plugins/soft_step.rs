@@ -1,0 +1,301 @@
+//! The rigid-body solver in the ECS, opt-in: contacts turn bodies.
+//!
+//! Adding [`SoftStepPlugin`] to [`UrtoPlugins`](crate::UrtoPlugins) hands integration and
+//! contact response to the core [`Solver`] (soft-step substeps, contacts with lever arms,
+//! friction, restitution; see [`crate::dynamics::solver`]): the Integrate stage and the legacy
+//! response stand aside (their systems run only without this plugin's resource), the broad and
+//! narrow phases find the contacts at the step's start positions, and one system in the
+//! Response set gathers the bodies, calls [`Solver::step`] and writes positions, rotations and
+//! velocities back. Collision messages, sleeping, hierarchies and validation work as before.
+//!
+//! ```
+//! # use bevy_app::{App, PluginGroup};
+//! # use urto::prelude::*;
+//! # use urto::plugins::SoftStepPlugin;
+//! let mut app = App::new();
+//! app.add_plugins((UrtoPlugins::default(), SoftStepPlugin::default()));
+//! ```
+//!
+//! What this stage does not do yet (issue 10's later stages): the ECS narrow phase reports no
+//! speculative contacts, so a falling body is caught once it touches and pushed out softly;
+//! springs are not applied; continuous collision does not sweep (it sees no integration);
+//! sleeping bodies count as immovable until game code wakes them; the parts of a kinematic
+//! compound push with their root's motion only. Bodies are ordered by entity (creation order)
+//! and contacts by collider pair, never by archetype iteration.
+
+use crate::components::*;
+use crate::dynamics::solver::Solver;
+use crate::dynamics::solver::{
+    BodyInput, ContactInput, ContactPointInput, SoftStepSettings, SolverBodies,
+};
+use crate::plugins::forces::GatheredForces;
+use crate::plugins::narrow_phase::Contacts;
+use crate::schedule::{SubstepSchedule, SubstepSet};
+use crate::settings::{ContactSettings, PhysicsTimestep};
+use crate::stats::{PhysicsStats, Stage};
+use bevy_app::prelude::*;
+use bevy_ecs::prelude::*;
+use glam::{Quat, Vec3};
+use std::time::Instant;
+
+/// Opt-in: the soft-step rigid-body solver replaces integration and the legacy response.
+#[derive(Debug, Clone, Default)]
+pub struct SoftStepPlugin {
+    /// The solver's tunables (Box2D v3's defaults, stiffer contacts; see
+    /// [`SoftStepSettings`]).
+    pub settings: SoftStepSettings,
+}
+
+impl Plugin for SoftStepPlugin {
+    fn build(&self, app: &mut App) {
+        app.insert_resource(SoftStepSolver {
+            solver: Solver::new(self.settings),
+            ..Default::default()
+        })
+        .add_systems(
+            SubstepSchedule,
+            solve_soft_step.in_set(SubstepSet::Response),
+        );
+    }
+}
+
+/// The persistent solver and its buffers; its presence switches the legacy integration and
+/// response off.
+#[derive(Resource, Default)]
+pub struct SoftStepSolver {
+    /// The core solver (its settings and the impulses kept between steps).
+    pub solver: Solver,
+    entities: Vec<Entity>,
+    bodies: SolverBodies,
+    contacts: Vec<ContactInput>,
+}
+
+/// Run condition of the stages the soft step replaces.
+pub(crate) fn legacy_solver(solver: Option<Res<SoftStepSolver>>) -> bool {
+    solver.is_none()
+}
+
+type Mover<'a> = (
+    Entity,
+    &'a mut Position,
+    &'a mut Rotation,
+    &'a mut Velocity,
+    &'a mut AngularVelocity,
+    &'a Mass,
+    &'a Inertia,
+    Option<&'a LockedAxes>,
+    Option<&'a AngularDrag>,
+    Option<&'a LinearDrag>,
+    Option<&'a SleepState>,
+);
+type MoverFilter = (Without<Static>, Without<Quarantined>, Without<ChildOf>);
+type MoverItem<'a> = (
+    Entity,
+    &'a Position,
+    &'a Rotation,
+    &'a Velocity,
+    &'a AngularVelocity,
+    &'a Mass,
+    &'a Inertia,
+    Option<&'a LockedAxes>,
+    Option<&'a AngularDrag>,
+    Option<&'a LinearDrag>,
+    Option<&'a SleepState>,
+);
+
+#[allow(clippy::too_many_arguments)]
+fn solve_soft_step(
+    mut movers: Query<Mover, MoverFilter>,
+    poses: Query<&GlobalPose>,
+    materials: Query<(Option<&Restitution>, Option<&Friction>)>,
+    contacts: Res<Contacts>,
+    gathered: Res<GatheredForces>,
+    settings: Res<ContactSettings>,
+    timestep: Res<PhysicsTimestep>,
+    mut soft: ResMut<SoftStepSolver>,
+    mut stats: ResMut<PhysicsStats>,
+) {
+    let start = Instant::now();
+    let s = &mut *soft;
+    collect_entities(&movers, &contacts, &mut s.entities);
+    s.bodies.clear();
+    for &e in &s.entities {
+        let input = match movers.get(e) {
+            Ok(m) if !asleep(m.10) => body_input(m, &gathered),
+            _ => BodyInput {
+                center: poses.get(e).map_or(Vec3::ZERO, |p| p.0.translation),
+                ..Default::default()
+            },
+        };
+        s.bodies.push(input);
+    }
+    add_user_forces(&gathered, &s.entities, &mut s.bodies);
+    gather_contacts(
+        &contacts,
+        &s.entities,
+        &materials,
+        &settings,
+        &mut s.contacts,
+    );
+    s.solver
+        .step(&mut s.bodies, &s.contacts, timestep.substep_dt());
+    for (slot, &e) in s.entities.iter().enumerate() {
+        if let Ok(m) = movers.get_mut(e) {
+            if !asleep(m.10) {
+                scatter(m, &s.bodies, slot);
+            }
+        }
+    }
+    stats.set_counter("soft_step/bodies", s.entities.len() as f64);
+    stats.set_counter("soft_step/contacts", s.contacts.len() as f64);
+    stats.add_time(Stage::Response, start.elapsed());
+    stats.count_run("soft_step");
+}
+
+fn asleep(sleep: Option<&SleepState>) -> bool {
+    sleep.is_some_and(|s| s.asleep)
+}
+
+/// Every awake moving body and every body a contact names, sorted by entity (creation order),
+/// each once.
+fn collect_entities(
+    movers: &Query<Mover, MoverFilter>,
+    contacts: &Contacts,
+    out: &mut Vec<Entity>,
+) {
+    out.clear();
+    out.extend(movers.iter().filter(|m| !asleep(m.10)).map(|m| m.0));
+    for pair in &contacts.pairs {
+        out.push(pair.a);
+        out.push(pair.b);
+    }
+    out.sort_unstable();
+    out.dedup();
+}
+
+/// A moving body at the step's start: its centre of mass, inertia, gravity and damping.
+fn body_input(m: MoverItem, gathered: &GatheredForces) -> BodyInput {
+    let (_, p, r, v, w, mass, inertia, locked, angular_drag, drag, _) = m;
+    let inverse_mass = mass.inverse();
+    let dynamic = inverse_mass > 0.0;
+    BodyInput {
+        center: p.0 + r.0 * inertia.local_center_of_mass,
+        orientation: r.0,
+        linear_velocity: v.0,
+        angular_velocity: w.0,
+        inverse_mass,
+        inverse_principal_inertia: if dynamic {
+            inertia.inverse_principal()
+        } else {
+            Vec3::ZERO
+        },
+        inertia_frame: inertia.frame,
+        linear_acceleration: gathered.gravity.unwrap_or(Vec3::ZERO),
+        torque: Vec3::ZERO,
+        linear_damping: drag.map_or(0.0, |d| d.0 * inverse_mass),
+        angular_damping: angular_drag.map_or(0.0, |d| d.0),
+        free_axes: locked.map_or(Vec3::ONE, |l| l.free_rotation_axes()),
+    }
+}
+
+/// The step's forces and torques, each to its body's slot (bodies are sorted by entity).
+fn add_user_forces(gathered: &GatheredForces, entities: &[Entity], bodies: &mut SolverBodies) {
+    for (e, f) in &gathered.forces {
+        if let Ok(slot) = entities.binary_search(e) {
+            let p = &mut bodies.params[slot];
+            if p.dynamic {
+                p.linear_acceleration += *f * p.inverse_mass;
+            }
+        }
+    }
+    for (e, t) in &gathered.torques {
+        if let Ok(slot) = entities.binary_search(e) {
+            let p = &mut bodies.params[slot];
+            if p.dynamic {
+                p.angular_acceleration += p.inverse_inertia * *t;
+            }
+        }
+    }
+}
+
+/// The narrow phase's manifolds as solver contacts, keyed by collider pair (sorted).
+fn gather_contacts(
+    contacts: &Contacts,
+    entities: &[Entity],
+    materials: &Query<(Option<&Restitution>, Option<&Friction>)>,
+    settings: &ContactSettings,
+    out: &mut Vec<ContactInput>,
+) {
+    out.clear();
+    let material = |e: Entity| {
+        let (r, f) = materials.get(e).unwrap_or((None, None));
+        (
+            r.map_or(settings.default_restitution, |r| r.0),
+            f.map_or(settings.default_friction, |f| f.0),
+        )
+    };
+    for pair in &contacts.pairs {
+        let (Ok(a), Ok(b)) = (
+            entities.binary_search(&pair.a),
+            entities.binary_search(&pair.b),
+        ) else {
+            continue;
+        };
+        let ((ea, fa), (eb, fb)) = (material(pair.a), material(pair.b));
+        // The lower slot first, whatever order the broad phase found the pair in (it follows
+        // insertion, hence archetype, order).
+        let (a, b, normal) = if a <= b {
+            (a, b, pair.manifold.normal)
+        } else {
+            (b, a, -pair.manifold.normal)
+        };
+        let mut input = ContactInput {
+            a: a as u32,
+            b: b as u32,
+            normal,
+            friction: (fa * fb).max(0.0).sqrt(),
+            restitution: 0.5 * (ea + eb),
+            points: Default::default(),
+            count: pair.manifold.len() as u8,
+            key: pair_key(pair.collider_a, pair.collider_b),
+        };
+        for (p, cp) in input.points.iter_mut().zip(pair.manifold.points()) {
+            *p = ContactPointInput {
+                point: cp.point,
+                separation: -cp.depth,
+            };
+        }
+        out.push(input);
+    }
+    out.sort_by_key(|c| c.key);
+    // Two manifolds of one collider pair (meshes) share a key: keep the first, the solver's
+    // warm start needs keys to be unique.
+    out.dedup_by_key(|c| c.key);
+}
+
+/// A key for a pair of colliders, stable from step to step.
+fn pair_key(a: Entity, b: Entity) -> u64 {
+    let (lo, hi) = if a.index_u32() <= b.index_u32() {
+        (a, b)
+    } else {
+        (b, a)
+    };
+    ((lo.index_u32() as u64) << 32) | hi.index_u32() as u64
+}
+
+/// Writes a moving body's new pose and velocities.
+fn scatter(
+    m: <Mover<'_> as bevy_ecs::query::QueryData>::Item<'_, '_>,
+    bodies: &SolverBodies,
+    slot: usize,
+) {
+    let (_, mut p, mut r, mut v, mut w, _, inertia, ..) = m;
+    let orientation: Quat = bodies.orientation(slot);
+    let center = bodies.center(slot);
+    p.set_if_neq(Position(
+        center - orientation * inertia.local_center_of_mass,
+    ));
+    r.set_if_neq(Rotation(orientation));
+    v.set_if_neq(Velocity(bodies.states[slot].linear_velocity));
+    w.set_if_neq(AngularVelocity(bodies.states[slot].angular_velocity));
+}
