@@ -31,6 +31,13 @@ fn body_rates(app: &App, e: Entity) -> Vec3 {
     r.inverse() * get::<AngularVelocity>(app, e).0
 }
 
+/// A 1 kg ball of radius 0.5 at `at`.
+fn ball(app: &mut App, at: Vec3) -> Entity {
+    app.world_mut()
+        .spawn((Collider::sphere(0.5), Position(at), Velocity::default()))
+        .id()
+}
+
 fn spinning_box(app: &mut App, half: Vec3, w: Vec3) -> Entity {
     app.world_mut()
         .spawn((
@@ -169,14 +176,7 @@ fn a_box_spun_about_its_intermediate_axis_flips_with_the_analytic_period_within_
 #[test]
 fn a_torque_gives_alpha_tau_over_i_and_locked_axes_refuse_it() {
     let mut app = app_without_gravity();
-    let free = app
-        .world_mut()
-        .spawn((
-            Collider::sphere(0.5),
-            Position::default(),
-            Velocity::default(),
-        ))
-        .id();
+    let free = ball(&mut app, Vec3::ZERO);
     let locked = app
         .world_mut()
         .spawn((
@@ -202,14 +202,7 @@ fn a_torque_gives_alpha_tau_over_i_and_locked_axes_refuse_it() {
 #[test]
 fn a_force_at_a_point_pushes_and_turns_within_1e_4() {
     let mut app = app_without_gravity();
-    let b = app
-        .world_mut()
-        .spawn((
-            Collider::sphere(0.5),
-            Position::new(1.0, 2.0, 3.0),
-            Velocity::default(),
-        ))
-        .id();
+    let b = ball(&mut app, Vec3::new(1.0, 2.0, 3.0));
     let mut push = ForceAtPoint::default();
     // 6 N along x, applied 0.5 m above the centre: torque 3 N m about +y.
     push.add(Vec3::X * 6.0, Vec3::new(1.0, 2.0, 3.5));
@@ -409,14 +402,7 @@ fn a_spinning_ball_stays_awake_and_setting_a_spin_wakes_a_sleeper() {
             AngularVelocity(Vec3::Z * 5.0),
         ))
         .id();
-    let still = app
-        .world_mut()
-        .spawn((
-            Collider::sphere(0.5),
-            Position::new(3.0, 0.0, 0.5),
-            Velocity::default(),
-        ))
-        .id();
+    let still = ball(&mut app, Vec3::new(3.0, 0.0, 0.5));
     urto::step(app.world_mut(), 120).unwrap();
     assert!(
         !get::<SleepState>(&app, spinner).asleep,

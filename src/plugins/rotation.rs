@@ -10,8 +10,9 @@
 //!   into [`AngularBody`] values, [`integrate_rotations`] advances them, and their
 //!   [`Rotation`] and [`AngularVelocity`] are written back. A body turns about its centre of
 //!   mass, so when that is off its origin the origin moves with the turn. Bodies that neither
-//!   spin nor feel a torque are skipped after one look, and none is gathered when no body
-//!   turns: a scene in which nothing turns pays one pass over its bodies.
+//!   spin nor feel a torque are skipped after one look; when nothing turned in the last
+//!   substep, no torque acts and no angular velocity changed, the stage returns after that
+//!   check alone (a change-tick scan), so a scene in which nothing turns pays almost nothing.
 
 use crate::components::*;
 use crate::dynamics::{AngularBody, integrate_rotations};
@@ -223,9 +224,12 @@ type Turning<'a> = (
     Option<&'a SleepState>,
 );
 type TurningFilter = (Without<Static>, Without<Quarantined>, Without<ChildOf>);
+/// Bodies whose angular velocity was written since the stage last ran.
+type Spun<'w, 's> = Query<'w, 's, (), (Changed<AngularVelocity>, TurningFilter)>;
 
+#[allow(clippy::too_many_arguments)]
 fn integrate_turning_bodies(
-    mut bodies: Query<Turning, TurningFilter>,
+    mut queries: ParamSet<(Query<Turning, TurningFilter>, Spun)>,
     gathered: Res<GatheredForces>,
     timestep: Res<PhysicsTimestep>,
     integration: Res<Integration>,
@@ -235,10 +239,17 @@ fn integrate_turning_bodies(
 ) {
     let start = Instant::now();
     let b = &mut *buffers;
+    // Nothing turned last substep, no torque acts and no angular velocity was written since:
+    // nothing can turn now either, and a scene that never spins pays this check alone.
+    if b.bodies.is_empty() && gathered.torques.is_empty() && queries.p1().is_empty() {
+        stats.set_counter("integrate/turning", 0.0);
+        return;
+    }
     b.torques.clear();
     for (e, t) in &gathered.torques {
         *b.torques.entry(*e).or_default() += *t;
     }
+    let mut bodies = queries.p0();
     gather_turning(&bodies, b);
     let options = crate::dynamics::RotationOptions {
         gyroscopic: settings.gyroscopic,

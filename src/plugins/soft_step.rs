@@ -35,6 +35,7 @@ use crate::settings::{ContactSettings, PhysicsTimestep};
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
+use bevy_ecs::query::{QueryItem, ROQueryItem};
 use glam::{Quat, Vec3};
 use std::time::Instant;
 
@@ -89,20 +90,6 @@ type Mover<'a> = (
     Option<&'a SleepState>,
 );
 type MoverFilter = (Without<Static>, Without<Quarantined>, Without<ChildOf>);
-type MoverItem<'a> = (
-    Entity,
-    &'a Position,
-    &'a Rotation,
-    &'a Velocity,
-    &'a AngularVelocity,
-    &'a Mass,
-    &'a Inertia,
-    Option<&'a LockedAxes>,
-    Option<&'a AngularDrag>,
-    Option<&'a LinearDrag>,
-    Option<&'a SleepState>,
-);
-
 #[allow(clippy::too_many_arguments)]
 fn solve_soft_step(
     mut movers: Query<Mover, MoverFilter>,
@@ -123,7 +110,12 @@ fn solve_soft_step(
         let input = match movers.get(e) {
             Ok(m) if !asleep(m.10) => body_input(m, &gathered),
             _ => BodyInput {
-                center: poses.get(e).map_or(Vec3::ZERO, |p| p.0.translation),
+                center: poses
+                    .get(e)
+                    .map(|p| p.0.translation)
+                    .ok()
+                    .filter(|c| c.is_finite())
+                    .unwrap_or(Vec3::ZERO),
                 ..Default::default()
             },
         };
@@ -140,10 +132,10 @@ fn solve_soft_step(
     s.solver
         .step(&mut s.bodies, &s.contacts, timestep.substep_dt());
     for (slot, &e) in s.entities.iter().enumerate() {
-        if let Ok(m) = movers.get_mut(e) {
-            if !asleep(m.10) {
-                scatter(m, &s.bodies, slot);
-            }
+        if let Ok(m) = movers.get_mut(e)
+            && !asleep(m.10)
+        {
+            scatter(m, &s.bodies, slot);
         }
     }
     stats.set_counter("soft_step/bodies", s.entities.len() as f64);
@@ -174,7 +166,7 @@ fn collect_entities(
 }
 
 /// A moving body at the step's start: its centre of mass, inertia, gravity and damping.
-fn body_input(m: MoverItem, gathered: &GatheredForces) -> BodyInput {
+fn body_input(m: ROQueryItem<'_, '_, Mover<'_>>, gathered: &GatheredForces) -> BodyInput {
     let (_, p, r, v, w, mass, inertia, locked, angular_drag, drag, _) = m;
     let inverse_mass = mass.inverse();
     let dynamic = inverse_mass > 0.0;
@@ -284,11 +276,7 @@ fn pair_key(a: Entity, b: Entity) -> u64 {
 }
 
 /// Writes a moving body's new pose and velocities.
-fn scatter(
-    m: <Mover<'_> as bevy_ecs::query::QueryData>::Item<'_, '_>,
-    bodies: &SolverBodies,
-    slot: usize,
-) {
+fn scatter(m: QueryItem<'_, '_, Mover<'_>>, bodies: &SolverBodies, slot: usize) {
     let (_, mut p, mut r, mut v, mut w, _, inertia, ..) = m;
     let orientation: Quat = bodies.orientation(slot);
     let center = bodies.center(slot);

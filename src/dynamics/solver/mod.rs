@@ -119,25 +119,9 @@ impl Solver {
             for c in &self.constraints {
                 c.warm_start(&mut bodies.states, &bodies.params);
             }
-            for c in &mut self.constraints {
-                c.solve(
-                    &mut bodies.states,
-                    &bodies.params,
-                    inv_h,
-                    s.max_push_out,
-                    true,
-                );
-            }
+            self.solve_contacts(bodies, inv_h, true);
             integrate_positions(bodies, h, s.max_rotation_per_substep);
-            for c in &mut self.constraints {
-                c.solve(
-                    &mut bodies.states,
-                    &bodies.params,
-                    inv_h,
-                    s.max_push_out,
-                    false,
-                );
-            }
+            self.solve_contacts(bodies, inv_h, false);
         }
         for c in &mut self.constraints {
             c.restitute(&mut bodies.states, &bodies.params, s.restitution_threshold);
@@ -145,6 +129,14 @@ impl Solver {
         let orientations = &bodies.orientations;
         self.cache
             .store(&self.constraints, |a| orientations[a as usize], h);
+    }
+
+    /// One pass over every contact: biased (push-out) or relaxing (no bias, friction).
+    fn solve_contacts(&mut self, bodies: &mut SolverBodies, inv_h: f32, use_bias: bool) {
+        let push = self.settings.max_push_out;
+        for c in &mut self.constraints {
+            c.solve(&mut bodies.states, &bodies.params, inv_h, push, use_bias);
+        }
     }
 
     /// Builds this step's constraints and seeds them from the cache.
