@@ -9,7 +9,8 @@
 //!    last step's impulses ([`WarmStartCache`]);
 //! 2. `substeps` times:
 //!    1. **integrate velocities** — gravity, forces, torques and damping;
-//!    2. **warm start** — apply the accumulated impulses;
+//!    2. **warm start** — apply the accumulated impulses (each contact's points are swept in
+//!       the opposite order from the last substep, so Gauss–Seidel favours none of them);
 //!    3. **solve** — one biased pass: penetration pushed out softly, speculative points closed;
 //!    4. **integrate positions** — each body's motion since the step's start (`dp`, `dq`);
 //!    5. **relax** — one pass without bias, friction included;
@@ -116,6 +117,9 @@ impl Solver {
         self.prepare(bodies, contacts, h);
         for _ in 0..substeps {
             integrate_velocities(bodies, h);
+            for c in &mut self.constraints {
+                c.flip = !c.flip;
+            }
             for c in &self.constraints {
                 c.warm_start(&mut bodies.states, &bodies.params);
             }
