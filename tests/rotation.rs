@@ -558,3 +558,35 @@ fn with_the_soft_step_an_unrelated_component_changes_no_bit_of_a_pile() {
     );
     assert!(plain.iter().all(|(p, _)| p.z > 0.1 && p.z < 2.0));
 }
+
+#[test]
+fn with_the_soft_step_a_tilted_dumbbell_compound_falls_onto_both_ends_within_1_cm() {
+    let mut app = soft_step_app();
+    app.world_mut()
+        .spawn((Collider::half_space(Vec3::Z), Static));
+    // A bar along x with a ball at each end, parts of one body; dropped tilted 0.4 rad.
+    let root = app
+        .world_mut()
+        .spawn((
+            Collider::cuboid(0.6, 0.05, 0.05),
+            Position::new(0.0, 0.0, 1.5),
+            Rotation(Quat::from_rotation_y(0.4)),
+            Velocity::default(),
+            Mass(3.0),
+        ))
+        .id();
+    for x in [-0.8f32, 0.8] {
+        app.world_mut().spawn((
+            Collider::sphere(0.25),
+            Position::new(x, 0.0, 0.0),
+            ChildOf(root),
+        ));
+    }
+    urto::step(app.world_mut(), 300).unwrap();
+    // Both balls on the ground: the bar level at the balls' radius.
+    let r = get::<Rotation>(&app, root).0;
+    let z = get::<Position>(&app, root).0.z;
+    let bar = r * Vec3::X;
+    assert!(bar.z.abs() < 0.02, "the bar is not level: {bar}");
+    assert!((z - 0.25).abs() < 0.01, "the bar's centre is at {z} m");
+}
