@@ -11,7 +11,6 @@ mod support;
 
 use bevy_app::App;
 use bevy_ecs::entity::Entity;
-use bevy_ecs::name::Name;
 use clap::Parser;
 use glam::{Quat, Vec3};
 use std::error::Error;
@@ -125,7 +124,6 @@ fn build_pyramid(app: &mut App, rows: u32) -> Vec<Entity> {
                     Velocity::default(),
                     Mass(2.0),
                     Friction(0.6),
-                    Name::new(format!("box {row}.{k}")),
                 ))
                 .id();
             boxes.push(id);

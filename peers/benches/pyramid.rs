@@ -1,0 +1,268 @@
+//! Pyramid peer benchmark: urto's soft-step solver (`SoftStepPlugin`) against rapier3d on the
+//! same pyramid of boxes, rotations unlocked in both (issue 10's benchmark scene).
+//!
+//! The scene: `ROWS` rows of unit boxes (1 kg, 1 m, 1 cm apart in each row) on a static 1 m slab;
+//! friction 0.6, no restitution, dt = 1/60, gravity 9.81 m/s² down Z. urto runs its soft-step
+//! defaults (4 substeps, contacts at 60 Hz, 120 Hz against immovable bodies); rapier runs its
+//! defaults (4 solver iterations, TGS-soft, sleeping on, single-threaded). One criterion iteration
+//! is the first `STEPS` steps of a fresh scene (the build is not timed): divide by `STEPS` for a
+//! step.
+//!
+//! Quality, printed once per engine to stderr: the largest distance any box ends from where it
+//! started after `STEPS` steps, the pyramid's sag (its top box's drop), and bodies asleep.
+//!
+//! Run (from `peers/`): `cargo bench --bench pyramid 2> pyramid_sanity.txt`;
+//! `PEERS_PYRAMID_ROWS=40` for a larger one.
+
+use bevy_app::App;
+use criterion::{
+    BenchmarkId, Criterion, SamplingMode, Throughput, criterion_group, criterion_main,
+};
+use glam::{Quat, Vec3};
+use rapier3d::prelude as rp;
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+use urto::plugins::SoftStepPlugin;
+use urto::prelude::*;
+
+const DT: f32 = 1.0 / 60.0;
+const HALF: f32 = 0.5;
+const STEPS: u32 = 300;
+const FRICTION: f32 = 0.6;
+
+fn rows() -> u32 {
+    std::env::var("PEERS_PYRAMID_ROWS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(20)
+}
+
+/// Where each box starts.
+fn boxes(rows: u32) -> Vec<Vec3> {
+    let mut out = Vec::new();
+    for row in 0..rows {
+        let count = rows - row;
+        for k in 0..count {
+            let y = (k as f32 - (count - 1) as f32 * 0.5) * 2.0 * HALF * 1.01;
+            out.push(Vec3::new(0.0, y, HALF + 2.0 * HALF * row as f32));
+        }
+    }
+    out
+}
+
+/// Largest displacement from the start, and the top box's drop.
+fn quality(start: &[Vec3], end: &[Vec3]) -> (f32, f32) {
+    let drift = start
+        .iter()
+        .zip(end)
+        .map(|(s, e)| s.distance(*e))
+        .fold(0.0f32, f32::max);
+    let top = start.len() - 1;
+    (drift, start[top].z - end[top].z)
+}
+
+struct Urto {
+    app: App,
+    bodies: Vec<bevy_ecs::entity::Entity>,
+}
+
+impl Urto {
+    fn new(start: &[Vec3]) -> Self {
+        let mut app = App::new();
+        app.add_plugins((UrtoPlugins::default(), SoftStepPlugin::default()))
+            .insert_resource(Gravity::new(Vec3::new(0.0, 0.0, -9.81)).expect("finite"));
+        app.world_mut().spawn((
+            Collider::cuboid(100.0, 100.0, 0.5),
+            Position::new(0.0, 0.0, -0.5),
+            Static,
+            Friction(FRICTION),
+            Restitution(0.0),
+        ));
+        let bodies = start
+            .iter()
+            .map(|&p| {
+                app.world_mut()
+                    .spawn((
+                        Collider::cuboid(HALF, HALF, HALF),
+                        Position(p),
+                        Velocity::default(),
+                        Mass(1.0),
+                        Friction(FRICTION),
+                        Restitution(0.0),
+                    ))
+                    .id()
+            })
+            .collect();
+        Self { app, bodies }
+    }
+
+    fn step(&mut self, n: u32) {
+        urto::step(self.app.world_mut(), n).expect("UrtoPlugins");
+    }
+
+    fn positions(&self) -> Vec<Vec3> {
+        let w = self.app.world();
+        self.bodies
+            .iter()
+            .map(|&b| w.get::<Position>(b).expect("body").0)
+            .collect()
+    }
+}
+
+struct Rapier {
+    gravity: rp::Vector,
+    params: rp::IntegrationParameters,
+    pipeline: rp::PhysicsPipeline,
+    islands: rp::IslandManager,
+    broad_phase: rp::DefaultBroadPhase,
+    narrow_phase: rp::NarrowPhase,
+    bodies: rp::RigidBodySet,
+    colliders: rp::ColliderSet,
+    impulse_joints: rp::ImpulseJointSet,
+    multibody_joints: rp::MultibodyJointSet,
+    soft_bodies: rp::SoftBodySet,
+    ccd: rp::CCDSolver,
+    boxes: Vec<rp::RigidBodyHandle>,
+}
+
+fn rv(v: Vec3) -> rp::Vector {
+    rp::Vector::new(v.x, v.y, v.z)
+}
+
+impl Rapier {
+    /// Rotations free (rapier's default), sleeping on (its default).
+    fn new(start: &[Vec3]) -> Self {
+        let mut bodies = rp::RigidBodySet::new();
+        let mut colliders = rp::ColliderSet::new();
+        let ground = bodies.insert(rp::RigidBodyBuilder::fixed().translation(rv(Vec3::new(0.0, 0.0, -0.5))));
+        colliders.insert_with_parent(
+            rp::ColliderBuilder::cuboid(100.0, 100.0, 0.5).friction(FRICTION).restitution(0.0),
+            ground,
+            &mut bodies,
+        );
+        let boxes = start
+            .iter()
+            .map(|&p| {
+                let h = bodies.insert(rp::RigidBodyBuilder::dynamic().translation(rv(p)));
+                let c = rp::ColliderBuilder::cuboid(HALF, HALF, HALF)
+                    .mass(1.0)
+                    .friction(FRICTION)
+                    .restitution(0.0);
+                colliders.insert_with_parent(c, h, &mut bodies);
+                h
+            })
+            .collect();
+        Self {
+            gravity: rv(Vec3::new(0.0, 0.0, -9.81)),
+            params: rp::IntegrationParameters {
+                dt: DT,
+                ..Default::default()
+            },
+            pipeline: rp::PhysicsPipeline::new(),
+            islands: rp::IslandManager::new(),
+            broad_phase: rp::DefaultBroadPhase::default(),
+            narrow_phase: rp::NarrowPhase::new(),
+            bodies,
+            colliders,
+            impulse_joints: rp::ImpulseJointSet::new(),
+            multibody_joints: rp::MultibodyJointSet::new(),
+            soft_bodies: rp::SoftBodySet::new(),
+            ccd: rp::CCDSolver::new(),
+            boxes,
+        }
+    }
+
+    fn step(&mut self, n: u32) {
+        for _ in 0..n {
+            self.pipeline.step(
+                self.gravity,
+                &self.params,
+                &mut self.islands,
+                &mut self.broad_phase,
+                &mut self.narrow_phase,
+                &mut self.bodies,
+                &mut self.colliders,
+                &mut self.impulse_joints,
+                &mut self.multibody_joints,
+                &mut self.soft_bodies,
+                &mut self.ccd,
+                &(),
+                &(),
+            );
+        }
+    }
+
+    fn positions(&self) -> Vec<Vec3> {
+        self.boxes
+            .iter()
+            .map(|h| {
+                let t = self.bodies[*h].translation();
+                Vec3::new(t.x, t.y, t.z)
+            })
+            .collect()
+    }
+
+    fn asleep(&self) -> usize {
+        self.boxes.iter().filter(|h| self.bodies[**h].is_sleeping()).count()
+    }
+}
+
+fn timed<S>(iters: u64, mut build: impl FnMut() -> S, mut run: impl FnMut(&mut S)) -> Duration {
+    let mut total = Duration::ZERO;
+    for _ in 0..iters {
+        let mut sim = build();
+        let start = Instant::now();
+        run(&mut sim);
+        total += start.elapsed();
+        black_box(&sim);
+    }
+    total
+}
+
+fn bench_pyramid(c: &mut Criterion) {
+    let rows = rows();
+    let start = boxes(rows);
+    let n = start.len();
+
+    let mut u = Urto::new(&start);
+    u.step(STEPS);
+    let (drift, sag) = quality(&start, &u.positions());
+    let turned = {
+        let w = u.app.world();
+        u.bodies
+            .iter()
+            .filter(|&&b| w.get::<Rotation>(b).expect("body").0.angle_between(Quat::IDENTITY) > 0.01)
+            .count()
+    };
+    eprintln!(
+        "[sanity] pyramid {rows} rows ({n} boxes) urto soft step after {STEPS} steps: largest drift {:.1} mm, top sag {:.1} mm, boxes turned > 0.01 rad {turned}, asleep 0 (no islands yet)",
+        drift * 1e3,
+        sag * 1e3
+    );
+    let mut r = Rapier::new(&start);
+    r.step(STEPS);
+    let (drift, sag) = quality(&start, &r.positions());
+    eprintln!(
+        "[sanity] pyramid {rows} rows ({n} boxes) rapier after {STEPS} steps: largest drift {:.1} mm, top sag {:.1} mm, asleep {}",
+        drift * 1e3,
+        sag * 1e3,
+        r.asleep()
+    );
+
+    let mut group = c.benchmark_group(format!("pyramid_{rows}_rows_{STEPS}_steps"));
+    group
+        .sample_size(10)
+        .sampling_mode(SamplingMode::Flat)
+        .measurement_time(Duration::from_secs(10))
+        .throughput(Throughput::Elements(u64::from(STEPS)));
+    group.bench_function(BenchmarkId::new("urto_soft_step", n), |b| {
+        b.iter_custom(|iters| timed(iters, || Urto::new(&start), |u| u.step(STEPS)))
+    });
+    group.bench_function(BenchmarkId::new("rapier", n), |b| {
+        b.iter_custom(|iters| timed(iters, || Rapier::new(&start), |r| r.step(STEPS)))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench_pyramid);
+criterion_main!(benches);
