@@ -29,6 +29,23 @@ const DT: f32 = 1.0 / 60.0;
 const HALF: f32 = 0.5;
 const STEPS: u32 = 300;
 const FRICTION: f32 = 0.6;
+/// rapier with its default sleeping, and with sleeping off (urto has no islands yet).
+const RAPIER_VARIANTS: [(&str, bool); 2] = [("rapier", true), ("rapier_sleeping_off", false)];
+
+/// urto's time per stage in the last step (µs).
+fn stages_line(stats: &PhysicsStats) -> String {
+    Stage::ALL
+        .iter()
+        .map(|s| {
+            format!(
+                "{} {:.0}",
+                s.name(),
+                stats.stage_time(*s).as_secs_f64() * 1e6
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
 
 fn rows() -> u32 {
     std::env::var("PEERS_PYRAMID_ROWS")
@@ -130,20 +147,26 @@ fn rv(v: Vec3) -> rp::Vector {
 }
 
 impl Rapier {
-    /// Rotations free (rapier's default), sleeping on (its default).
-    fn new(start: &[Vec3]) -> Self {
+    /// Rotations free (rapier's default); sleeping on (its default) or off.
+    fn new(start: &[Vec3], can_sleep: bool) -> Self {
         let mut bodies = rp::RigidBodySet::new();
         let mut colliders = rp::ColliderSet::new();
-        let ground = bodies.insert(rp::RigidBodyBuilder::fixed().translation(rv(Vec3::new(0.0, 0.0, -0.5))));
+        let ground =
+            bodies.insert(rp::RigidBodyBuilder::fixed().translation(rv(Vec3::new(0.0, 0.0, -0.5))));
         colliders.insert_with_parent(
-            rp::ColliderBuilder::cuboid(100.0, 100.0, 0.5).friction(FRICTION).restitution(0.0),
+            rp::ColliderBuilder::cuboid(100.0, 100.0, 0.5)
+                .friction(FRICTION)
+                .restitution(0.0),
             ground,
             &mut bodies,
         );
         let boxes = start
             .iter()
             .map(|&p| {
-                let h = bodies.insert(rp::RigidBodyBuilder::dynamic().translation(rv(p)));
+                let body = rp::RigidBodyBuilder::dynamic()
+                    .translation(rv(p))
+                    .can_sleep(can_sleep);
+                let h = bodies.insert(body);
                 let c = rp::ColliderBuilder::cuboid(HALF, HALF, HALF)
                     .mass(1.0)
                     .friction(FRICTION)
@@ -203,7 +226,10 @@ impl Rapier {
     }
 
     fn asleep(&self) -> usize {
-        self.boxes.iter().filter(|h| self.bodies[**h].is_sleeping()).count()
+        self.boxes
+            .iter()
+            .filter(|h| self.bodies[**h].is_sleeping())
+            .count()
     }
 }
 
@@ -231,7 +257,13 @@ fn bench_pyramid(c: &mut Criterion) {
         let w = u.app.world();
         u.bodies
             .iter()
-            .filter(|&&b| w.get::<Rotation>(b).expect("body").0.angle_between(Quat::IDENTITY) > 0.01)
+            .filter(|&&b| {
+                w.get::<Rotation>(b)
+                    .expect("body")
+                    .0
+                    .angle_between(Quat::IDENTITY)
+                    > 0.01
+            })
             .count()
     };
     eprintln!(
@@ -239,15 +271,19 @@ fn bench_pyramid(c: &mut Criterion) {
         drift * 1e3,
         sag * 1e3
     );
-    let mut r = Rapier::new(&start);
-    r.step(STEPS);
-    let (drift, sag) = quality(&start, &r.positions());
-    eprintln!(
-        "[sanity] pyramid {rows} rows ({n} boxes) rapier after {STEPS} steps: largest drift {:.1} mm, top sag {:.1} mm, asleep {}",
-        drift * 1e3,
-        sag * 1e3,
-        r.asleep()
-    );
+    for (label, can_sleep) in RAPIER_VARIANTS {
+        let mut r = Rapier::new(&start, can_sleep);
+        r.step(STEPS);
+        let (drift, sag) = quality(&start, &r.positions());
+        eprintln!(
+            "[sanity] pyramid {rows} rows ({n} boxes) {label} after {STEPS} steps: largest drift {:.1} mm, top sag {:.1} mm, asleep {}",
+            drift * 1e3,
+            sag * 1e3,
+            r.asleep()
+        );
+    }
+    let stages = u.app.world().resource::<PhysicsStats>();
+    eprintln!("[urto stages] last step: {}", stages_line(stages));
 
     let mut group = c.benchmark_group(format!("pyramid_{rows}_rows_{STEPS}_steps"));
     group
@@ -258,9 +294,13 @@ fn bench_pyramid(c: &mut Criterion) {
     group.bench_function(BenchmarkId::new("urto_soft_step", n), |b| {
         b.iter_custom(|iters| timed(iters, || Urto::new(&start), |u| u.step(STEPS)))
     });
-    group.bench_function(BenchmarkId::new("rapier", n), |b| {
-        b.iter_custom(|iters| timed(iters, || Rapier::new(&start), |r| r.step(STEPS)))
-    });
+    for (label, can_sleep) in RAPIER_VARIANTS {
+        group.bench_function(BenchmarkId::new(label, n), |b| {
+            b.iter_custom(|iters| {
+                timed(iters, || Rapier::new(&start, can_sleep), |r| r.step(STEPS))
+            })
+        });
+    }
     group.finish();
 }
 
