@@ -431,11 +431,15 @@ fn soft_step_app() -> App {
     app
 }
 
+/// [`soft_step_app`] with a ground plane through the origin.
+fn soft_step_app_on_ground() -> App {
+    let mut app = soft_step_app_on_ground();
+    app
+}
+
 #[test]
 fn with_the_soft_step_a_tilted_box_dropped_on_the_ground_tumbles_and_rests_flat_within_1_cm() {
-    let mut app = soft_step_app();
-    app.world_mut()
-        .spawn((Collider::half_space(Vec3::Z), Static));
+    let mut app = soft_step_app_on_ground();
     let b = app
         .world_mut()
         .spawn((
@@ -513,9 +517,7 @@ struct Gameplay;
 /// every third body (which moves them to other archetypes, so queries visit them in another
 /// order).
 fn soft_step_pile(tagged: bool) -> Vec<(Vec3, Quat)> {
-    let mut app = soft_step_app();
-    app.world_mut()
-        .spawn((Collider::half_space(Vec3::Z), Static));
+    let mut app = soft_step_app_on_ground();
     let mut bodies = Vec::new();
     for i in 0..30 {
         let at = Vec3::new(
@@ -561,9 +563,7 @@ fn with_the_soft_step_an_unrelated_component_changes_no_bit_of_a_pile() {
 
 #[test]
 fn with_the_soft_step_a_tilted_dumbbell_compound_falls_onto_both_ends_within_1_cm() {
-    let mut app = soft_step_app();
-    app.world_mut()
-        .spawn((Collider::half_space(Vec3::Z), Static));
+    let mut app = soft_step_app_on_ground();
     // A bar along x with a ball at each end, parts of one body; dropped tilted 0.4 rad.
     let root = app
         .world_mut()

@@ -25,6 +25,10 @@ use std::time::{Duration, Instant};
 use urto::plugins::SoftStepPlugin;
 use urto::prelude::*;
 
+#[path = "common/rapier_world.rs"]
+mod rapier_world;
+use rapier_world::RapierWorld;
+
 const DT: f32 = 1.0 / 60.0;
 const HALF: f32 = 0.5;
 const STEPS: u32 = 300;
@@ -127,18 +131,7 @@ impl Urto {
 }
 
 struct Rapier {
-    gravity: rp::Vector,
-    params: rp::IntegrationParameters,
-    pipeline: rp::PhysicsPipeline,
-    islands: rp::IslandManager,
-    broad_phase: rp::DefaultBroadPhase,
-    narrow_phase: rp::NarrowPhase,
-    bodies: rp::RigidBodySet,
-    colliders: rp::ColliderSet,
-    impulse_joints: rp::ImpulseJointSet,
-    multibody_joints: rp::MultibodyJointSet,
-    soft_bodies: rp::SoftBodySet,
-    ccd: rp::CCDSolver,
+    world: RapierWorld,
     boxes: Vec<rp::RigidBodyHandle>,
 }
 
@@ -149,77 +142,37 @@ fn rv(v: Vec3) -> rp::Vector {
 impl Rapier {
     /// Rotations free (rapier's default); sleeping on (its default) or off.
     fn new(start: &[Vec3], can_sleep: bool) -> Self {
-        let mut bodies = rp::RigidBodySet::new();
-        let mut colliders = rp::ColliderSet::new();
-        let ground =
-            bodies.insert(rp::RigidBodyBuilder::fixed().translation(rv(Vec3::new(0.0, 0.0, -0.5))));
-        colliders.insert_with_parent(
-            rp::ColliderBuilder::cuboid(100.0, 100.0, 0.5)
-                .friction(FRICTION)
-                .restitution(0.0),
-            ground,
-            &mut bodies,
-        );
+        let mut world = RapierWorld::new(rv(Vec3::new(0.0, 0.0, -9.81)), DT);
+        let ground = rp::RigidBodyBuilder::fixed().translation(rv(Vec3::new(0.0, 0.0, -0.5)));
+        let slab = rp::ColliderBuilder::cuboid(100.0, 100.0, 0.5)
+            .friction(FRICTION)
+            .restitution(0.0);
+        world.add(ground, slab);
         let boxes = start
             .iter()
             .map(|&p| {
                 let body = rp::RigidBodyBuilder::dynamic()
                     .translation(rv(p))
                     .can_sleep(can_sleep);
-                let h = bodies.insert(body);
                 let c = rp::ColliderBuilder::cuboid(HALF, HALF, HALF)
                     .mass(1.0)
                     .friction(FRICTION)
                     .restitution(0.0);
-                colliders.insert_with_parent(c, h, &mut bodies);
-                h
+                world.add(body, c)
             })
             .collect();
-        Self {
-            gravity: rv(Vec3::new(0.0, 0.0, -9.81)),
-            params: rp::IntegrationParameters {
-                dt: DT,
-                ..Default::default()
-            },
-            pipeline: rp::PhysicsPipeline::new(),
-            islands: rp::IslandManager::new(),
-            broad_phase: rp::DefaultBroadPhase::default(),
-            narrow_phase: rp::NarrowPhase::new(),
-            bodies,
-            colliders,
-            impulse_joints: rp::ImpulseJointSet::new(),
-            multibody_joints: rp::MultibodyJointSet::new(),
-            soft_bodies: rp::SoftBodySet::new(),
-            ccd: rp::CCDSolver::new(),
-            boxes,
-        }
+        Self { world, boxes }
     }
 
     fn step(&mut self, n: u32) {
-        for _ in 0..n {
-            self.pipeline.step(
-                self.gravity,
-                &self.params,
-                &mut self.islands,
-                &mut self.broad_phase,
-                &mut self.narrow_phase,
-                &mut self.bodies,
-                &mut self.colliders,
-                &mut self.impulse_joints,
-                &mut self.multibody_joints,
-                &mut self.soft_bodies,
-                &mut self.ccd,
-                &(),
-                &(),
-            );
-        }
+        self.world.step(n);
     }
 
     fn positions(&self) -> Vec<Vec3> {
         self.boxes
             .iter()
             .map(|h| {
-                let t = self.bodies[*h].translation();
+                let t = self.world.bodies[*h].translation();
                 Vec3::new(t.x, t.y, t.z)
             })
             .collect()
@@ -228,7 +181,7 @@ impl Rapier {
     fn asleep(&self) -> usize {
         self.boxes
             .iter()
-            .filter(|h| self.bodies[**h].is_sleeping())
+            .filter(|h| self.world.bodies[**h].is_sleeping())
             .count()
     }
 }

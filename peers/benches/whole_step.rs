@@ -43,6 +43,10 @@ use std::time::{Duration, Instant};
 use urto::plugins::Contacts;
 use urto::prelude::*;
 
+#[path = "common/rapier_world.rs"]
+mod rapier_world;
+use rapier_world::RapierWorld;
+
 /// dt of both engines (urto's default `PhysicsTimestep`, rapier's default `IntegrationParameters`).
 const DT: f32 = 1.0 / 60.0;
 const G: f32 = 9.81;
@@ -368,18 +372,7 @@ fn gv(v: rp::Vector) -> Vec3 {
 
 /// rapier's usual structures, stepped with `PhysicsPipeline::step`.
 struct Rapier {
-    gravity: rp::Vector,
-    params: rp::IntegrationParameters,
-    pipeline: rp::PhysicsPipeline,
-    islands: rp::IslandManager,
-    broad_phase: rp::DefaultBroadPhase,
-    narrow_phase: rp::NarrowPhase,
-    bodies: rp::RigidBodySet,
-    colliders: rp::ColliderSet,
-    impulse_joints: rp::ImpulseJointSet,
-    multibody_joints: rp::MultibodyJointSet,
-    soft_bodies: rp::SoftBodySet,
-    ccd: rp::CCDSolver,
+    world: RapierWorld,
     balls: Vec<rp::RigidBodyHandle>,
 }
 
@@ -387,12 +380,7 @@ impl Rapier {
     /// The scene with rapier's default parameters (dt = 1/60, 4 solver iterations); rotations
     /// locked; `can_sleep` on (rapier's default) or off.
     fn new(scene: &Scene, can_sleep: bool) -> Self {
-        let params = rp::IntegrationParameters {
-            dt: DT,
-            ..Default::default()
-        };
-        let mut bodies = rp::RigidBodySet::new();
-        let mut colliders = rp::ColliderSet::new();
+        let mut world = RapierWorld::new(rv(scene.gravity), DT);
         for p in &scene.planes {
             let (at, shape) = match scene.walls {
                 Walls::HalfSpaces => (p.point, rp::SharedShape::halfspace(rv(p.normal))),
@@ -401,11 +389,10 @@ impl Rapier {
                     (centre, rp::SharedShape::cuboid(half.x, half.y, half.z))
                 }
             };
-            let h = bodies.insert(rp::RigidBodyBuilder::fixed().translation(rv(at)));
             let c = rp::ColliderBuilder::new(shape)
                 .friction(scene.friction)
                 .restitution(scene.restitution);
-            colliders.insert_with_parent(c, h, &mut bodies);
+            world.add(rp::RigidBodyBuilder::fixed().translation(rv(at)), c);
         }
         let balls = scene
             .balls
@@ -416,50 +403,18 @@ impl Rapier {
                     .linvel(rv(b.vel))
                     .lock_rotations()
                     .can_sleep(can_sleep);
-                let h = bodies.insert(body);
                 let c = rp::ColliderBuilder::ball(RADIUS)
                     .mass(1.0)
                     .friction(scene.friction)
                     .restitution(scene.restitution);
-                colliders.insert_with_parent(c, h, &mut bodies);
-                h
+                world.add(body, c)
             })
             .collect();
-        Self {
-            gravity: rv(scene.gravity),
-            params,
-            pipeline: rp::PhysicsPipeline::new(),
-            islands: rp::IslandManager::new(),
-            broad_phase: rp::DefaultBroadPhase::default(),
-            narrow_phase: rp::NarrowPhase::new(),
-            bodies,
-            colliders,
-            impulse_joints: rp::ImpulseJointSet::new(),
-            multibody_joints: rp::MultibodyJointSet::new(),
-            soft_bodies: rp::SoftBodySet::new(),
-            ccd: rp::CCDSolver::new(),
-            balls,
-        }
+        Self { world, balls }
     }
 
     fn step(&mut self, n: u32) {
-        for _ in 0..n {
-            self.pipeline.step(
-                self.gravity,
-                &self.params,
-                &mut self.islands,
-                &mut self.broad_phase,
-                &mut self.narrow_phase,
-                &mut self.bodies,
-                &mut self.colliders,
-                &mut self.impulse_joints,
-                &mut self.multibody_joints,
-                &mut self.soft_bodies,
-                &mut self.ccd,
-                &(),
-                &(),
-            );
-        }
+        self.world.step(n);
     }
 
     /// Positions and velocities, touching pairs (pairs with an active solver contact), sleeping
@@ -470,7 +425,7 @@ impl Rapier {
             .balls
             .iter()
             .map(|&h| {
-                let b = &self.bodies[h];
+                let b = &self.world.bodies[h];
                 sleeping += usize::from(b.is_sleeping());
                 Ball {
                     pos: gv(b.translation()),
@@ -479,6 +434,7 @@ impl Rapier {
             })
             .collect();
         let touching = self
+            .world
             .narrow_phase
             .contact_pairs()
             .filter(|p| p.has_any_active_contact())
