@@ -433,7 +433,9 @@ fn soft_step_app() -> App {
 
 /// [`soft_step_app`] with a ground plane through the origin.
 fn soft_step_app_on_ground() -> App {
-    let mut app = soft_step_app_on_ground();
+    let mut app = soft_step_app();
+    app.world_mut()
+        .spawn((Collider::half_space(Vec3::Z), Static));
     app
 }
 
