@@ -121,14 +121,14 @@ impl Solver {
                 c.flip = !c.flip;
             }
             for c in &self.constraints {
-                c.warm_start(&mut bodies.states, &bodies.params);
+                c.warm_start(&mut bodies.states);
             }
             self.solve_contacts(bodies, inv_h, true);
             integrate_positions(bodies, h, s.max_rotation_per_substep);
             self.solve_contacts(bodies, inv_h, false);
         }
         for c in &mut self.constraints {
-            c.restitute(&mut bodies.states, &bodies.params, s.restitution_threshold);
+            c.restitute(&mut bodies.states, s.restitution_threshold);
         }
         let orientations = &bodies.orientations;
         self.cache
@@ -139,7 +139,7 @@ impl Solver {
     fn solve_contacts(&mut self, bodies: &mut SolverBodies, inv_h: f32, use_bias: bool) {
         let push = self.settings.max_push_out;
         for c in &mut self.constraints {
-            c.solve(&mut bodies.states, &bodies.params, inv_h, push, use_bias);
+            c.solve(&mut bodies.states, inv_h, push, use_bias);
         }
     }
 
