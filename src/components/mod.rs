@@ -227,6 +227,11 @@ pub struct SleepState {
 }
 
 impl SleepState {
+    /// True for a body that has a sleep state and is asleep (bodies without one never sleep).
+    pub fn is_asleep(state: Option<&Self>) -> bool {
+        state.is_some_and(|s| s.asleep)
+    }
+
     /// Awake, with the stillness count restarted.
     pub fn wake(&mut self) {
         self.asleep = false;

@@ -82,7 +82,9 @@ fn integrate_bodies(
         &mut b.scratch,
     );
     let mut bodies = queries.p0();
-    let awake = bodies.iter_mut().filter(|(.., s)| !is_asleep(*s));
+    let awake = bodies
+        .iter_mut()
+        .filter(|(.., s)| !SleepState::is_asleep(*s));
     for (i, (_, mut p, mut v, ..)) in awake.enumerate() {
         p.set_if_neq(Position(b.positions[i]));
         v.set_if_neq(Velocity(b.velocities[i]));
@@ -90,11 +92,6 @@ fn integrate_bodies(
     stats.set_counter("integrate/bodies", b.positions.len() as f64);
     stats.add_time(Stage::Integrate, start.elapsed());
     stats.count_run("integrate");
-}
-
-/// Sleeping bodies are not integrated (query order minus them = array order).
-fn is_asleep(sleep: Option<&SleepState>) -> bool {
-    sleep.is_some_and(|s| s.asleep)
 }
 
 /// Copies the moving bodies into the flat arrays and the model (query order = array order).
@@ -109,7 +106,8 @@ fn gather_state(
     b.model.gravity = gathered.gravity;
     let needs_index = !gathered.only_gravity();
     b.index.clear();
-    let awake = bodies.iter().filter(|(.., s)| !is_asleep(*s));
+    // Sleeping bodies are not integrated (query order minus them = array order).
+    let awake = bodies.iter().filter(|(.., s)| !SleepState::is_asleep(*s));
     for (i, (entity, p, v, m, _)) in awake.enumerate() {
         b.positions.push(p.0);
         b.velocities.push(v.0);

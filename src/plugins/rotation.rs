@@ -111,8 +111,13 @@ fn compute_inertia(
     let b = &mut *buffers;
     b.dirty.clear();
     b.dirty.extend(&root_queries.p0());
-    for part in &changed_parts {
-        b.dirty.push(root_of(part, &parents));
+    if !changed_parts.is_empty() {
+        // A chain of ChildOf is at most as long as there are parts (a cycle, which validation
+        // reports, stops there).
+        let longest_chain = parents.iter().len() + 1;
+        for part in &changed_parts {
+            b.dirty.push(root_of(part, &parents, longest_chain));
+        }
     }
     if b.dirty.is_empty() {
         return;
@@ -135,9 +140,9 @@ fn compute_inertia(
     });
 }
 
-/// The topmost ancestor of `e` (stops on a cycle of `ChildOf`, which validation reports).
-fn root_of(mut e: Entity, parents: &Query<&ChildOf>) -> Entity {
-    for _ in 0..parents.iter().len() + 1 {
+/// The topmost ancestor of `e`, at most `longest_chain` steps up.
+fn root_of(mut e: Entity, parents: &Query<&ChildOf>, longest_chain: usize) -> Entity {
+    for _ in 0..longest_chain {
         match parents.get(e) {
             Ok(parent) => e = parent.parent(),
             Err(_) => break,
@@ -165,7 +170,8 @@ fn gather_compound(
         let Ok((collider, children, ..)) = parts.get(e) else {
             continue;
         };
-        if let Some(c) = collider {
+        // A part with an impossible shape is quarantined; its numbers reach no inertia.
+        if let Some(c) = collider.filter(|c| c.shape.validate().is_ok()) {
             out.push((pose, c.shape.mass_properties(1.0)));
         }
         for &child in children.into_iter().flatten() {
@@ -267,7 +273,7 @@ fn gather_turning(bodies: &Query<Turning, TurningFilter>, b: &mut RotationBuffer
     b.bodies.clear();
     b.centers.clear();
     for (slot, (e, _, r, w, inertia, drag, locked, sleep)) in bodies.iter().enumerate() {
-        if sleep.is_some_and(|s| s.asleep) {
+        if SleepState::is_asleep(sleep) {
             continue;
         }
         let torque = if b.torques.is_empty() {
@@ -275,9 +281,6 @@ fn gather_turning(bodies: &Query<Turning, TurningFilter>, b: &mut RotationBuffer
         } else {
             b.torques.get(&e).copied().unwrap_or(Vec3::ZERO)
         };
-        if w.0 == Vec3::ZERO && torque == Vec3::ZERO {
-            continue;
-        }
         let body = AngularBody {
             orientation: r.0,
             angular_velocity: w.0,

@@ -46,7 +46,7 @@ fn sleep_enabled(settings: Res<SleepSettings>) -> bool {
 /// Whether `e` takes part in no simulation this substep: static scenery or a sleeping body.
 pub(crate) fn dormant(state: Option<(bool, Option<&SleepState>)>) -> bool {
     match state {
-        Some((is_static, sleep)) => is_static || sleep.is_some_and(|s| s.asleep),
+        Some((is_static, sleep)) => is_static || SleepState::is_asleep(sleep),
         None => false,
     }
 }

@@ -49,8 +49,12 @@ pub struct SoftStepPlugin {
 
 impl Plugin for SoftStepPlugin {
     fn build(&self, app: &mut App) {
+        let settings = self.settings.validated().unwrap_or_else(|e| {
+            log::warn!("urto: SoftStepPlugin settings refused ({e}); using the defaults");
+            SoftStepSettings::default()
+        });
         app.insert_resource(SoftStepSolver {
-            solver: Solver::new(self.settings),
+            solver: Solver::new(settings),
             ..Default::default()
         })
         .add_systems(
@@ -108,7 +112,7 @@ fn solve_soft_step(
     s.bodies.clear();
     for &e in &s.entities {
         let input = match movers.get(e) {
-            Ok(m) if !asleep(m.10) => body_input(m, &gathered),
+            Ok(m) if !SleepState::is_asleep(m.10) => body_input(m, &gathered),
             _ => BodyInput {
                 center: poses
                     .get(e)
@@ -133,7 +137,7 @@ fn solve_soft_step(
         .step(&mut s.bodies, &s.contacts, timestep.substep_dt());
     for (slot, &e) in s.entities.iter().enumerate() {
         if let Ok(m) = movers.get_mut(e)
-            && !asleep(m.10)
+            && !SleepState::is_asleep(m.10)
         {
             scatter(m, &s.bodies, slot);
         }
@@ -144,10 +148,6 @@ fn solve_soft_step(
     stats.count_run("soft_step");
 }
 
-fn asleep(sleep: Option<&SleepState>) -> bool {
-    sleep.is_some_and(|s| s.asleep)
-}
-
 /// Every awake moving body and every body a contact names, sorted by entity (creation order),
 /// each once.
 fn collect_entities(
@@ -156,7 +156,12 @@ fn collect_entities(
     out: &mut Vec<Entity>,
 ) {
     out.clear();
-    out.extend(movers.iter().filter(|m| !asleep(m.10)).map(|m| m.0));
+    out.extend(
+        movers
+            .iter()
+            .filter(|m| !SleepState::is_asleep(m.10))
+            .map(|m| m.0),
+    );
     for pair in &contacts.pairs {
         out.push(pair.a);
         out.push(pair.b);
@@ -249,7 +254,7 @@ fn gather_contacts(
             restitution: 0.5 * (ea + eb),
             points: Default::default(),
             count: pair.manifold.len() as u8,
-            key: pair_key(pair.collider_a, pair.collider_b),
+            key: pair_key(pair.collider_a, pair.collider_b) << 16,
         };
         for (p, cp) in input.points.iter_mut().zip(pair.manifold.points()) {
             *p = ContactPointInput {
@@ -259,20 +264,28 @@ fn gather_contacts(
         }
         out.push(input);
     }
+    // Stable: the manifolds of one collider pair (meshes) keep the narrow phase's order, and
+    // their rank among the pair's manifolds makes each key unique.
     out.sort_by_key(|c| c.key);
-    // Two manifolds of one collider pair (meshes) share a key: keep the first, the solver's
-    // warm start needs keys to be unique.
-    out.dedup_by_key(|c| c.key);
+    let mut rank = 0u128;
+    for i in 0..out.len() {
+        rank = if i > 0 && out[i].key >> 16 == out[i - 1].key >> 16 {
+            rank + 1
+        } else {
+            0
+        };
+        out[i].key |= rank.min(0xffff);
+    }
 }
 
 /// A key for a pair of colliders, stable from step to step.
-fn pair_key(a: Entity, b: Entity) -> u64 {
+fn pair_key(a: Entity, b: Entity) -> u128 {
     let (lo, hi) = if a.index_u32() <= b.index_u32() {
         (a, b)
     } else {
         (b, a)
     };
-    ((lo.index_u32() as u64) << 32) | hi.index_u32() as u64
+    ((lo.index_u32() as u128) << 32) | hi.index_u32() as u128
 }
 
 /// Writes a moving body's new pose and velocities.

@@ -63,7 +63,7 @@ pub struct ContactInput {
     pub count: u8,
     /// A key stable from step to step for the same pair of colliders (warm starting follows
     /// it); contacts must be given in increasing key order.
-    pub key: u64,
+    pub key: u128,
 }
 
 /// A point of a prepared constraint.
@@ -115,7 +115,7 @@ pub struct ContactConstraint {
     /// How many are used.
     pub count: u8,
     /// The caller's pair key.
-    pub key: u64,
+    pub key: u128,
     /// Solve the points backwards this substep (flipped every substep).
     pub flip: bool,
     /// `1/m` of A and B, copied so the passes touch only the velocities.
@@ -149,6 +149,16 @@ impl RowPart {
             0.0
         };
         Self { arm, turn, mass }
+    }
+}
+
+/// Restitution within `0..=1`; a non-finite value (which would fling both bodies to infinity)
+/// is 0, and more than 1 (a bounce that gains energy) is 1.
+fn sane_restitution(e: f32) -> f32 {
+    if e.is_finite() {
+        e.clamp(0.0, 1.0)
+    } else {
+        0.0
     }
 }
 
@@ -194,7 +204,7 @@ impl ContactConstraint {
             normal: n,
             tangents,
             friction: input.friction.max(0.0),
-            restitution: input.restitution.max(0.0),
+            restitution: sane_restitution(input.restitution),
             softness,
             points,
             count: input.count,

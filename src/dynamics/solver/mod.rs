@@ -39,6 +39,7 @@ pub use contact::{ConstraintPoint, ContactConstraint, ContactInput, ContactPoint
 pub use softness::Softness;
 pub use warm_start::WarmStartCache;
 
+use crate::settings::{MAX_SUBSTEPS, SettingsError};
 use glam::{Quat, Vec3};
 
 /// The solver's tunables (defaults as in Box2D v3 and rapier 0.36).
@@ -81,6 +82,39 @@ impl Default for SoftStepSettings {
     }
 }
 
+impl SoftStepSettings {
+    /// The settings if every number is usable: `1..=MAX_SUBSTEPS` substeps, stiffnesses,
+    /// damping ratio, restitution threshold and warm-start distance finite and `>= 0`, push-out
+    /// speed and rotation bound finite and `> 0`.
+    pub fn validated(self) -> Result<Self, SettingsError> {
+        if !(1..=MAX_SUBSTEPS).contains(&self.substeps) {
+            return Err(SettingsError::BadSubsteps(self.substeps));
+        }
+        let at_least_zero = [
+            ("contact_hertz", self.contact_hertz),
+            ("static_contact_hertz", self.static_contact_hertz),
+            ("damping_ratio", self.damping_ratio),
+            ("restitution_threshold", self.restitution_threshold),
+            ("warm_start_distance", self.warm_start_distance),
+        ];
+        let above_zero = [
+            ("max_push_out", self.max_push_out),
+            ("max_rotation_per_substep", self.max_rotation_per_substep),
+        ];
+        for (name, v) in at_least_zero {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(SettingsError::BadCoefficient(name, v));
+            }
+        }
+        for (name, v) in above_zero {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(SettingsError::BadCoefficient(name, v));
+            }
+        }
+        Ok(self)
+    }
+}
+
 /// The persistent solver: its constraint buffer and the impulses kept between steps.
 #[derive(Clone, Debug, Default)]
 pub struct Solver {
@@ -107,7 +141,10 @@ impl Solver {
 
     /// Advances `bodies` by `dt` under `contacts` (sorted by key; see the module doc).
     pub fn step(&mut self, bodies: &mut SolverBodies, contacts: &[ContactInput], dt: f32) {
-        let s = self.settings;
+        // The settings are public: unusable ones (a NaN stiffness, u32::MAX substeps) step with
+        // the defaults rather than hang or spread NaN.
+        let s = self.settings.validated().unwrap_or_default();
+        self.settings = s;
         let substeps = s.substeps.max(1);
         let h = dt / substeps as f32;
         if !(h > 0.0 && h.is_finite()) {

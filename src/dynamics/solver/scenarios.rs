@@ -94,7 +94,7 @@ impl Scene {
                     restitution: a.restitution.max(b.restitution),
                     points: Default::default(),
                     count: m.points().len() as u8,
-                    key: ((i as u64) << 32) | j as u64,
+                    key: ((i as u128) << 32) | j as u128,
                 };
                 for (p, cp) in input.points.iter_mut().zip(m.points()) {
                     *p = ContactPointInput {

@@ -25,7 +25,7 @@ struct StoredPoint {
 /// One contact's impulses.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct StoredContact {
-    key: u64,
+    key: u128,
     points: [StoredPoint; MAX_MANIFOLD_POINTS],
     count: u8,
 }
