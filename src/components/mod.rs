@@ -198,6 +198,19 @@ impl Collider {
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 pub struct BoundingVolume(pub Aabb);
 
+impl BoundingVolume {
+    /// Half the diagonal (0 when empty or unbounded): how far the body reaches from the
+    /// volume's centre, for the speed of its turning surface (`|ω|` times this).
+    pub fn reach(&self) -> f32 {
+        let half = self.0.half_extents();
+        if half.is_finite() && half.cmpge(glam::Vec3::ZERO).all() {
+            half.length()
+        } else {
+            0.0
+        }
+    }
+}
+
 /// The world pose of a body, derived each substep from [`Position`] and [`Rotation`]: a root's
 /// own, or its parent's world pose composed with its local one. Read it, don't write it.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]

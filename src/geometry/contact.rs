@@ -4,7 +4,8 @@
 //! A towards shape B**, `depth >= 0` is how far they interpenetrate along it, and a pair at
 //! distance exactly zero (touching) *is* in contact with depth 0 — the same closed-set convention
 //! as [`Aabb::intersects`](crate::bounding::Aabb::intersects). Points are in world space, midway
-//! between the two surfaces.
+//! between the two surfaces. A speculative contact (found with a margin, for a solver that
+//! detects once per step) also holds points still apart, with negative depth.
 
 use glam::Vec3;
 
@@ -16,7 +17,9 @@ pub const MAX_MANIFOLD_POINTS: usize = 4;
 pub struct ContactPoint {
     /// World-space point midway between the two surfaces.
     pub point: Vec3,
-    /// Penetration along the manifold normal, `>= 0`.
+    /// Penetration along the manifold normal: `>= 0` from the exact tests, negative (the gap)
+    /// for the points of a speculative contact
+    /// ([`speculative_contact`](crate::geometry::contacts::speculative_contact)) still apart.
     pub depth: f32,
 }
 
@@ -76,6 +79,12 @@ impl ContactManifold {
     /// The deepest penetration over the points (0 when empty).
     pub fn max_depth(&self) -> f32 {
         self.points().iter().fold(0.0, |d, p| d.max(p.depth))
+    }
+
+    /// True when some point is closer than `tolerance` (a speculative contact whose points
+    /// are all farther apart is not touching yet).
+    pub fn touching(&self, tolerance: f32) -> bool {
+        self.points().iter().any(|p| p.depth >= -tolerance)
     }
 
     /// The same contact seen from B: the normal flips, the points stay.

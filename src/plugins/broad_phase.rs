@@ -18,6 +18,7 @@ use crate::broad_phase::{
 use crate::components::*;
 use crate::plugins::core::PrepareIndex;
 use crate::plugins::proxy_table::{Proxy, ProxyTable};
+use crate::plugins::soft_step::{Lookahead, LookaheadParams};
 use crate::plugins::validation::quarantine;
 use crate::schedule::{BroadPhaseSystems, PhysicsSchedule, SubstepSchedule};
 use crate::stats::{PhysicsStats, Stage};
@@ -131,27 +132,48 @@ impl Plugin for BroadPhasePlugin {
 }
 
 /// What the broad phase needs to know of a root body.
-type Indexed<'a> = (Entity, &'a BoundingVolume, Has<Static>, Has<Velocity>);
-type IndexedRow<'a> = (Entity, &'a BoundingVolume, bool, bool);
+type Indexed<'a> = (
+    Entity,
+    &'a BoundingVolume,
+    Has<Static>,
+    Option<&'a Velocity>,
+    Option<&'a AngularVelocity>,
+);
+type IndexedRow<'a> = (
+    Entity,
+    &'a BoundingVolume,
+    bool,
+    Option<&'a Velocity>,
+    Option<&'a AngularVelocity>,
+);
 type Root = (Without<ChildOf>, Without<Quarantined>);
+/// A moving body's margin follows its velocity, so a new velocity re-indexes it.
+type Moved = Or<(
+    Changed<BoundingVolume>,
+    Changed<Velocity>,
+    Changed<AngularVelocity>,
+)>;
 type NoLongerRoot = Or<(Added<Quarantined>, Changed<ChildOf>)>;
 
 /// Brings the structures in step with the world: registers new roots (in bulk), moves changed
 /// ones, drops removed, despawned, quarantined and re-parented ones, then commits. Only roots of
-/// hierarchies are indexed; their volume bounds their whole compound body.
+/// hierarchies are indexed; their volume bounds their whole compound body, grown by its
+/// speculative margin when the solver asks for one ([`Lookahead`]).
 #[allow(clippy::too_many_arguments)]
 fn sync_broad_phase(
     mut index: ResMut<BroadPhaseIndex>,
-    changed: Query<Indexed, (Root, Changed<BoundingVolume>)>,
+    changed: Query<Indexed, (Root, Moved)>,
     roots: Query<Indexed, Root>,
     gone: Query<Entity, NoLongerRoot>,
     mut despawned: RemovedComponents<BoundingVolume>,
     mut released: RemovedComponents<Quarantined>,
     mut orphaned: RemovedComponents<ChildOf>,
+    lookahead: LookaheadParams,
     mut stats: ResMut<PhysicsStats>,
     mut commands: Commands,
 ) {
     let start = Instant::now();
+    let lookahead = lookahead.get();
     let index = &mut *index;
     for e in despawned.read().chain(gone.iter()) {
         index.forget(e);
@@ -162,7 +184,7 @@ fn sync_broad_phase(
         .filter_map(|e| roots.get(*e).ok())
         .chain(changed.iter())
     {
-        index.upsert(row);
+        index.upsert(row, &lookahead);
     }
     index.flush_batches(&mut commands);
     index.moving.commit();
@@ -190,13 +212,18 @@ impl BroadPhaseIndex {
 
     /// Registers a new root or moves a known one (re-registering it if its kind changed); a
     /// root with nothing to collide (an empty volume) is dropped.
-    fn upsert(&mut self, (e, bv, is_static, has_velocity): IndexedRow) {
+    fn upsert(&mut self, (e, bv, is_static, v, w): IndexedRow, lookahead: &Lookahead) {
         if !bv.0.is_valid() {
             self.forget(e);
             return;
         }
         let bounded = bv.0.is_finite();
-        let moving = has_velocity && !is_static;
+        let moving = v.is_some() && !is_static;
+        let aabb = if moving {
+            bv.0.expanded(lookahead.of(v, w, bv))
+        } else {
+            bv.0
+        };
         let wanted = |p: Proxy| match p {
             Proxy::Moving(_) => bounded && moving,
             Proxy::Static(_) => bounded && !moving,
@@ -204,10 +231,10 @@ impl BroadPhaseIndex {
         };
         match self.proxies.get(e) {
             Some(Proxy::Moving(id)) if wanted(Proxy::Moving(id)) => {
-                let _ = self.moving.update(id, bv.0);
+                let _ = self.moving.update(id, aabb);
             }
             Some(Proxy::Static(id)) if wanted(Proxy::Static(id)) => {
-                let _ = self.grid.update(id, bv.0);
+                let _ = self.grid.update(id, aabb);
             }
             Some(Proxy::Unbounded) if !bounded => {}
             known => {
@@ -215,8 +242,8 @@ impl BroadPhaseIndex {
                     self.forget(e);
                 }
                 match self.proxies.register(e, bounded, moving) {
-                    Proxy::Moving(id) => self.moving_batch.push((id, bv.0, BodyKind::Dynamic)),
-                    Proxy::Static(id) => self.static_batch.push((id, bv.0)),
+                    Proxy::Moving(id) => self.moving_batch.push((id, aabb, BodyKind::Dynamic)),
+                    Proxy::Static(id) => self.static_batch.push((id, aabb)),
                     Proxy::Unbounded => {}
                 }
             }

@@ -22,6 +22,8 @@ use crate::geometry::ContactManifold;
 use crate::plugins::broad_phase::BroadPhaseIndex;
 use crate::plugins::integration::IntegrateBodies;
 use crate::plugins::narrow_phase::{ComputeContacts, ContactPair, Contacts};
+use crate::plugins::response::ReportCollisions;
+use crate::plugins::soft_step::{SolveBodies, legacy_solver};
 use crate::schedule::{SubstepSchedule, SubstepSet};
 use crate::settings::{ContactSettings, PhysicsTimestep};
 use crate::stats::{PhysicsStats, Stage};
@@ -71,13 +73,25 @@ impl Plugin for CcdPlugin {
                 (
                     (
                         record_sweep_starts.before(IntegrateBodies),
-                        sweep_fast_bodies.after(IntegrateBodies),
+                        sweep_fast_bodies
+                            .after(IntegrateBodies)
+                            .run_if(legacy_solver),
                     )
                         .run_if(any_with_component::<Velocity>)
                         .in_set(SubstepSet::Integrate),
                     add_impacts_to_contacts
                         .after(ComputeContacts)
+                        .run_if(legacy_solver)
                         .in_set(SubstepSet::NarrowPhase),
+                    // With the rigid-body solver the motion is the solver's: sweep it after
+                    // the solve, and report the impacts with the step's collisions.
+                    (sweep_fast_bodies, add_impacts_to_contacts)
+                        .chain()
+                        .run_if(not(legacy_solver))
+                        .run_if(any_with_component::<Velocity>)
+                        .after(SolveBodies)
+                        .before(ReportCollisions)
+                        .in_set(SubstepSet::Response),
                 ),
             );
     }
@@ -224,6 +238,7 @@ fn sweep_fast_bodies(
                 collider_a: body,
                 collider_b: leaf,
                 manifold: ContactManifold::single(-hit.normal, hit.point, 0.0),
+                normal_impulse: 0.0,
             });
         }
         // Impacts left over (max_impacts reached): stay at the last impact point.

@@ -34,10 +34,10 @@ pub use forces::{ForcesPlugin, GatheredForces};
 pub use hierarchy::HierarchyPlugin;
 pub use integration::IntegrationPlugin;
 pub use narrow_phase::{ContactPair, Contacts, NarrowPhasePlugin};
-pub use response::{CollisionEnded, CollisionStarted, ResponsePlugin};
+pub use response::{CollisionEnded, CollisionStarted, ReportCollisions, ResponsePlugin};
 pub use rotation::RotationPlugin;
 pub use sleep::SleepPlugin;
-pub use soft_step::{SoftStepPlugin, SoftStepSolver};
+pub use soft_step::{SoftStepPlugin, SoftStepSolver, SolveBodies, SpeculativeMargin};
 pub use transform_sync::TransformSyncPlugin;
 pub use validation::ValidationPlugin;
 

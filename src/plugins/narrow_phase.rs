@@ -21,11 +21,14 @@
 use crate::bounding::Aabb;
 use crate::bvh::QueryStats;
 use crate::components::*;
-use crate::geometry::contacts::{ContactScratch, NO_TRIANGLE, contact_with_scratch};
+use crate::geometry::contacts::{
+    ContactScratch, NO_TRIANGLE, contact_with_scratch, speculative_contact_with_scratch,
+};
 use crate::geometry::{ContactManifold, Shape};
 use crate::hierarchy::{BvTree, HierarchyStats, PairScratch, descend_pairs};
 use crate::plugins::broad_phase::BroadPhasePairs;
 use crate::plugins::sleep::dormant;
+use crate::plugins::soft_step::LookaheadParams;
 use crate::schedule::{SubstepSchedule, SubstepSet};
 use crate::settings::SleepSettings;
 use crate::stats::{PhysicsStats, Stage};
@@ -61,8 +64,12 @@ pub struct ContactPair {
     pub collider_a: Entity,
     /// The collider of `b`'s hierarchy that touched.
     pub collider_b: Entity,
-    /// Where and how deep they touch.
+    /// Where and how deep they touch (with the rigid-body solver, also points still up to the
+    /// speculative margin apart, with negative depths).
     pub manifold: ContactManifold,
+    /// The largest normal impulse the rigid-body solver applied to this contact in one substep
+    /// of the step (N·s); 0 until it has solved, and without it.
+    pub normal_impulse: f32,
 }
 
 /// The contacts of this substep, in the broad phase's pair order.
@@ -135,21 +142,34 @@ type Node<'a> = (
     Option<&'a Children>,
 );
 
-/// A body's hierarchy, seen through the ECS, for the pair descent of [`crate::hierarchy`].
+/// A body's hierarchy, seen through the ECS, for the pair descent of [`crate::hierarchy`];
+/// its volumes grown by `grow` (half a pair's speculative margin: two volumes each grown by
+/// half of it meet when the parts are within the margin).
 struct EcsTree<'q, 'w, 's, 'd> {
     nodes: &'q Query<'w, 's, Node<'d>, Without<Quarantined>>,
+    grow: f32,
+}
+
+impl EcsTree<'_, '_, '_, '_> {
+    fn grown(&self, b: Aabb) -> Aabb {
+        if self.grow > 0.0 && b.is_valid() {
+            b.expanded(self.grow)
+        } else {
+            b
+        }
+    }
 }
 
 impl BvTree for EcsTree<'_, '_, '_, '_> {
     type Node = Entity;
 
     fn subtree_bv(&self, n: Entity) -> Aabb {
-        self.nodes.get(n).map_or(Aabb::EMPTY, |(_, _, bv, _)| bv.0)
+        self.grown(self.nodes.get(n).map_or(Aabb::EMPTY, |(_, _, bv, _)| bv.0))
     }
 
     fn own_bv(&self, n: Entity) -> Option<Aabb> {
         let (collider, global, ..) = self.nodes.get(n).ok()?;
-        collider.map(|c| c.shape.world_aabb(&global.0))
+        collider.map(|c| self.grown(c.shape.world_aabb(&global.0)))
     }
 
     fn children(&self, n: Entity, out: &mut Vec<Entity>) {
@@ -162,11 +182,21 @@ impl BvTree for EcsTree<'_, '_, '_, '_> {
 /// Whether a body is static or asleep (see [`crate::plugins::sleep`]).
 pub(crate) type Dormancy<'a> = (Has<Static>, Option<&'a SleepState>);
 
+/// What a root body's speculative margin depends on.
+type Motion<'a> = (
+    Has<Static>,
+    Option<&'a Velocity>,
+    Option<&'a AngularVelocity>,
+    &'a BoundingVolume,
+);
+
 #[allow(clippy::too_many_arguments)]
 fn compute_contacts(
     pairs: Res<BroadPhasePairs>,
     nodes: Query<Node, Without<Quarantined>>,
     dormancy: Query<Dormancy>,
+    motion: Query<Motion>,
+    lookahead: LookaheadParams,
     sleep: Option<Res<SleepSettings>>,
     mut contacts: ResMut<Contacts>,
     mut scratch: ResMut<NarrowPhaseScratch>,
@@ -185,7 +215,11 @@ fn compute_contacts(
     scratch.contact.set_record_hits(record);
     debug.pairs.clear();
     visits.clear();
-    let tree = EcsTree { nodes: &nodes };
+    let lookahead = lookahead.get();
+    let margin = |e: Entity| match motion.get(e) {
+        Ok((false, v, w, bv)) => lookahead.of(v, w, bv),
+        _ => 0.0,
+    };
     let start = Instant::now();
     contacts.pairs.clear();
     let sleeping = sleep.is_some_and(|s| s.enabled);
@@ -194,11 +228,16 @@ fn compute_contacts(
         if sleeping && dormant(a) && dormant(b) {
             continue; // at rest against each other: nothing to compute until one wakes
         }
+        let margin = margin(a) + margin(b);
         let compound = |e: Entity| matches!(nodes.get(e), Ok((.., Some(_))));
         if !compound(a) && !compound(b) {
-            scratch.test_leaves(&nodes, (a, b), (a, b), &mut contacts, &mut debug);
+            scratch.test_leaves(&nodes, (a, b), (a, b), margin, &mut contacts, &mut debug);
             continue;
         }
+        let tree = EcsTree {
+            nodes: &nodes,
+            grow: 0.5 * margin,
+        };
         let NarrowPhaseScratch {
             pairs: stack,
             leaf_pairs,
@@ -220,7 +259,7 @@ fn compute_contacts(
         }
         for i in 0..scratch.leaf_pairs.len() {
             let leaves = scratch.leaf_pairs[i];
-            scratch.test_leaves(&nodes, (a, b), leaves, &mut contacts, &mut debug);
+            scratch.test_leaves(&nodes, (a, b), leaves, margin, &mut contacts, &mut debug);
         }
     }
     if visits.enabled {
@@ -248,12 +287,13 @@ fn compute_contacts(
 
 impl NarrowPhaseScratch {
     /// Tests collider `leaves.0` (of body `roots.0`) against collider `leaves.1` (of `roots.1`)
-    /// at their world poses; a mesh goes through its BVH.
+    /// at their world poses, looking `margin` ahead; a mesh goes through its BVH.
     fn test_leaves(
         &mut self,
         nodes: &Query<Node, Without<Quarantined>>,
         (a, b): (Entity, Entity),
         (la, lb): (Entity, Entity),
+        margin: f32,
         contacts: &mut Contacts,
         debug: &mut OverlappingLeaves,
     ) {
@@ -261,7 +301,25 @@ impl NarrowPhaseScratch {
         else {
             return;
         };
-        let m = contact_with_scratch(&ca.shape, &ga.0, &cb.shape, &gb.0, &mut self.contact);
+        // The lower collider first, whatever order the broad phase found the pair in (its
+        // order follows insertion, hence archetype order): which box gives the reference face,
+        // which shape is grown by the margin, must not depend on an unrelated component.
+        let swap = lb < la;
+        let ((sa, pa), (sb, pb)) = if swap {
+            ((&cb.shape, &gb.0), (&ca.shape, &ga.0))
+        } else {
+            ((&ca.shape, &ga.0), (&cb.shape, &gb.0))
+        };
+        let scratch = &mut self.contact;
+        let mut m = if margin > 0.0 {
+            speculative_contact_with_scratch(sa, pa, sb, pb, margin, scratch)
+        } else {
+            contact_with_scratch(sa, pa, sb, pb, scratch)
+        };
+        if swap {
+            scratch.flip_hits();
+            m = m.map(ContactManifold::flipped);
+        }
         let involves_mesh = is_mesh(&ca.shape) || is_mesh(&cb.shape);
         self.mesh_pairs += u64::from(involves_mesh);
         if let Some(manifold) = m {
@@ -271,6 +329,7 @@ impl NarrowPhaseScratch {
                 collider_a: la,
                 collider_b: lb,
                 manifold,
+                normal_impulse: 0.0,
             });
             if debug.enabled && involves_mesh {
                 let overlap = leaf_overlap(la, &ca.shape, lb, &cb.shape, &self.contact);

@@ -51,13 +51,21 @@ impl Plugin for ResponsePlugin {
             .add_message::<CollisionEnded>()
             .add_systems(
                 SubstepSchedule,
-                (resolve_contacts.run_if(legacy_solver), report_collisions)
+                (
+                    resolve_contacts.run_if(legacy_solver),
+                    report_collisions.in_set(ReportCollisions),
+                )
                     .chain()
                     .run_if(any_with_component::<Collider>)
                     .in_set(SubstepSet::Response),
             );
     }
 }
+
+/// The comparison of touching pairs that writes the collision messages, as a label: whatever
+/// adds contacts after the solve (continuous collision) runs before it.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ReportCollisions;
 
 /// Solver arrays reused from step to step. Index 0 is the shared immovable body (all statics).
 #[derive(Resource, Default)]
@@ -326,6 +334,12 @@ fn part_velocity(
 #[derive(Resource, Default)]
 struct TouchingPairs(Vec<(Entity, Entity)>);
 
+/// A speculative contact (see [`crate::plugins::soft_step`]) counts as touching once a point is
+/// this close (m), or once the solver pushed along it (a fast body stopped at the surface within
+/// the step): Box2D's linear slop, so that a body resting a hair above its support under the
+/// soft contact does not flicker between touching and not.
+pub const TOUCHING_TOLERANCE: f32 = 0.005;
+
 /// Compares this substep's touching pairs with the last one's. Pairs of sleeping or static
 /// bodies were not tested (nothing moved) and still touch; when a pair ends, a sleeping body in
 /// it wakes (what it rested on moved away or vanished).
@@ -339,7 +353,13 @@ fn report_collisions(
     mut ended: MessageWriter<CollisionEnded>,
 ) {
     fresh.clear();
-    fresh.extend(contacts.pairs.iter().map(|c| (c.a.min(c.b), c.a.max(c.b))));
+    fresh.extend(
+        contacts
+            .pairs
+            .iter()
+            .filter(|c| c.normal_impulse > 0.0 || c.manifold.touching(TOUCHING_TOLERANCE))
+            .map(|c| (c.a.min(c.b), c.a.max(c.b))),
+    );
     fresh.sort_unstable();
     fresh.dedup();
     // Each pair touching before is touching still, kept (asleep or static on both sides: not

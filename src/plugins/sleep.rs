@@ -107,7 +107,7 @@ fn fall_asleep(
             continue;
         }
         // A turning body's surface moves at up to |ω| times its reach (Box2D's sleep test).
-        let turning = w.as_ref().map_or(0.0, |w| w.0.length()) * reach(volume);
+        let turning = w.as_ref().map_or(0.0, |w| w.0.length()) * volume.reach();
         if v.0.length().max(turning) >= settings.speed {
             if sleep.still_for != 0.0 {
                 sleep.still_for = 0.0;
@@ -124,15 +124,5 @@ fn fall_asleep(
                 w.bypass_change_detection().0 = Vec3::ZERO;
             }
         }
-    }
-}
-
-/// Half the diagonal of a body's bounding volume (0 when it has none).
-fn reach(volume: &BoundingVolume) -> f32 {
-    let half = volume.0.half_extents();
-    if half.is_finite() && half.cmpge(Vec3::ZERO).all() {
-        half.length()
-    } else {
-        0.0
     }
 }

@@ -48,6 +48,9 @@ pub struct BodyParams {
     /// True for bodies the solver may move (dynamic); kinematic and static bodies keep their
     /// velocities.
     pub dynamic: bool,
+    /// For a body turning with the gyroscopic term: its principal frame (in the body frame) and
+    /// `1/I` per principal axis.
+    pub gyroscopic: Option<(Quat, Vec3)>,
 }
 
 /// One body as the caller describes it at the step's start.
@@ -77,6 +80,9 @@ pub struct BodyInput {
     pub angular_damping: f32,
     /// 1 per world axis the body may turn about, 0 where locked.
     pub free_axes: Vec3,
+    /// Turn with the gyroscopic term `−ω × Iω` (Dzhanibekov's flip, a spinning top's
+    /// precession); honoured for dynamic bodies with every axis free and finite inertia.
+    pub gyroscopic: bool,
 }
 
 impl Default for BodyInput {
@@ -95,6 +101,7 @@ impl Default for BodyInput {
             linear_damping: 0.0,
             angular_damping: 0.0,
             free_axes: Vec3::ONE,
+            gyroscopic: false,
         }
     }
 }
@@ -160,6 +167,12 @@ impl SolverBodies {
             linear_damping: b.linear_damping,
             angular_damping: b.angular_damping,
             dynamic,
+            gyroscopic: (b.gyroscopic
+                && dynamic
+                && b.free_axes == Vec3::ONE
+                && b.inverse_principal_inertia.cmpgt(Vec3::ZERO).all()
+                && b.inverse_principal_inertia.is_finite())
+            .then_some((b.inertia_frame, b.inverse_principal_inertia)),
         });
         self.centers.push(b.center);
         self.orientations.push(b.orientation);

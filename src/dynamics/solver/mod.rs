@@ -8,7 +8,8 @@
 //! 1. **prepare** — contact rows with lever arms ([`ContactConstraint::prepare`]), seeded with
 //!    last step's impulses ([`WarmStartCache`]);
 //! 2. `substeps` times:
-//!    1. **integrate velocities** — gravity, forces, torques and damping;
+//!    1. **integrate velocities** — gravity, forces, torques, springs (evaluated at the
+//!       substep's state, so a stiff spring is as stable as the substep is short) and damping;
 //!    2. **warm start** — apply the accumulated impulses (each contact's points are swept in
 //!       the opposite order from the last substep, so Gauss–Seidel favours none of them);
 //!    3. **solve** — one biased pass: penetration pushed out softly, speculative points closed;
@@ -39,6 +40,8 @@ pub use contact::{ConstraintPoint, ContactConstraint, ContactInput, ContactPoint
 pub use softness::Softness;
 pub use warm_start::WarmStartCache;
 
+use crate::dynamics::forces::{ForceModel, Spring, SpringEnd};
+use crate::dynamics::free_rotation::FreeBody;
 use crate::settings::{MAX_SUBSTEPS, SettingsError};
 use glam::{Quat, Vec3};
 
@@ -122,6 +125,8 @@ pub struct Solver {
     pub settings: SoftStepSettings,
     constraints: Vec<ContactConstraint>,
     cache: WarmStartCache,
+    /// Centres and velocities of the substep, for the springs.
+    spring_state: (Vec<Vec3>, Vec<Vec3>),
 }
 
 impl Solver {
@@ -139,8 +144,15 @@ impl Solver {
         &self.constraints
     }
 
-    /// Advances `bodies` by `dt` under `contacts` (sorted by key; see the module doc).
-    pub fn step(&mut self, bodies: &mut SolverBodies, contacts: &[ContactInput], dt: f32) {
+    /// Advances `bodies` by `dt` under `contacts` (sorted by key; see the module doc) and
+    /// `springs` (their `body` and `other` are slots; each pulls its bodies' centres of mass).
+    pub fn step(
+        &mut self,
+        bodies: &mut SolverBodies,
+        contacts: &[ContactInput],
+        springs: &[Spring],
+        dt: f32,
+    ) {
         // The settings are public: unusable ones (a NaN stiffness, u32::MAX substeps) step with
         // the defaults rather than hang or spread NaN.
         let s = self.settings.validated().unwrap_or_default();
@@ -154,6 +166,9 @@ impl Solver {
         self.prepare(bodies, contacts, h);
         for _ in 0..substeps {
             integrate_velocities(bodies, h);
+            if !springs.is_empty() {
+                self.apply_springs(bodies, springs, h);
+            }
             for c in &mut self.constraints {
                 c.flip = !c.flip;
             }
@@ -170,6 +185,33 @@ impl Solver {
         let orientations = &bodies.orientations;
         self.cache
             .store(&self.constraints, |a| orientations[a as usize], h);
+    }
+
+    /// Each spring's impulse for one substep, from the bodies' state now; an end past the
+    /// bodies (a bad slot) is skipped.
+    fn apply_springs(&mut self, bodies: &mut SolverBodies, springs: &[Spring], h: f32) {
+        let (centers, velocities) = &mut self.spring_state;
+        centers.clear();
+        velocities.clear();
+        for (i, state) in bodies.states.iter().enumerate() {
+            centers.push(bodies.centers[i] + state.delta_position);
+            velocities.push(state.linear_velocity);
+        }
+        let n = centers.len();
+        for spring in springs {
+            let other = match spring.other {
+                SpringEnd::Body(j) => Some(j),
+                SpringEnd::Anchor(_) => None,
+            };
+            if spring.body >= n || other.is_some_and(|j| j >= n) {
+                continue;
+            }
+            let f = ForceModel::spring_force(spring, centers, velocities) * h;
+            push(bodies, spring.body, f);
+            if let Some(j) = other {
+                push(bodies, j, -f);
+            }
+        }
     }
 
     /// One pass over every contact: biased (push-out) or relaxing (no bias, friction).
@@ -205,25 +247,37 @@ impl Solver {
     }
 }
 
-/// Gravity, forces and torques for one substep, then damping `1/(1 + h c)` (stable for any
-/// rate). Kinematic and static bodies keep their velocities.
+/// Adds `impulse` to body `i`'s momentum, if it is dynamic.
+fn push(bodies: &mut SolverBodies, i: usize, impulse: Vec3) {
+    let p = &bodies.params[i];
+    if p.dynamic {
+        bodies.states[i].linear_velocity += impulse * p.inverse_mass;
+    }
+}
+
+/// Gravity, forces and torques for one substep, then damping by the exact decay `e^{−h c}`
+/// (stable for any rate, and free drift decays as `e^{−c t}` whatever the substep; Box2D's
+/// `1/(1 + h c)` is its first-order approximation). Kinematic and static bodies keep their
+/// velocities.
 fn integrate_velocities(bodies: &mut SolverBodies, h: f32) {
+    let decay = |c: f32| if c > 0.0 { (-h * c).exp() } else { 1.0 };
     for (state, p) in bodies.states.iter_mut().zip(&bodies.params) {
         if !p.dynamic {
             continue;
         }
         state.linear_velocity =
-            (state.linear_velocity + p.linear_acceleration * h) / (1.0 + h * p.linear_damping);
+            (state.linear_velocity + p.linear_acceleration * h) * decay(p.linear_damping);
         state.angular_velocity =
-            (state.angular_velocity + p.angular_acceleration * h) / (1.0 + h * p.angular_damping);
+            (state.angular_velocity + p.angular_acceleration * h) * decay(p.angular_damping);
     }
 }
 
 /// Moves every body by its velocity for one substep: `dp += h v`, and `dq` turned by `h ω`
 /// (the linearised quaternion update, renormalised, as Box2D; at most `max_rotation` per
-/// substep).
+/// substep). A gyroscopic body turning noticeably instead follows the free rigid body's exact
+/// flow for `h` ([`FreeBody`]: McLachlan's splitting, momentum exact), which also updates `ω`.
 fn integrate_positions(bodies: &mut SolverBodies, h: f32, max_rotation: f32) {
-    for state in &mut bodies.states {
+    for (i, state) in bodies.states.iter_mut().enumerate() {
         state.delta_position += state.linear_velocity * h;
         let mut w = state.angular_velocity;
         if w == Vec3::ZERO {
@@ -235,7 +289,21 @@ fn integrate_positions(bodies: &mut SolverBodies, h: f32, max_rotation: f32) {
             state.angular_velocity = w;
         }
         let dq = state.delta_rotation;
+        if let Some((frame, inverse_moments)) = bodies.params[i].gyroscopic
+            && turn > GYROSCOPIC_MIN_TURN
+        {
+            let start = bodies.orientations[i];
+            let mut free = FreeBody::new(dq * start, frame, inverse_moments, w);
+            free.drift(f64::from(h));
+            state.delta_rotation = (free.orientation(frame) * start.inverse()).normalize();
+            state.angular_velocity = free.angular_velocity();
+            continue;
+        }
         let spin = Quat::from_xyzw(w.x, w.y, w.z, 0.0) * dq;
         state.delta_rotation = (dq + spin * (0.5 * h)).normalize();
     }
 }
+
+/// Below this turn per substep (rad) the gyroscopic term changes `ω` by less than `turn²` of
+/// itself per substep, far below the contacts' own error: the linearised update is used.
+const GYROSCOPIC_MIN_TURN: f32 = 1e-4;

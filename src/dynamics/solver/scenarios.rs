@@ -99,7 +99,7 @@ impl Scene {
                 for (p, cp) in input.points.iter_mut().zip(m.points()) {
                     *p = ContactPointInput {
                         point: cp.point,
-                        separation: cp.separation,
+                        separation: -cp.depth,
                     };
                 }
                 self.contacts.push(input);
@@ -123,7 +123,7 @@ impl Scene {
                 ..Default::default()
             });
         }
-        self.solver.step(&mut self.arrays, &self.contacts, DT);
+        self.solver.step(&mut self.arrays, &self.contacts, &[], DT);
         for (i, b) in self.bodies.iter_mut().enumerate() {
             b.center = self.arrays.center(i);
             b.orientation = self.arrays.orientation(i);

@@ -1,5 +1,5 @@
 //! Speculative contacts: pairs found while still apart by up to a margin, with their
-//! separations, so that a solver that detects once per step can stop a body at the surface
+//! separations as negative depths, so that a solver that detects once per step can stop a body at the surface
 //! before it gets there (Catto, "Speculative Contacts", 2013; Box2D's 2 cm speculative
 //! distance).
 //!
@@ -7,12 +7,12 @@
 //! tested grown by the margin — a ball's radius, a box's half extents — and each point's
 //! separation is the margin minus its depth against the grown shape. For a ball this is exact;
 //! for a box it is exact across faces and errs on the early side near edges and corners (a
-//! grown box is not a rounded one), which only makes a contact speculative sooner. Half-spaces
-//! and meshes are not grown: a pair of them reports penetration only.
+//! grown box is not a rounded one), which only makes a contact speculative sooner. A half-space
+//! grows by moving its boundary out (exact). Meshes are not grown: two meshes report
+//! penetration only (a mesh–mesh distance query is issue 14's GJK work).
 
-use super::contact;
-use crate::geometry::{ContactManifold, Cuboid, Isometry, MAX_MANIFOLD_POINTS, Shape, Sphere};
-use glam::Vec3;
+use super::{ContactScratch, contact_with_scratch};
+use crate::geometry::{ContactManifold, ContactPoint, Cuboid, Isometry, Shape, Sphere};
 
 /// The shape grown by `margin`, or `None` if it cannot be grown.
 fn grown(shape: &Shape, margin: f32) -> Option<Shape> {
@@ -27,87 +27,104 @@ fn grown(shape: &Shape, margin: f32) -> Option<Shape> {
     }
 }
 
-/// A point of a speculative contact.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct SpeculativePoint {
-    /// World point midway between the true surfaces.
-    pub point: Vec3,
-    /// Distance between the surfaces along the normal: negative in penetration.
-    pub separation: f32,
-}
-
-/// A contact found with a speculative margin: points that may still be apart.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SpeculativeContact {
-    /// Unit normal from A to B.
-    pub normal: Vec3,
-    points: [SpeculativePoint; MAX_MANIFOLD_POINTS],
-    len: u8,
-}
-
-impl SpeculativeContact {
-    /// The points.
-    pub fn points(&self) -> &[SpeculativePoint] {
-        &self.points[..self.len as usize]
-    }
-
-    /// The manifold of the grown shape brought back to the true surfaces: the grown surface of
-    /// A lies `added` further along the normal (of B, `added` back), so the midpoint moved by
-    /// half of it; and a point on a grown box's rim (a corner of the grown face) is pulled in
-    /// across the normal to the true box, or the lever arms would be `added` too long.
-    fn from_grown(
-        m: ContactManifold,
-        added: f32,
-        grown: Option<(&Cuboid, &Isometry)>,
-        grown_a: bool,
-    ) -> Self {
-        let shift = m.normal * (if grown_a { -0.5 } else { 0.5 } * added);
-        let mut points = [SpeculativePoint::default(); MAX_MANIFOLD_POINTS];
-        for (out, p) in points.iter_mut().zip(m.points()) {
-            let mut point = p.point + shift;
-            if let Some((c, pose)) = grown {
-                let local = pose.inverse_transform_point(point);
-                let inside = local.clamp(-c.half_extents, c.half_extents);
-                let pulled = pose.transform_point(inside);
-                // Keep the offset along the normal; remove only the part across it.
-                let off = point - pulled;
-                point = pulled + m.normal * off.dot(m.normal);
-            }
-            *out = SpeculativePoint {
-                point,
-                separation: added - p.depth,
-            };
+/// The manifold of a grown shape brought back to the true surfaces: the grown surface of A
+/// lies `added` further along the normal (of B, `added` back), so the midpoint moved by half of
+/// it, and each depth shrinks by `added` (negative: still apart); a point on a grown box's rim
+/// (a corner of the grown face) is pulled in across the normal to the true box, or the lever
+/// arms would be `added` too long.
+fn from_grown(
+    m: ContactManifold,
+    added: f32,
+    rim: Option<(&Cuboid, &Isometry)>,
+    grown_a: bool,
+) -> ContactManifold {
+    let shift = m.normal * (if grown_a { -0.5 } else { 0.5 } * added);
+    let mut out = ContactManifold::new(m.normal);
+    for p in m.points() {
+        let mut point = p.point + shift;
+        if let Some((c, pose)) = rim {
+            let local = pose.inverse_transform_point(point);
+            let inside = local.clamp(-c.half_extents, c.half_extents);
+            let pulled = pose.transform_point(inside);
+            // Keep the offset along the normal; remove only the part across it.
+            let off = point - pulled;
+            point = pulled + m.normal * off.dot(m.normal);
         }
-        Self {
-            normal: m.normal,
-            points,
-            len: m.len() as u8,
-        }
+        out.push(ContactPoint {
+            point,
+            depth: p.depth - added,
+        });
     }
+    out
 }
 
 /// The contact of `a` and `b` with a speculative `margin` (see the module doc), or `None` when
-/// they are farther apart than the margin.
+/// they are farther apart than the margin. Depths are signed: a point still `d` apart has depth
+/// `-d`. Allocates for meshes; see [`speculative_contact_with_scratch`].
 pub fn speculative_contact(
     a: &Shape,
     pose_a: &Isometry,
     b: &Shape,
     pose_b: &Isometry,
     margin: f32,
-) -> Option<SpeculativeContact> {
-    if margin > 0.0 {
+) -> Option<ContactManifold> {
+    speculative_contact_with_scratch(a, pose_a, b, pose_b, margin, &mut ContactScratch::new())
+}
+
+/// [`speculative_contact`] with caller-owned buffers (as
+/// [`contact_with_scratch`]).
+pub fn speculative_contact_with_scratch(
+    a: &Shape,
+    pose_a: &Isometry,
+    b: &Shape,
+    pose_b: &Isometry,
+    margin: f32,
+    scratch: &mut ContactScratch,
+) -> Option<ContactManifold> {
+    if margin > 0.0 && margin.is_finite() {
         if let Some(ga) = grown(a, margin) {
-            let m = contact(&ga, pose_a, b, pose_b)?;
+            let m = contact_with_scratch(&ga, pose_a, b, pose_b, scratch)?;
             let rim = cuboid_of(a).map(|c| (c, pose_a));
-            return Some(SpeculativeContact::from_grown(m, margin, rim, true));
+            return Some(from_grown(m, margin, rim, true));
         }
         if let Some(gb) = grown(b, margin) {
-            let m = contact(a, pose_a, &gb, pose_b)?;
+            let m = contact_with_scratch(a, pose_a, &gb, pose_b, scratch)?;
             let rim = cuboid_of(b).map(|c| (c, pose_b));
-            return Some(SpeculativeContact::from_grown(m, margin, rim, false));
+            return Some(from_grown(m, margin, rim, false));
+        }
+        // A half-space grows by moving its boundary out: a mesh above the ground is found.
+        if let Some(raised) = raised_half_space(a, pose_a, margin) {
+            let m = contact_with_scratch(a, &raised, b, pose_b, scratch)?;
+            return Some(from_grown(m, margin, None, true));
+        }
+        if let Some(raised) = raised_half_space(b, pose_b, margin) {
+            let m = contact_with_scratch(a, pose_a, b, &raised, scratch)?;
+            return Some(from_grown(m, margin, None, false));
         }
     }
-    contact(a, pose_a, b, pose_b).map(|m| SpeculativeContact::from_grown(m, 0.0, None, true))
+    contact_with_scratch(a, pose_a, b, pose_b, scratch)
+}
+
+/// How far a body can move in `dt`, for its speculative margin: its centre at `speed` plus
+/// gravity's `a dt²/2`, and its surface turning at `angular_speed` times its `reach` (the
+/// radius about its centre that holds it). Non-finite inputs count as no motion (validation
+/// quarantines such bodies).
+pub fn motion_bound(speed: f32, angular_speed: f32, reach: f32, acceleration: f32, dt: f32) -> f32 {
+    let d = (speed + angular_speed * reach) * dt + 0.5 * acceleration * dt * dt;
+    if d.is_finite() { d.max(0.0) } else { 0.0 }
+}
+
+/// The pose of a half-space moved `margin` out along its outward normal (`None` for any other
+/// shape).
+fn raised_half_space(shape: &Shape, pose: &Isometry, margin: f32) -> Option<Isometry> {
+    let Shape::HalfSpace(h) = shape else {
+        return None;
+    };
+    let out = pose.rotation * h.normal;
+    Some(Isometry::new(
+        pose.translation + out * margin,
+        pose.rotation,
+    ))
 }
 
 fn cuboid_of(shape: &Shape) -> Option<&Cuboid> {
@@ -120,6 +137,7 @@ fn cuboid_of(shape: &Shape) -> Option<&Cuboid> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Vec3;
 
     #[test]
     fn a_ball_above_the_ground_reports_its_exact_gap() {
@@ -128,7 +146,7 @@ mod tests {
         let at = Isometry::from_translation(Vec3::new(0.0, 0.0, 0.51));
         let c = speculative_contact(&ground, &Isometry::default(), &ball, &at, 0.02).unwrap();
         let p = c.points()[0];
-        assert!((p.separation - 0.01).abs() < 1e-6, "{}", p.separation);
+        assert!((p.depth + 0.01).abs() < 1e-6, "{}", p.depth);
         // Midway between the true surfaces (z = 0 and z = 0.01), not the grown ones.
         assert!((p.point.z - 0.005).abs() < 1e-6, "{}", p.point);
         assert!(speculative_contact(&ground, &Isometry::default(), &ball, &at, 0.005).is_none());
@@ -143,8 +161,22 @@ mod tests {
         assert_eq!(c.points().len(), 4);
         for p in c.points() {
             assert!((p.point.x.abs() - 0.5).abs() < 1e-5 && (p.point.y.abs() - 0.5).abs() < 1e-5);
-            assert!((p.separation - 0.01).abs() < 1e-5);
+            assert!((p.depth + 0.01).abs() < 1e-5);
         }
+    }
+
+    #[test]
+    fn a_mesh_box_above_the_ground_reports_its_gap_from_the_raised_plane() {
+        let ground = Shape::half_space(Vec3::Z);
+        let mesh = crate::geometry::TriMesh::cuboid(Vec3::splat(0.5)).unwrap();
+        let b = Shape::TriMesh(crate::geometry::MeshCollider::new(mesh).unwrap());
+        let at = Isometry::from_translation(Vec3::new(0.0, 0.0, 0.53));
+        let c = speculative_contact(&ground, &Isometry::default(), &b, &at, 0.05).unwrap();
+        assert!(!c.points().is_empty());
+        for p in c.points() {
+            assert!((p.depth + 0.03).abs() < 1e-5, "{}", p.depth);
+        }
+        assert!(speculative_contact(&ground, &Isometry::default(), &b, &at, 0.02).is_none());
     }
 
     #[test]
@@ -156,7 +188,7 @@ mod tests {
         assert!(c.normal.abs_diff_eq(Vec3::Z, 1e-6));
         assert_eq!(c.points().len(), 4);
         for p in c.points() {
-            assert!((p.separation - 0.015).abs() < 1e-5);
+            assert!((p.depth + 0.015).abs() < 1e-5);
             assert!((p.point.z - (0.5 + 0.0075)).abs() < 1e-5, "{}", p.point);
         }
     }

@@ -1,29 +1,39 @@
-//! The rigid-body solver in the ECS, opt-in: contacts turn bodies.
+//! The rigid-body solver in the ECS: contacts turn bodies.
 //!
-//! Adding [`SoftStepPlugin`] to [`UrtoPlugins`](crate::UrtoPlugins) hands integration and
+//! [`SoftStepPlugin`], added next to [`UrtoPlugins`](crate::UrtoPlugins), hands integration and
 //! contact response to the core [`Solver`] (soft-step substeps, contacts with lever arms,
-//! friction, restitution; see [`crate::dynamics::solver`]): the Integrate stage and the legacy
-//! response stand aside (their systems run only without this plugin's resource), the broad and
-//! narrow phases find the contacts at the step's start positions, and one system in the
+//! friction, restitution, springs; see [`crate::dynamics::solver`]): the Integrate stage and
+//! the legacy response stand aside (their systems run only without this plugin's resource),
+//! the broad and narrow phases find the contacts once per step at the step's start, looking
+//! ahead by each body's speculative margin ([`SpeculativeMargin`]), and one system in the
 //! Response set gathers the bodies, calls [`Solver::step`] and writes positions, rotations and
-//! velocities back. Collision messages, sleeping, hierarchies and validation work as before.
+//! velocities back. Continuous collision sweeps the solver's motion afterwards; collision
+//! messages, sleeping, hierarchies and validation work as before.
+//!
+//! It is opt-in until it is the default (issue 10); without it the legacy pipeline runs (the
+//! selected [`Integration`](crate::settings::Integration) method, bodies that do not turn on
+//! contact):
 //!
 //! ```
-//! # use bevy_app::{App, PluginGroup};
+//! # use bevy_app::App;
 //! # use urto::prelude::*;
 //! # use urto::plugins::SoftStepPlugin;
 //! let mut app = App::new();
 //! app.add_plugins((UrtoPlugins::default(), SoftStepPlugin::default()));
 //! ```
 //!
-//! What this stage does not do yet (issue 10's later stages): the ECS narrow phase reports no
-//! speculative contacts, so a falling body is caught once it touches and pushed out softly;
-//! springs are not applied; continuous collision does not sweep (it sees no integration);
-//! sleeping bodies count as immovable until game code wakes them; the parts of a kinematic
-//! compound push with their root's motion only. Bodies are ordered by entity (creation order)
+//! Not done yet (issue 10's later stages): sleeping is per body, not per island (an awake body
+//! approaching a sleeper wakes it); the parts of a kinematic compound push with their root's
+//! motion only; springs pull centres of mass. Bodies are ordered by entity (creation order)
 //! and contacts by collider pair, never by archetype iteration.
 
+mod lookahead;
+
+pub use lookahead::SpeculativeMargin;
+pub(crate) use lookahead::{Lookahead, LookaheadParams};
+
 use crate::components::*;
+use crate::dynamics::forces::{Spring as CoreSpring, SpringEnd};
 use crate::dynamics::solver::Solver;
 use crate::dynamics::solver::{
     BodyInput, ContactInput, ContactPointInput, SoftStepSettings, SolverBodies,
@@ -31,7 +41,7 @@ use crate::dynamics::solver::{
 use crate::plugins::forces::GatheredForces;
 use crate::plugins::narrow_phase::Contacts;
 use crate::schedule::{SubstepSchedule, SubstepSet};
-use crate::settings::{ContactSettings, PhysicsTimestep};
+use crate::settings::{ContactSettings, PhysicsTimestep, RotationSettings, SleepSettings};
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
@@ -57,12 +67,20 @@ impl Plugin for SoftStepPlugin {
             solver: Solver::new(settings),
             ..Default::default()
         })
+        .init_resource::<SpeculativeMargin>()
         .add_systems(
             SubstepSchedule,
-            solve_soft_step.in_set(SubstepSet::Response),
+            solve_soft_step
+                .in_set(SolveBodies)
+                .in_set(SubstepSet::Response),
         );
     }
 }
+
+/// The solver's system, as a label: continuous collision sweeps after it and the collision
+/// messages are reported after that.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct SolveBodies;
 
 /// The persistent solver and its buffers; its presence switches the legacy integration and
 /// response off.
@@ -73,6 +91,10 @@ pub struct SoftStepSolver {
     entities: Vec<Entity>,
     bodies: SolverBodies,
     contacts: Vec<ContactInput>,
+    springs: Vec<CoreSpring>,
+    waking: Vec<Entity>,
+    keyed: Vec<(ContactInput, u32)>,
+    sources: Vec<u32>,
 }
 
 /// Run condition of the stages the soft step replaces.
@@ -91,7 +113,7 @@ type Mover<'a> = (
     Option<&'a LockedAxes>,
     Option<&'a AngularDrag>,
     Option<&'a LinearDrag>,
-    Option<&'a SleepState>,
+    Option<&'a mut SleepState>,
 );
 type MoverFilter = (Without<Static>, Without<Quarantined>, Without<ChildOf>);
 #[allow(clippy::too_many_arguments)]
@@ -99,20 +121,26 @@ fn solve_soft_step(
     mut movers: Query<Mover, MoverFilter>,
     poses: Query<&GlobalPose>,
     materials: Query<(Option<&Restitution>, Option<&Friction>)>,
-    contacts: Res<Contacts>,
+    mut contacts: ResMut<Contacts>,
     gathered: Res<GatheredForces>,
     settings: Res<ContactSettings>,
+    sleep: Option<Res<SleepSettings>>,
+    rotation: Option<Res<RotationSettings>>,
     timestep: Res<PhysicsTimestep>,
     mut soft: ResMut<SoftStepSolver>,
     mut stats: ResMut<PhysicsStats>,
 ) {
     let start = Instant::now();
     let s = &mut *soft;
+    let gyroscopic = rotation.is_none_or(|r| r.gyroscopic);
+    if let Some(sleep) = sleep.filter(|s| s.enabled) {
+        wake_touched_sleepers(&mut movers, &contacts, sleep.speed, &mut s.waking);
+    }
     collect_entities(&movers, &contacts, &mut s.entities);
     s.bodies.clear();
     for &e in &s.entities {
         let input = match movers.get(e) {
-            Ok(m) if !SleepState::is_asleep(m.10) => body_input(m, &gathered),
+            Ok(m) if !SleepState::is_asleep(m.10) => body_input(m, &gathered, gyroscopic),
             _ => BodyInput {
                 center: poses
                     .get(e)
@@ -126,18 +154,26 @@ fn solve_soft_step(
         s.bodies.push(input);
     }
     add_user_forces(&gathered, &s.entities, &mut s.bodies);
+    gather_springs(&gathered, &s.entities, &s.bodies, &poses, &mut s.springs);
     gather_contacts(
         &contacts,
         &s.entities,
         &materials,
         &settings,
+        &mut s.keyed,
         &mut s.contacts,
+        &mut s.sources,
     );
-    s.solver
-        .step(&mut s.bodies, &s.contacts, timestep.substep_dt());
+    s.solver.step(
+        &mut s.bodies,
+        &s.contacts,
+        &s.springs,
+        timestep.substep_dt(),
+    );
+    report_impulses(&s.solver, &s.sources, &mut contacts);
     for (slot, &e) in s.entities.iter().enumerate() {
         if let Ok(m) = movers.get_mut(e)
-            && !SleepState::is_asleep(m.10)
+            && !SleepState::is_asleep(m.10.as_deref())
         {
             scatter(m, &s.bodies, slot);
         }
@@ -146,6 +182,44 @@ fn solve_soft_step(
     stats.set_counter("soft_step/contacts", s.contacts.len() as f64);
     stats.add_time(Stage::Response, start.elapsed());
     stats.count_run("soft_step");
+}
+
+/// Wakes each sleeping body that an awake one approaches faster than `wake_speed` along their
+/// contact's normal, or that a kinematic body touches (its parts may move on their own): the
+/// sleeper then takes part in this step's solve.
+fn wake_touched_sleepers(
+    movers: &mut Query<Mover, MoverFilter>,
+    contacts: &Contacts,
+    wake_speed: f32,
+    waking: &mut Vec<Entity>,
+) {
+    waking.clear();
+    let state = |e: Entity| {
+        movers.get(e).ok().map(|m| {
+            let asleep = SleepState::is_asleep(m.10);
+            (m.3.0, m.5.inverse() > 0.0, asleep)
+        })
+    };
+    for c in &contacts.pairs {
+        let (Some(a), Some(b)) = (state(c.a), state(c.b)) else {
+            continue;
+        };
+        // The normal points from a to b.
+        let n = c.manifold.normal;
+        if a.2 && !b.2 && (!b.1 || -b.0.dot(n) > wake_speed) {
+            waking.push(c.a);
+        }
+        if b.2 && !a.2 && (!a.1 || a.0.dot(n) > wake_speed) {
+            waking.push(c.b);
+        }
+    }
+    for &e in waking.iter() {
+        if let Ok(mut m) = movers.get_mut(e)
+            && let Some(sleep) = m.10.as_mut()
+        {
+            sleep.wake();
+        }
+    }
 }
 
 /// Every awake moving body and every body a contact names, sorted by entity (creation order),
@@ -171,7 +245,11 @@ fn collect_entities(
 }
 
 /// A moving body at the step's start: its centre of mass, inertia, gravity and damping.
-fn body_input(m: ROQueryItem<'_, '_, Mover<'_>>, gathered: &GatheredForces) -> BodyInput {
+fn body_input(
+    m: ROQueryItem<'_, '_, Mover<'_>>,
+    gathered: &GatheredForces,
+    gyroscopic: bool,
+) -> BodyInput {
     let (_, p, r, v, w, mass, inertia, locked, angular_drag, drag, _) = m;
     let inverse_mass = mass.inverse();
     let dynamic = inverse_mass > 0.0;
@@ -192,6 +270,7 @@ fn body_input(m: ROQueryItem<'_, '_, Mover<'_>>, gathered: &GatheredForces) -> B
         linear_damping: drag.map_or(0.0, |d| d.0 * inverse_mass),
         angular_damping: angular_drag.map_or(0.0, |d| d.0),
         free_axes: locked.map_or(Vec3::ONE, |l| l.free_rotation_axes()),
+        gyroscopic,
     }
 }
 
@@ -215,15 +294,56 @@ fn add_user_forces(gathered: &GatheredForces, entities: &[Entity], bodies: &mut 
     }
 }
 
-/// The narrow phase's manifolds as solver contacts, keyed by collider pair (sorted).
+/// The step's springs between solver slots. An end that is no solver body is an anchor at its
+/// world position; an end with no finite position (quarantined, gone) drops the spring, so a
+/// bad body never reaches a good one through it.
+fn gather_springs(
+    gathered: &GatheredForces,
+    entities: &[Entity],
+    bodies: &SolverBodies,
+    poses: &Query<&GlobalPose>,
+    out: &mut Vec<CoreSpring>,
+) {
+    out.clear();
+    for (owner, s) in &gathered.springs {
+        let Ok(body) = entities.binary_search(owner) else {
+            continue;
+        };
+        let other = match s.target {
+            SpringTarget::Point(p) => SpringEnd::Anchor(p),
+            SpringTarget::Entity(e) => match entities.binary_search(&e) {
+                Ok(j) if bodies.params[j].dynamic => SpringEnd::Body(j),
+                _ => match poses.get(e) {
+                    Ok(p) => SpringEnd::Anchor(p.0.translation),
+                    Err(_) => continue,
+                },
+            },
+        };
+        if matches!(other, SpringEnd::Anchor(p) if !p.is_finite()) {
+            continue;
+        }
+        out.push(CoreSpring {
+            body,
+            other,
+            rest_length: s.rest_length,
+            stiffness: s.stiffness,
+            damping: s.damping,
+        });
+    }
+}
+
+/// The narrow phase's manifolds as solver contacts, keyed by collider pair (sorted), each with
+/// the index of the pair it came from (`sources`).
 fn gather_contacts(
     contacts: &Contacts,
     entities: &[Entity],
     materials: &Query<(Option<&Restitution>, Option<&Friction>)>,
     settings: &ContactSettings,
+    keyed: &mut Vec<(ContactInput, u32)>,
     out: &mut Vec<ContactInput>,
+    sources: &mut Vec<u32>,
 ) {
-    out.clear();
+    keyed.clear();
     let material = |e: Entity| {
         let (r, f) = materials.get(e).unwrap_or((None, None));
         (
@@ -231,7 +351,7 @@ fn gather_contacts(
             f.map_or(settings.default_friction, |f| f.0),
         )
     };
-    for pair in &contacts.pairs {
+    for (source, pair) in contacts.pairs.iter().enumerate() {
         let (Ok(a), Ok(b)) = (
             entities.binary_search(&pair.a),
             entities.binary_search(&pair.b),
@@ -262,19 +382,36 @@ fn gather_contacts(
                 separation: -cp.depth,
             };
         }
-        out.push(input);
+        keyed.push((input, source as u32));
     }
     // Stable: the manifolds of one collider pair (meshes) keep the narrow phase's order, and
     // their rank among the pair's manifolds makes each key unique.
-    out.sort_by_key(|c| c.key);
+    keyed.sort_by_key(|(c, _)| c.key);
+    out.clear();
+    sources.clear();
     let mut rank = 0u128;
-    for i in 0..out.len() {
-        rank = if i > 0 && out[i].key >> 16 == out[i - 1].key >> 16 {
+    for (i, &(mut input, source)) in keyed.iter().enumerate() {
+        rank = if i > 0 && input.key >> 16 == keyed[i - 1].0.key >> 16 {
             rank + 1
         } else {
             0
         };
-        out[i].key |= rank.min(0xffff);
+        input.key |= rank.min(0xffff);
+        out.push(input);
+        sources.push(source);
+    }
+}
+
+/// Each contact's largest normal impulse of the step, back to the pair it came from (the
+/// collision messages count a speculative contact that pushed as touching).
+fn report_impulses(solver: &Solver, sources: &[u32], contacts: &mut Contacts) {
+    for (c, &source) in solver.constraints().iter().zip(sources) {
+        let impulse = c.points[..c.count as usize]
+            .iter()
+            .fold(0.0f32, |m, p| m.max(p.max_normal_impulse));
+        if let Some(pair) = contacts.pairs.get_mut(source as usize) {
+            pair.normal_impulse = impulse;
+        }
     }
 }
 
