@@ -310,7 +310,7 @@ impl ResponseBuffers {
 
 /// The velocity of the point `at` of `part` relative to its root `body`, from how the part moved
 /// in the root's frame since the step began; `None` until both have a [`StepStartPose`].
-fn part_velocity(
+pub(crate) fn part_velocity(
     body: Entity,
     part: Entity,
     at: Vec3,

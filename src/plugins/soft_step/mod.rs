@@ -23,8 +23,8 @@
 //! ```
 //!
 //! Not done yet (issue 10's later stages): sleeping is per body, not per island (an awake body
-//! approaching a sleeper wakes it); the parts of a kinematic compound push with their root's
-//! motion only; springs pull centres of mass. Bodies are ordered by entity (creation order)
+//! approaching a sleeper wakes it); two meshes are found only once they touch; springs pull
+//! centres of mass. Bodies are ordered by entity (creation order)
 //! and contacts by collider pair, never by archetype iteration.
 
 mod lookahead;
@@ -40,6 +40,7 @@ use crate::dynamics::solver::{
 };
 use crate::plugins::forces::GatheredForces;
 use crate::plugins::narrow_phase::Contacts;
+use crate::plugins::response::part_velocity;
 use crate::schedule::{SubstepSchedule, SubstepSet};
 use crate::settings::{ContactSettings, PhysicsTimestep, RotationSettings, SleepSettings};
 use crate::stats::{PhysicsStats, Stage};
@@ -71,6 +72,7 @@ impl Plugin for SoftStepPlugin {
         .add_systems(
             SubstepSchedule,
             solve_soft_step
+                .run_if(any_with_component::<Velocity>)
                 .in_set(SolveBodies)
                 .in_set(SubstepSet::Response),
         );
@@ -119,7 +121,7 @@ type MoverFilter = (Without<Static>, Without<Quarantined>, Without<ChildOf>);
 #[allow(clippy::too_many_arguments)]
 fn solve_soft_step(
     mut movers: Query<Mover, MoverFilter>,
-    poses: Query<&GlobalPose>,
+    poses: Query<(&GlobalPose, Option<&StepStartPose>)>,
     materials: Query<(Option<&Restitution>, Option<&Friction>)>,
     mut contacts: ResMut<Contacts>,
     gathered: Res<GatheredForces>,
@@ -136,7 +138,7 @@ fn solve_soft_step(
     if let Some(sleep) = sleep.filter(|s| s.enabled) {
         wake_touched_sleepers(&mut movers, &contacts, sleep.speed, &mut s.waking);
     }
-    collect_entities(&movers, &contacts, &mut s.entities);
+    let awake = collect_entities(&movers, &contacts, &mut s.entities);
     s.bodies.clear();
     for &e in &s.entities {
         let input = match movers.get(e) {
@@ -144,7 +146,7 @@ fn solve_soft_step(
             _ => BodyInput {
                 center: poses
                     .get(e)
-                    .map(|p| p.0.translation)
+                    .map(|(p, _)| p.0.translation)
                     .ok()
                     .filter(|c| c.is_finite())
                     .unwrap_or(Vec3::ZERO),
@@ -164,6 +166,15 @@ fn solve_soft_step(
         &mut s.contacts,
         &mut s.sources,
     );
+    add_part_motion(
+        &contacts,
+        &s.entities,
+        &poses,
+        timestep.substep_dt(),
+        &s.sources,
+        &mut s.contacts,
+        &mut s.bodies,
+    );
     s.solver.step(
         &mut s.bodies,
         &s.contacts,
@@ -179,6 +190,7 @@ fn solve_soft_step(
         }
     }
     stats.set_counter("soft_step/bodies", s.entities.len() as f64);
+    stats.set_counter("soft_step/awake_bodies", awake as f64);
     stats.set_counter("soft_step/contacts", s.contacts.len() as f64);
     stats.add_time(Stage::Response, start.elapsed());
     stats.count_run("soft_step");
@@ -223,12 +235,12 @@ fn wake_touched_sleepers(
 }
 
 /// Every awake moving body and every body a contact names, sorted by entity (creation order),
-/// each once.
+/// each once; returns how many are awake moving bodies.
 fn collect_entities(
     movers: &Query<Mover, MoverFilter>,
     contacts: &Contacts,
     out: &mut Vec<Entity>,
-) {
+) -> usize {
     out.clear();
     out.extend(
         movers
@@ -236,12 +248,14 @@ fn collect_entities(
             .filter(|m| !SleepState::is_asleep(m.10))
             .map(|m| m.0),
     );
+    let awake = out.len();
     for pair in &contacts.pairs {
         out.push(pair.a);
         out.push(pair.b);
     }
     out.sort_unstable();
     out.dedup();
+    awake
 }
 
 /// A moving body at the step's start: its centre of mass, inertia, gravity and damping.
@@ -301,7 +315,7 @@ fn gather_springs(
     gathered: &GatheredForces,
     entities: &[Entity],
     bodies: &SolverBodies,
-    poses: &Query<&GlobalPose>,
+    poses: &Query<(&GlobalPose, Option<&StepStartPose>)>,
     out: &mut Vec<CoreSpring>,
 ) {
     out.clear();
@@ -314,7 +328,7 @@ fn gather_springs(
             SpringTarget::Entity(e) => match entities.binary_search(&e) {
                 Ok(j) if bodies.params[j].dynamic => SpringEnd::Body(j),
                 _ => match poses.get(e) {
-                    Ok(p) => SpringEnd::Anchor(p.0.translation),
+                    Ok((p, _)) => SpringEnd::Anchor(p.0.translation),
                     Err(_) => continue,
                 },
             },
@@ -399,6 +413,51 @@ fn gather_contacts(
         input.key |= rank.min(0xffff);
         out.push(input);
         sources.push(source);
+    }
+}
+
+/// The parts of kinematic and static compounds that the game moves (a robot's links) push with
+/// their own motion: each such contact's side becomes an extra immovable solver body at the
+/// contact, moving with the root's velocity at that point plus the part's own velocity
+/// ([`part_velocity`]). Appended after the entities' slots, so no entity's slot changes.
+fn add_part_motion(
+    contacts: &Contacts,
+    entities: &[Entity],
+    poses: &Query<(&GlobalPose, Option<&StepStartPose>)>,
+    dt: f32,
+    sources: &[u32],
+    inputs: &mut [ContactInput],
+    bodies: &mut SolverBodies,
+) {
+    for (input, &source) in inputs.iter_mut().zip(sources) {
+        let pair = &contacts.pairs[source as usize];
+        let points = &input.points[..input.count as usize];
+        let at = points.iter().map(|p| p.point).sum::<Vec3>() / points.len().max(1) as f32;
+        for slot in [&mut input.a, &mut input.b] {
+            let i = *slot as usize;
+            let (Some(&body), false) = (entities.get(i), bodies.params[i].dynamic) else {
+                continue;
+            };
+            let part = if body == pair.a {
+                pair.collider_a
+            } else {
+                pair.collider_b
+            };
+            if part == body {
+                continue;
+            }
+            let Some(v) = part_velocity(body, part, at, poses, dt).filter(|v| *v != Vec3::ZERO)
+            else {
+                continue;
+            };
+            let state = bodies.states[i];
+            let root = state.linear_velocity + state.angular_velocity.cross(at - bodies.centers[i]);
+            *slot = bodies.push(BodyInput {
+                center: at,
+                linear_velocity: root + v,
+                ..Default::default()
+            });
+        }
     }
 }
 
