@@ -245,7 +245,7 @@ fn with_the_soft_step_an_infinite_restitution_stays_bounded_and_spreads_no_nan()
 }
 
 #[test]
-fn with_the_soft_step_a_ball_dropped_from_2_5_m_bounces_to_its_analytic_apex_within_3_percent() {
+fn with_the_soft_step_a_ball_dropped_from_2_5_m_bounces_to_its_analytic_apex_within_2_percent() {
     let mut app = soft_step_app();
     app.world_mut()
         .spawn((Collider::half_space(Vec3::Z), Static, Restitution(0.6)));
@@ -259,9 +259,10 @@ fn with_the_soft_step_a_ball_dropped_from_2_5_m_bounces_to_its_analytic_apex_wit
         ))
         .id();
     // Falls 2.5 m, comes back up e² of it: the speculative contact stops the ball at the
-    // surface within the step. Measured 2.6 % low at 4 substeps of a 60 Hz step: the approach
-    // speed is taken one substep before the impact (missing one substep of gravity) and the
-    // bounce leaves the surface at the step's end, not at the impact.
+    // surface within the step, and the bounce starts from the approach speed carried on to the
+    // moment of contact. Measured 1.6 % low at 4 substeps of a 60 Hz step (2.6 % before that
+    // carry), the rest being the substeps' symplectic Euler, which loses `v h / 2` of height on
+    // each flight.
     let (mut bounced, mut apex) = (false, 0.0f32);
     for _ in 0..150 {
         urto::step(app.world_mut(), 1).unwrap();
@@ -276,7 +277,7 @@ fn with_the_soft_step_a_ball_dropped_from_2_5_m_bounces_to_its_analytic_apex_wit
     }
     let expected = 0.36 * 2.5;
     assert!(
-        (apex / expected - 1.0).abs() < 0.03,
+        (apex / expected - 1.0).abs() < 0.02,
         "apex {apex} m, analytic {expected} m"
     );
 }

@@ -122,6 +122,10 @@ pub struct ContactConstraint {
     pub inverse_mass: [f32; 2],
     /// Whether A and B may be moved (kinematic and static bodies keep their velocities).
     pub dynamic: [bool; 2],
+    /// How fast the external accelerations (gravity, forces) close the gap along the normal:
+    /// `(a_b − a_a)·n` (m/s²), to carry a speculative point's approach speed on to the moment
+    /// it touches.
+    pub closing_acceleration: f32,
 }
 
 /// What one row of one point needs in the passes (Jolt's `AxisConstraintPart`, Box2D's
@@ -159,6 +163,23 @@ fn sane_restitution(e: f32) -> f32 {
         e.clamp(0.0, 1.0)
     } else {
         0.0
+    }
+}
+
+/// The normal speed at which a point approaching at `vn` (< 0) from `s` away meets the surface:
+/// a speculative point first pushes a substep before it touches, and the step's accelerations
+/// (`closing`, < 0 when they close the gap) keep acting until it does: `v² = vn² − 2 a s`. A
+/// bounce then starts from the speed of the real impact (dropped balls came back 2.6 % short at
+/// 60 Hz without this). Touching or penetrating points keep `vn`.
+fn impact_speed(vn: f32, s: f32, closing: f32) -> f32 {
+    if s <= 0.0 || vn >= 0.0 {
+        return vn;
+    }
+    let squared = vn * vn - 2.0 * closing * s;
+    if squared.is_finite() && squared > vn * vn {
+        -squared.sqrt()
+    } else {
+        vn
     }
 }
 
@@ -212,6 +233,7 @@ impl ContactConstraint {
             flip: false,
             inverse_mass: [pa.inverse_mass, pb.inverse_mass],
             dynamic: [pa.dynamic, pb.dynamic],
+            closing_acceleration: (pb.linear_acceleration - pa.linear_acceleration).dot(n),
         }
     }
 
@@ -276,7 +298,7 @@ impl ContactConstraint {
             let applied = total - cp.normal_impulse;
             let p = &mut self.points[i];
             if p.max_normal_impulse == 0.0 && total > 0.0 {
-                p.relative_velocity = vn;
+                p.relative_velocity = impact_speed(vn, s, self.closing_acceleration);
             }
             p.normal_impulse = total;
             p.max_normal_impulse = p.max_normal_impulse.max(total);
