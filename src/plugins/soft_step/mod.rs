@@ -27,20 +27,20 @@
 //! centres of mass. Bodies are ordered by entity (creation order)
 //! and contacts by collider pair, never by archetype iteration.
 
+mod contact_inputs;
 mod lookahead;
 
 pub use lookahead::SpeculativeMargin;
+
+use contact_inputs::{add_part_motion, gather_contacts, report_impulses};
 pub(crate) use lookahead::{Lookahead, LookaheadParams};
 
 use crate::components::*;
 use crate::dynamics::forces::{Spring as CoreSpring, SpringEnd};
 use crate::dynamics::solver::Solver;
-use crate::dynamics::solver::{
-    BodyInput, ContactInput, ContactPointInput, SoftStepSettings, SolverBodies,
-};
+use crate::dynamics::solver::{BodyInput, ContactInput, SoftStepSettings, SolverBodies};
 use crate::plugins::forces::GatheredForces;
 use crate::plugins::narrow_phase::Contacts;
-use crate::plugins::response::part_velocity;
 use crate::schedule::{SubstepSchedule, SubstepSet};
 use crate::settings::{ContactSettings, PhysicsTimestep, RotationSettings, SleepSettings};
 use crate::stats::{PhysicsStats, Stage};
@@ -344,144 +344,6 @@ fn gather_springs(
             damping: s.damping,
         });
     }
-}
-
-/// The narrow phase's manifolds as solver contacts, keyed by collider pair (sorted), each with
-/// the index of the pair it came from (`sources`).
-fn gather_contacts(
-    contacts: &Contacts,
-    entities: &[Entity],
-    materials: &Query<(Option<&Restitution>, Option<&Friction>)>,
-    settings: &ContactSettings,
-    keyed: &mut Vec<(ContactInput, u32)>,
-    out: &mut Vec<ContactInput>,
-    sources: &mut Vec<u32>,
-) {
-    keyed.clear();
-    let material = |e: Entity| {
-        let (r, f) = materials.get(e).unwrap_or((None, None));
-        (
-            r.map_or(settings.default_restitution, |r| r.0),
-            f.map_or(settings.default_friction, |f| f.0),
-        )
-    };
-    for (source, pair) in contacts.pairs.iter().enumerate() {
-        let (Ok(a), Ok(b)) = (
-            entities.binary_search(&pair.a),
-            entities.binary_search(&pair.b),
-        ) else {
-            continue;
-        };
-        let ((ea, fa), (eb, fb)) = (material(pair.a), material(pair.b));
-        // The lower slot first, whatever order the broad phase found the pair in (it follows
-        // insertion, hence archetype, order).
-        let (a, b, normal) = if a <= b {
-            (a, b, pair.manifold.normal)
-        } else {
-            (b, a, -pair.manifold.normal)
-        };
-        let mut input = ContactInput {
-            a: a as u32,
-            b: b as u32,
-            normal,
-            friction: (fa * fb).max(0.0).sqrt(),
-            restitution: 0.5 * (ea + eb),
-            points: Default::default(),
-            count: pair.manifold.len() as u8,
-            key: pair_key(pair.collider_a, pair.collider_b) << 16,
-        };
-        for (p, cp) in input.points.iter_mut().zip(pair.manifold.points()) {
-            *p = ContactPointInput {
-                point: cp.point,
-                separation: -cp.depth,
-            };
-        }
-        keyed.push((input, source as u32));
-    }
-    // Stable: the manifolds of one collider pair (meshes) keep the narrow phase's order, and
-    // their rank among the pair's manifolds makes each key unique.
-    keyed.sort_by_key(|(c, _)| c.key);
-    out.clear();
-    sources.clear();
-    let mut rank = 0u128;
-    for (i, &(mut input, source)) in keyed.iter().enumerate() {
-        rank = if i > 0 && input.key >> 16 == keyed[i - 1].0.key >> 16 {
-            rank + 1
-        } else {
-            0
-        };
-        input.key |= rank.min(0xffff);
-        out.push(input);
-        sources.push(source);
-    }
-}
-
-/// The parts of kinematic and static compounds that the game moves (a robot's links) push with
-/// their own motion: each such contact's side becomes an extra immovable solver body at the
-/// contact, moving with the root's velocity at that point plus the part's own velocity
-/// ([`part_velocity`]). Appended after the entities' slots, so no entity's slot changes.
-fn add_part_motion(
-    contacts: &Contacts,
-    entities: &[Entity],
-    poses: &Query<(&GlobalPose, Option<&StepStartPose>)>,
-    dt: f32,
-    sources: &[u32],
-    inputs: &mut [ContactInput],
-    bodies: &mut SolverBodies,
-) {
-    for (input, &source) in inputs.iter_mut().zip(sources) {
-        let pair = &contacts.pairs[source as usize];
-        let points = &input.points[..input.count as usize];
-        let at = points.iter().map(|p| p.point).sum::<Vec3>() / points.len().max(1) as f32;
-        for slot in [&mut input.a, &mut input.b] {
-            let i = *slot as usize;
-            let (Some(&body), false) = (entities.get(i), bodies.params[i].dynamic) else {
-                continue;
-            };
-            let part = if body == pair.a {
-                pair.collider_a
-            } else {
-                pair.collider_b
-            };
-            if part == body {
-                continue;
-            }
-            let Some(v) = part_velocity(body, part, at, poses, dt).filter(|v| *v != Vec3::ZERO)
-            else {
-                continue;
-            };
-            let state = bodies.states[i];
-            let root = state.linear_velocity + state.angular_velocity.cross(at - bodies.centers[i]);
-            *slot = bodies.push(BodyInput {
-                center: at,
-                linear_velocity: root + v,
-                ..Default::default()
-            });
-        }
-    }
-}
-
-/// Each contact's largest normal impulse of the step, back to the pair it came from (the
-/// collision messages count a speculative contact that pushed as touching).
-fn report_impulses(solver: &Solver, sources: &[u32], contacts: &mut Contacts) {
-    for (c, &source) in solver.constraints().iter().zip(sources) {
-        let impulse = c.points[..c.count as usize]
-            .iter()
-            .fold(0.0f32, |m, p| m.max(p.max_normal_impulse));
-        if let Some(pair) = contacts.pairs.get_mut(source as usize) {
-            pair.normal_impulse = impulse;
-        }
-    }
-}
-
-/// A key for a pair of colliders, stable from step to step.
-fn pair_key(a: Entity, b: Entity) -> u128 {
-    let (lo, hi) = if a.index_u32() <= b.index_u32() {
-        (a, b)
-    } else {
-        (b, a)
-    };
-    ((lo.index_u32() as u128) << 32) | hi.index_u32() as u128
 }
 
 /// Writes a moving body's new pose and velocities.
