@@ -485,3 +485,39 @@ fn with_the_soft_step_a_ball_dropped_on_a_sleeping_ball_wakes_it() {
         "pushed aside by the off-centre hit: moved {moved}"
     );
 }
+
+/// How far a solid ball rolling at 2 m/s on flat ground gets in 5 s with rolling resistance `b`.
+fn rolled(b: Option<f32>) -> f32 {
+    let mut app = soft_step_app();
+    app.world_mut()
+        .spawn((Collider::half_space(Vec3::Z), Static, Friction(1.0)));
+    let mut ball = app.world_mut().spawn((
+        Collider::sphere(0.5),
+        Position::new(0.0, 0.0, 0.5),
+        Velocity::new(2.0, 0.0, 0.0),
+        AngularVelocity(Vec3::new(0.0, 4.0, 0.0)),
+        Friction(1.0),
+    ));
+    if let Some(b) = b {
+        ball.insert(RollingResistance(b));
+    }
+    let ball = ball.id();
+    urto::step(app.world_mut(), 300).unwrap();
+    get::<Position>(&app, ball).0.x
+}
+
+#[test]
+fn with_the_soft_step_rolling_resistance_stops_a_ball_at_the_analytic_distance_within_3_percent() {
+    // Torque b·m·g against rolling: a = (b/R) g / (1 + 2/5), stopping after v² / 2a.
+    let (b, r, v, g) = (0.05f32, 0.5f32, 2.0f32, 9.81f32);
+    let a = (b / r) * g / 1.4;
+    let expected = v * v / (2.0 * a);
+    let distance = rolled(Some(b));
+    assert!(
+        (distance / expected - 1.0).abs() < 0.03,
+        "stopped after {distance} m, analytic {expected} m"
+    );
+    // Without it the ball keeps rolling: 10 m in 5 s.
+    let free = rolled(None);
+    assert!((free / 10.0 - 1.0).abs() < 0.01, "rolled {free} m freely");
+}

@@ -141,6 +141,15 @@ pub struct Restitution(pub f32);
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
 pub struct Friction(pub f32);
 
+/// Rolling resistance (m): the lever arm `b` of the torque, at most `b` times the normal force,
+/// with which a contact resists rolling (a few millimetres for a hard ball on a hard floor;
+/// see [`crate::dynamics::solver::rolling`]). The pair uses the larger of its two bodies'
+/// values (as Box2D); absent means 0. Applied by the rigid-body solver
+/// ([`SoftStepPlugin`](crate::plugins::SoftStepPlugin)); a negative or non-finite value counts
+/// as 0.
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+pub struct RollingResistance(pub f32);
+
 /// The shape a body collides with, in the body's frame.
 #[derive(Component, Clone, Debug, PartialEq)]
 #[require(Position)]

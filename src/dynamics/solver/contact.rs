@@ -30,6 +30,7 @@
 //! creep.
 
 use super::body::{BodyParams, BodyState};
+use super::rolling::RollingRows;
 use super::softness::Softness;
 use crate::geometry::MAX_MANIFOLD_POINTS;
 use glam::Vec3;
@@ -57,6 +58,8 @@ pub struct ContactInput {
     pub friction: f32,
     /// Coefficient of restitution of the pair.
     pub restitution: f32,
+    /// Lever arm of the pair's rolling resistance (m; 0: none; see [`RollingRows`]).
+    pub rolling_resistance: f32,
     /// The points (the first `count`).
     pub points: [ContactPointInput; MAX_MANIFOLD_POINTS],
     /// How many points are used.
@@ -122,6 +125,8 @@ pub struct ContactConstraint {
     pub inverse_mass: [f32; 2],
     /// Whether A and B may be moved (kinematic and static bodies keep their velocities).
     pub dynamic: [bool; 2],
+    /// The rolling-resistance rows (none unless the pair has a lever arm).
+    pub rolling: RollingRows,
     /// How fast the external accelerations (gravity, forces) close the gap along the normal:
     /// `(a_b − a_a)·n` (m/s²), to carry a speculative point's approach speed on to the moment
     /// it touches.
@@ -234,6 +239,11 @@ impl ContactConstraint {
             inverse_mass: [pa.inverse_mass, pb.inverse_mass],
             dynamic: [pa.dynamic, pb.dynamic],
             closing_acceleration: (pb.linear_acceleration - pa.linear_acceleration).dot(n),
+            rolling: RollingRows::new(
+                input.rolling_resistance,
+                tangents,
+                [pa.inverse_inertia, pb.inverse_inertia],
+            ),
         }
     }
 
@@ -256,6 +266,10 @@ impl ContactConstraint {
                     cp.tangent_impulse[k],
                 );
             }
+        }
+        if self.rolling.arm > 0.0 {
+            let Pair { wa, wb, .. } = &mut pair;
+            self.rolling.warm_start(wa, wb);
         }
         pair.store(self, states);
     }
@@ -332,6 +346,11 @@ impl ContactConstraint {
                 pair.push_with(masses.0, t1, r1, new1 - old1);
                 cp.tangent_impulse = [new0, new1];
             }
+        }
+        if !use_bias && self.rolling.arm > 0.0 {
+            let normal: f32 = self.points[..count].iter().map(|p| p.normal_impulse).sum();
+            let Pair { wa, wb, .. } = &mut pair;
+            self.rolling.solve(wa, wb, self.tangents, normal);
         }
         pair.store(self, states);
     }

@@ -14,7 +14,7 @@
 //!       the opposite order from the last substep, so Gauss–Seidel favours none of them);
 //!    3. **solve** — one biased pass: penetration pushed out softly, speculative points closed;
 //!    4. **integrate positions** — each body's motion since the step's start (`dp`, `dq`);
-//!    5. **relax** — passes without bias, friction included (two by default, see
+//!    5. **relax** — passes without bias, friction and rolling resistance included (two by default, see
 //!       [`SoftStepSettings::relax_iterations`]);
 //! 3. **restitution** — bounces from the approach speeds at the step's start;
 //! 4. **store impulses** — for the next step's warm start.
@@ -30,6 +30,7 @@
 
 pub mod body;
 pub mod contact;
+pub mod rolling;
 pub mod softness;
 pub mod warm_start;
 
@@ -38,6 +39,7 @@ mod scenarios;
 
 pub use body::{BodyInput, BodyParams, BodyState, SolverBodies};
 pub use contact::{ConstraintPoint, ContactConstraint, ContactInput, ContactPointInput};
+pub use rolling::RollingRows;
 pub use softness::Softness;
 pub use warm_start::WarmStartCache;
 

@@ -92,6 +92,7 @@ impl Scene {
                     normal: m.normal,
                     friction: (a.friction * b.friction).sqrt(),
                     restitution: a.restitution.max(b.restitution),
+                    rolling_resistance: 0.0,
                     points: Default::default(),
                     count: m.points().len() as u8,
                     key: ((i as u128) << 32) | j as u128,

@@ -10,12 +10,19 @@ use crate::settings::ContactSettings;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 
+/// A body's contact material: restitution, friction and rolling resistance.
+pub(super) type Material = (
+    Option<&'static Restitution>,
+    Option<&'static Friction>,
+    Option<&'static RollingResistance>,
+);
+
 /// The narrow phase's manifolds as solver contacts, keyed by collider pair (sorted), each with
 /// the index of the pair it came from (`sources`).
 pub(super) fn gather_contacts(
     contacts: &Contacts,
     entities: &[Entity],
-    materials: &Query<(Option<&Restitution>, Option<&Friction>)>,
+    materials: &Query<Material>,
     settings: &ContactSettings,
     keyed: &mut Vec<(ContactInput, u32)>,
     out: &mut Vec<ContactInput>,
@@ -23,10 +30,11 @@ pub(super) fn gather_contacts(
 ) {
     keyed.clear();
     let material = |e: Entity| {
-        let (r, f) = materials.get(e).unwrap_or((None, None));
+        let (r, f, rolling) = materials.get(e).unwrap_or((None, None, None));
         (
             r.map_or(settings.default_restitution, |r| r.0),
             f.map_or(settings.default_friction, |f| f.0),
+            rolling.map_or(0.0, |r| r.0),
         )
     };
     for (source, pair) in contacts.pairs.iter().enumerate() {
@@ -36,7 +44,7 @@ pub(super) fn gather_contacts(
         ) else {
             continue;
         };
-        let ((ea, fa), (eb, fb)) = (material(pair.a), material(pair.b));
+        let ((ea, fa, ra), (eb, fb, rb)) = (material(pair.a), material(pair.b));
         // The lower slot first, whatever order the broad phase found the pair in (it follows
         // insertion, hence archetype, order).
         let (a, b, normal) = if a <= b {
@@ -50,6 +58,7 @@ pub(super) fn gather_contacts(
             normal,
             friction: (fa * fb).max(0.0).sqrt(),
             restitution: 0.5 * (ea + eb),
+            rolling_resistance: ra.max(rb),
             points: Default::default(),
             count: pair.manifold.len() as u8,
             key: pair_key(pair.collider_a, pair.collider_b) << 16,

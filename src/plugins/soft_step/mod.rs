@@ -32,7 +32,7 @@ mod lookahead;
 
 pub use lookahead::SpeculativeMargin;
 
-use contact_inputs::{add_part_motion, gather_contacts, report_impulses};
+use contact_inputs::{Material, add_part_motion, gather_contacts, report_impulses};
 pub(crate) use lookahead::{Lookahead, LookaheadParams};
 
 use crate::components::*;
@@ -122,7 +122,7 @@ type MoverFilter = (Without<Static>, Without<Quarantined>, Without<ChildOf>);
 fn solve_soft_step(
     mut movers: Query<Mover, MoverFilter>,
     poses: Query<(&GlobalPose, Option<&StepStartPose>)>,
-    materials: Query<(Option<&Restitution>, Option<&Friction>)>,
+    materials: Query<Material>,
     mut contacts: ResMut<Contacts>,
     gathered: Res<GatheredForces>,
     settings: Res<ContactSettings>,
