@@ -1,6 +1,6 @@
 //! The accuracy-cost report: what each way of buying accuracy costs in time, measured.
 //!
-//! Four experiments, one module each, every one from seeded inputs:
+//! Five experiments, one module each, every one from seeded inputs:
 //! 1. `integrators` — explicit Euler, symplectic Euler, velocity Verlet and RK4 against the
 //!    analytic projectile and spring over a range of `dt`, energy drift over a long run, wall time
 //!    per body and step, and the Pareto front of error against time;
@@ -8,7 +8,9 @@
 //!    fraction and cost against substeps and with continuous collision;
 //! 3. `bounding_volumes` — sphere / AABB / OBB / k-DOP hierarchies on the same mesh pairs: the
 //!    slides' cost model `Tc = Nv*Cv + Nn*Cn + Ns*Cs` checked against the measured time;
-//! 4. `bounce` — apex heights of a bouncing ball through the ECS plugin against `h_k = e^(2k) h_0`.
+//! 4. `bounce` — apex heights of a bouncing ball through the ECS plugin against `h_k = e^(2k) h_0`;
+//! 5. `solver` — the rigid-body solver's substeps and relax passes against a 20-box stack's
+//!    drift, penetration and sag, and their time per step.
 //!
 //! It writes `report.md` and SVG plots to `--out` (default `docs/accuracy`) and the same series
 //! to a rerun recording (`--rrd`, default `accuracy_cost.rrd`):
@@ -28,6 +30,7 @@ mod markdown;
 mod plot;
 mod progress;
 mod recording;
+mod solver;
 mod tunnelling;
 
 use clap::Parser;
@@ -85,7 +88,8 @@ fn main() -> Result<(), Box<dyn Error>> {
     let total = integrators::work_units(&cfg)
         + tunnelling::work_units(&cfg)
         + bounding_volumes::work_units(&cfg)
-        + bounce::work_units(&cfg);
+        + bounce::work_units(&cfg)
+        + solver::work_units(&cfg);
     let mut ctx = Context {
         cfg,
         out: args.out.clone(),
@@ -98,6 +102,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         tunnelling::run(&mut ctx)?,
         bounding_volumes::run(&mut ctx)?,
         bounce::run(&mut ctx)?,
+        solver::run(&mut ctx)?,
     ];
     ctx.progress.finish();
     ctx.rec.flush()?;
