@@ -17,6 +17,8 @@ use charts::{plot, record};
 use glam::Vec3;
 use std::time::Instant;
 use text::section;
+use urto::dynamics::solver::SoftStepSettings;
+use urto::plugins::SoftStepPlugin;
 use urto::prelude::*;
 
 /// Drop height of the ball's bottom above the plane (m).
@@ -46,10 +48,16 @@ struct Setting {
     dt: f32,
     substeps: u32,
     integrator: Integrator,
+    /// The rigid-body solver (`SoftStepPlugin`, its own 4 substeps) instead of the legacy
+    /// response; `integrator` is then unused.
+    soft_step: bool,
 }
 
 impl Setting {
     fn label(&self) -> String {
+        if self.soft_step {
+            return format!("soft-step solver, dt = 1/{:.0}", 1.0 / self.dt);
+        }
         format!(
             "{}, dt = 1/{:.0}{}",
             self.integrator.name(),
@@ -63,42 +71,56 @@ impl Setting {
     }
 }
 
-/// The settings compared: the default, each integrator, smaller and larger steps, substeps.
-const SETTINGS: [Setting; 7] = [
+/// The settings compared: the default, each integrator, smaller and larger steps, substeps, and
+/// the rigid-body solver.
+const SETTINGS: [Setting; 8] = [
     Setting {
         dt: 1.0 / 60.0,
         substeps: 1,
         integrator: Integrator::SymplecticEuler,
+        soft_step: false,
     },
     Setting {
         dt: 1.0 / 60.0,
         substeps: 1,
         integrator: Integrator::ExplicitEuler,
+        soft_step: false,
     },
     Setting {
         dt: 1.0 / 60.0,
         substeps: 1,
         integrator: Integrator::VelocityVerlet,
+        soft_step: false,
     },
     Setting {
         dt: 1.0 / 60.0,
         substeps: 1,
         integrator: Integrator::Rk4,
+        soft_step: false,
     },
     Setting {
         dt: 1.0 / 30.0,
         substeps: 1,
         integrator: Integrator::SymplecticEuler,
+        soft_step: false,
     },
     Setting {
         dt: 1.0 / 60.0,
         substeps: 4,
         integrator: Integrator::SymplecticEuler,
+        soft_step: false,
     },
     Setting {
         dt: 1.0 / 240.0,
         substeps: 1,
         integrator: Integrator::SymplecticEuler,
+        soft_step: false,
+    },
+    Setting {
+        dt: 1.0 / 60.0,
+        substeps: 1,
+        integrator: Integrator::SymplecticEuler,
+        soft_step: true,
     },
 ];
 
@@ -159,6 +181,15 @@ fn drop_ball(setting: Setting) -> BounceRun {
     let mut app = app_with(setting.dt, setting.substeps);
     app.insert_resource(Gravity::EARTH_Z_UP)
         .insert_resource(Integration(setting.integrator));
+    if setting.soft_step {
+        // The legacy response's bounce threshold, so that both end the sequence alike.
+        let threshold = ContactSettings::default().solver.restitution_threshold;
+        let settings = SoftStepSettings {
+            restitution_threshold: threshold,
+            ..Default::default()
+        };
+        app.add_plugins(SoftStepPlugin { settings });
+    }
     let world = app.world_mut();
     world.spawn((Collider::half_space(Vec3::Z), Static, Restitution(E)));
     let ball = world
