@@ -509,7 +509,8 @@ fn rolled(b: Option<f32>) -> f32 {
 #[test]
 fn with_the_soft_step_rolling_resistance_stops_a_ball_at_the_analytic_distance_within_3_percent() {
     // Torque b·m·g against rolling: a = (b/R) g / (1 + 2/5), stopping after v² / 2a.
-    let (b, r, v, g) = (0.05f32, 0.5f32, 2.0f32, 9.81f32);
+    let (b, r, v) = (0.05f32, 0.5f32, 2.0f32);
+    let g = Gravity::EARTH_Z_UP.acceleration().length();
     let a = (b / r) * g / 1.4;
     let expected = v * v / (2.0 * a);
     let distance = rolled(Some(b));
