@@ -522,3 +522,62 @@ fn with_the_soft_step_rolling_resistance_stops_a_ball_at_the_analytic_distance_w
     let free = rolled(None);
     assert!((free / 10.0 - 1.0).abs() < 0.01, "rolled {free} m freely");
 }
+
+#[test]
+fn with_the_soft_step_50_dominoes_topple_in_order_each_within_2_s_of_the_one_before() {
+    let mut app = soft_step_app();
+    app.world_mut()
+        .spawn((Collider::half_space(Vec3::Z), Static, Friction(0.6)));
+    // Dominoes 1 m tall, 0.5 m wide and 0.1 m thick, 0.5 m apart along x.
+    let dominoes: Vec<Entity> = (0..50)
+        .map(|i| {
+            app.world_mut()
+                .spawn((
+                    Collider::cuboid(0.05, 0.25, 0.5),
+                    Position::new(0.5 * i as f32, 0.0, 0.5),
+                    Velocity::default(),
+                    Friction(0.6),
+                    Restitution(0.0),
+                ))
+                .id()
+        })
+        .collect();
+    // Tip the first one towards the others.
+    app.world_mut()
+        .entity_mut(dominoes[0])
+        .insert(AngularVelocity(Vec3::new(0.0, 2.0, 0.0)));
+    let mut fell_at: Vec<Option<f32>> = vec![None; dominoes.len()];
+    for step in 1..=900 {
+        urto::step(app.world_mut(), 1).unwrap();
+        for (i, &d) in dominoes.iter().enumerate() {
+            let up = get::<Rotation>(&app, d).0 * Vec3::Z;
+            if fell_at[i].is_none() && up.z < 0.7 {
+                fell_at[i] = Some(step as f32 / 60.0);
+            }
+        }
+    }
+    let times: Vec<f32> = fell_at
+        .iter()
+        .enumerate()
+        .map(|(i, t)| t.unwrap_or_else(|| panic!("domino {i} still stands")))
+        .collect();
+    eprintln!(
+        "dominoes fell from {} s to {} s",
+        times[0],
+        times[times.len() - 1]
+    );
+    for (i, w) in times.windows(2).enumerate() {
+        assert!(
+            w[1] >= w[0] && w[1] - w[0] < 2.0,
+            "domino {} fell at {} s after domino {i} at {} s",
+            i + 1,
+            w[1],
+            w[0]
+        );
+    }
+    // And they fell forwards, along +x.
+    for &d in &dominoes {
+        let up = get::<Rotation>(&app, d).0 * Vec3::Z;
+        assert!(up.x > 0.5, "a domino fell sideways or backwards: up {up}");
+    }
+}
