@@ -8,7 +8,7 @@ use crate::dynamics::response::{
 };
 use crate::geometry::ContactManifold;
 use crate::plugins::narrow_phase::{ContactPair, Contacts};
-use crate::plugins::sleep::dormant;
+use crate::plugins::sleep::{ContactSide, dormant, wakes};
 use crate::plugins::soft_step::legacy_solver;
 use crate::schedule::{SubstepSchedule, SubstepSet};
 use crate::settings::{ContactSettings, PhysicsTimestep, SleepSettings};
@@ -265,22 +265,21 @@ impl ResponseBuffers {
         wake_speed: f32,
     ) {
         let state = |e: Entity| {
-            bodies
-                .get(e)
-                .ok()
-                .map(|(_, v, m, s)| (v.0, m.inverse() > 0.0, s.is_some_and(|s| s.asleep)))
+            bodies.get(e).ok().map(|(_, v, m, s)| ContactSide {
+                velocity: v.0,
+                dynamic: m.inverse() > 0.0,
+                asleep: s.is_some_and(|s| s.asleep),
+            })
         };
         for c in contacts {
             let (Some(a), Some(b)) = (state(c.a), state(c.b)) else {
                 continue;
             };
-            // The normal points from a to b. A kinematic body (its parts may move on their own)
-            // always wakes what it touches; a dynamic one when it approaches fast enough.
-            let n = c.manifold.normal;
-            if a.2 && !b.2 && (!b.1 || -b.0.dot(n) > wake_speed) {
+            let [wake_a, wake_b] = wakes(a, b, c.manifold.normal, wake_speed);
+            if wake_a {
                 self.waking.push(c.a);
             }
-            if b.2 && !a.2 && (!a.1 || a.0.dot(n) > wake_speed) {
+            if wake_b {
                 self.waking.push(c.b);
             }
         }

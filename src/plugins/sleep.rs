@@ -51,6 +51,26 @@ pub(crate) fn dormant(state: Option<(bool, Option<&SleepState>)>) -> bool {
     }
 }
 
+/// How a body in a contact stands for the wake-up rule: its velocity, whether it is dynamic,
+/// whether it sleeps.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ContactSide {
+    pub velocity: Vec3,
+    pub dynamic: bool,
+    pub asleep: bool,
+}
+
+/// Which sides of a contact (normal `n` from A to B) wake: a sleeper whose awake partner
+/// approaches it faster than `wake_speed` along the normal, or whose partner is kinematic
+/// (its parts may move on their own). Gravity's pull on a body resting on a sleeper counts as
+/// approach, so a stack wakes as a whole.
+pub(crate) fn wakes(a: ContactSide, b: ContactSide, n: Vec3, wake_speed: f32) -> [bool; 2] {
+    [
+        a.asleep && !b.asleep && (!b.dynamic || -b.velocity.dot(n) > wake_speed),
+        b.asleep && !a.asleep && (!a.dynamic || a.velocity.dot(n) > wake_speed),
+    ]
+}
+
 type Sleeper<'a> = (
     &'a mut SleepState,
     &'a Position,

@@ -41,6 +41,7 @@ use crate::dynamics::solver::Solver;
 use crate::dynamics::solver::{BodyInput, ContactInput, SoftStepSettings, SolverBodies};
 use crate::plugins::forces::GatheredForces;
 use crate::plugins::narrow_phase::Contacts;
+use crate::plugins::sleep::{ContactSide, wakes};
 use crate::schedule::{SubstepSchedule, SubstepSet};
 use crate::settings::{ContactSettings, PhysicsTimestep, RotationSettings, SleepSettings};
 use crate::stats::{PhysicsStats, Stage};
@@ -207,21 +208,21 @@ fn wake_touched_sleepers(
 ) {
     waking.clear();
     let state = |e: Entity| {
-        movers.get(e).ok().map(|m| {
-            let asleep = SleepState::is_asleep(m.10);
-            (m.3.0, m.5.inverse() > 0.0, asleep)
+        movers.get(e).ok().map(|m| ContactSide {
+            velocity: m.3.0,
+            dynamic: m.5.inverse() > 0.0,
+            asleep: SleepState::is_asleep(m.10),
         })
     };
     for c in &contacts.pairs {
         let (Some(a), Some(b)) = (state(c.a), state(c.b)) else {
             continue;
         };
-        // The normal points from a to b.
-        let n = c.manifold.normal;
-        if a.2 && !b.2 && (!b.1 || -b.0.dot(n) > wake_speed) {
+        let [wake_a, wake_b] = wakes(a, b, c.manifold.normal, wake_speed);
+        if wake_a {
             waking.push(c.a);
         }
-        if b.2 && !a.2 && (!a.1 || a.0.dot(n) > wake_speed) {
+        if wake_b {
             waking.push(c.b);
         }
     }
