@@ -7,6 +7,9 @@
 //! - Bounded static scenery is in a hashed uniform grid (the slides' "object vs static scene"):
 //!   indexed once, queried with each moving body's volume; statics never enter the sort.
 //! - Unbounded scenery (grounds, walls) is paired with every moving body.
+//! - With the rigid-body solver, a moving body's volume in the sweep is grown by its speculative
+//!   margin ([`SpeculativeMargin`](crate::plugins::SpeculativeMargin)), and a new velocity
+//!   re-indexes it, so pairs are found while the bodies can still close in one step.
 //!
 //! The moving-body algorithm is replaceable: any [`BroadPhase`] works, e.g.
 //! `BroadPhasePlugin { moving: || Box::new(SortAndSweep::new()), ..default() }`.

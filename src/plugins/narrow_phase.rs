@@ -6,6 +6,12 @@
 //! hierarchy's work is published as `hierarchy/bv_tests`, `hierarchy/nodes_visited` and
 //! `hierarchy/collider_pairs`.
 //!
+//! With the rigid-body solver each pair is tested looking ahead by the sum of its two bodies'
+//! speculative margins ([`speculative_contact_with_scratch`]: grown spheres and boxes, raised
+//! half-spaces; two meshes only once they touch), so manifolds may hold points still apart
+//! (negative depth). A pair is always computed with its lower collider first, so which shape is
+//! grown and which face is the reference never follow the broad phase's (archetype) order.
+//!
 //! Pairs involving a mesh go through the mesh's bounding-volume hierarchy
 //! ([`contact_with_scratch`]) with buffers kept in a resource from step to step, so a warm step
 //! allocates nothing. The hierarchy work of the step — the slides' cost counters `Nv`, `Nn`, `Ns`
