@@ -9,13 +9,16 @@ use std::fmt;
 
 /// Largest accepted step: beyond a second per step a game simulation has stopped meaning much.
 pub const MAX_DT: f32 = 1.0;
+/// Smallest accepted step (1 µs): Bevy's fixed clock counts in nanoseconds and refuses a zero
+/// step (it panics), and a step below a microsecond rounds there.
+pub const MIN_DT: f32 = 1e-6;
 /// Most substeps accepted per step.
 pub const MAX_SUBSTEPS: u32 = 1024;
 
 /// Why a setting was refused.
 #[derive(Clone, Debug, PartialEq)]
 pub enum SettingsError {
-    /// `dt` not finite, `<= 0`, or above [`MAX_DT`].
+    /// `dt` not finite, below [`MIN_DT`], or above [`MAX_DT`].
     BadTimestep(f32),
     /// Zero substeps or more than [`MAX_SUBSTEPS`].
     BadSubsteps(u32),
@@ -33,7 +36,7 @@ impl fmt::Display for SettingsError {
             Self::BadTimestep(dt) => {
                 write!(
                     f,
-                    "time step must be finite, > 0 and <= {MAX_DT} s, got {dt}"
+                    "time step must be finite, >= {MIN_DT} s and <= {MAX_DT} s, got {dt}"
                 )
             }
             Self::BadSubsteps(n) => write!(f, "substeps must be 1..={MAX_SUBSTEPS}, got {n}"),
@@ -118,7 +121,7 @@ impl PhysicsTimestep {
 }
 
 fn check_dt(dt: f32) -> Result<(), SettingsError> {
-    if dt.is_finite() && dt > 0.0 && dt <= MAX_DT {
+    if dt.is_finite() && (MIN_DT..=MAX_DT).contains(&dt) {
         Ok(())
     } else {
         Err(SettingsError::BadTimestep(dt))

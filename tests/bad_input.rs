@@ -143,3 +143,51 @@ fn bad_settings_are_errors() {
     let e = PhysicsTimestep::new(-1.0, 1).unwrap_err();
     assert!(e.to_string().contains("time step"), "{e}");
 }
+
+/// A step below a microsecond is refused: Bevy's fixed clock counts nanoseconds and panics on a
+/// zero step. The smallest accepted step runs inside an `App` with Bevy's clock.
+#[test]
+fn a_step_below_1_microsecond_is_refused_and_the_smallest_accepted_one_runs_in_an_app() {
+    assert!(PhysicsTimestep::new(1e-12, 1).is_err());
+    assert!(PhysicsTimestep::new(0.9e-6, 1).is_err());
+    let tiny = PhysicsTimestep::new(urto::settings::MIN_DT, 1).expect("1 µs is accepted");
+    let mut app = bevy_app::App::new();
+    app.add_plugins((bevy_time::TimePlugin, UrtoPlugins::with_timestep(tiny)));
+    app.world_mut()
+        .spawn((Collider::sphere(0.5), Velocity::new(1.0, 0.0, 0.0)));
+    app.finish();
+    app.cleanup();
+    for _ in 0..3 {
+        app.update();
+    }
+}
+
+/// Iteration counts of `u32::MAX` run at most `MAX_ITERATIONS` sweeps: the step ends, and the
+/// ball still rests on the ground.
+#[test]
+fn u32_max_solver_iterations_end_after_at_most_256_sweeps() {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    app.insert_resource(ContactSettings {
+        solver: urto::dynamics::response::SolverSettings {
+            velocity_iterations: u32::MAX,
+            position_iterations: u32::MAX,
+            ..Default::default()
+        },
+        ..Default::default()
+    });
+    app.world_mut()
+        .spawn((Collider::half_space(Vec3::Z), Static));
+    let ball = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(0.0, 0.0, 0.5),
+            Velocity::default(),
+        ))
+        .id();
+    urto::step(app.world_mut(), 10).unwrap();
+    let z = app.world().get::<Position>(ball).unwrap().0.z;
+    assert!((z - 0.5).abs() < 0.01, "ball at {z}");
+    assert_eq!(urto::dynamics::response::MAX_ITERATIONS, 256);
+}

@@ -26,12 +26,16 @@ pub fn reflect(v: Vec3, n: Vec3, e: f32) -> Vec3 {
     if vn < 0.0 { v - (1.0 + e) * vn * n } else { v }
 }
 
+/// Most sweeps of either kind a step runs, whatever the settings ask: `u32::MAX` sweeps would
+/// hang the step, and past a few hundred more sweeps change nothing.
+pub const MAX_ITERATIONS: u32 = 256;
+
 /// Tunables of the contact solver.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SolverSettings {
-    /// Gauss–Seidel sweeps over the velocity constraints.
+    /// Gauss–Seidel sweeps over the velocity constraints (at most [`MAX_ITERATIONS`] are run).
     pub velocity_iterations: u32,
-    /// Sweeps of direct position correction.
+    /// Sweeps of direct position correction (at most [`MAX_ITERATIONS`] are run).
     pub position_iterations: u32,
     /// Approach speeds below this (m/s) bounce with `e = 0`, so resting contact stays at rest
     /// instead of micro-bouncing on the velocity gravity adds every step.
@@ -245,7 +249,7 @@ pub fn solve_velocities(
     for c in contacts.iter_mut() {
         c.warm_start(velocities, inverse_mass);
     }
-    for _ in 0..settings.velocity_iterations.max(1) {
+    for _ in 0..settings.velocity_iterations.clamp(1, MAX_ITERATIONS) {
         let mut largest_change = 0.0f32;
         for c in contacts.iter_mut() {
             let k = inverse_mass[c.a] + inverse_mass[c.b];
@@ -404,7 +408,7 @@ pub fn correct_positions(
     // may arrive holding displacements already decided (see `resting_displacements`).
     displacement.resize(positions.len(), Vec3::ZERO);
     let scratch = displacement;
-    for _ in 0..settings.position_iterations {
+    for _ in 0..settings.position_iterations.min(MAX_ITERATIONS) {
         for c in contacts {
             let (mut wa, mut wb) = (inverse_mass[c.a], inverse_mass[c.b]);
             if let Some(level) = levels {
