@@ -191,3 +191,42 @@ fn u32_max_solver_iterations_end_after_at_most_256_sweeps() {
     assert!((z - 0.5).abs() < 0.01, "ball at {z}");
     assert_eq!(urto::dynamics::response::MAX_ITERATIONS, 256);
 }
+
+/// Two entities that are each other's `ChildOf` (a loop with no root) are both quarantined, and
+/// the step ends; a ball beside them falls as it would alone.
+#[test]
+fn a_childof_loop_is_quarantined_whole_and_the_step_ends() {
+    use bevy_ecs::hierarchy::ChildOf;
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    let a = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.5),
+            Position::default(),
+            Velocity::default(),
+        ))
+        .id();
+    let b = app
+        .world_mut()
+        .spawn((Collider::sphere(0.5), Position::default(), ChildOf(a)))
+        .id();
+    app.world_mut().entity_mut(a).insert(ChildOf(b));
+    let ball = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(5.0, 0.0, 10.0),
+            Velocity::default(),
+        ))
+        .id();
+    urto::step(app.world_mut(), 60).unwrap();
+    assert!(quarantined(&app, a) && quarantined(&app, b));
+    let z = app.world().get::<Position>(ball).unwrap().0.z;
+    // One second of free fall under symplectic Euler: 10 − g (1 + 1/60) / 2.
+    let expected = 10.0 - 9.8 * (1.0 + 1.0 / 60.0) / 2.0;
+    assert!(
+        (z - expected).abs() < 1e-3,
+        "ball at {z}, expected {expected}"
+    );
+}

@@ -547,8 +547,11 @@ fn kind_color(e: Entity, parents: &Query<&ChildOf>, kinds: &Query<KindView>) -> 
         return QUARANTINED;
     }
     let mut root = e;
-    while let Ok(p) = parents.get(root) {
-        root = p.parent();
+    for _ in 0..crate::plugins::validation::MAX_HIERARCHY_DEPTH {
+        match parents.get(root) {
+            Ok(p) => root = p.parent(),
+            Err(_) => break,
+        }
     }
     match kinds.get(root) {
         Ok((true, ..)) => STATIC,

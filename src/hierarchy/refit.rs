@@ -1,5 +1,8 @@
 //! Which nodes of a hierarchy to refit after some changed, and in which order.
 
+/// Longest path from a changed node up to its root that [`refit_order`] climbs.
+pub const MAX_PATH: u32 = 1 << 16;
+
 /// The nodes to refit when the nodes in `changed` had their own volume change: each of them and
 /// every ancestor, once, deepest first (so a node is refit after all its changed children).
 /// `parent` walks up the tree. Runs in O(changed × depth); nodes outside the changed paths are
@@ -17,6 +20,11 @@ pub fn refit_order<N: Copy + Ord>(
         while let Some(node) = up {
             out.push((0, node));
             path_depth += 1;
+            // A loop of parents would climb for ever: stop, as the ECS walks do (the loop's
+            // nodes are quarantined there).
+            if path_depth >= MAX_PATH {
+                break;
+            }
             up = parent(node);
         }
         // Depths are measured from the root: the last node pushed is the root, depth 0.

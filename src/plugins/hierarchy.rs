@@ -18,6 +18,7 @@ use crate::geometry::Isometry;
 use crate::hierarchy::refit_order;
 use crate::plugins::broad_phase::IndexBodies;
 use crate::plugins::core::PrepareIndex;
+use crate::plugins::validation::MAX_HIERARCHY_DEPTH;
 use crate::plugins::validation::quarantine;
 use crate::schedule::{BroadPhaseSystems, PhysicsSchedule, PhysicsSet, SubstepSchedule};
 use crate::stats::{PhysicsStats, Stage};
@@ -161,13 +162,17 @@ fn remember_part_poses(
 
 type PartMoved = (InHierarchy, Changed<GlobalPose>);
 
-/// Number of ancestors of `e`.
+/// Number of ancestors of `e`, at most [`MAX_HIERARCHY_DEPTH`] (a loop of parents, which
+/// validation quarantines, must not hang the step before it does).
 fn depth(e: Entity, parents: &Query<&ChildOf>) -> u32 {
     let mut d = 0;
     let mut up = e;
     while let Ok(p) = parents.get(up) {
         d += 1;
         up = p.parent();
+        if d >= MAX_HIERARCHY_DEPTH {
+            break;
+        }
     }
     d
 }

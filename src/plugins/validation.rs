@@ -24,7 +24,12 @@ impl Plugin for ValidationPlugin {
     fn build(&self, app: &mut App) {
         app.add_systems(
             PhysicsSchedule,
-            (quarantine_invalid_bodies, quarantine_invalid_rotation).in_set(PrepareStart),
+            (
+                quarantine_invalid_bodies,
+                quarantine_invalid_rotation,
+                quarantine_parent_cycles,
+            )
+                .in_set(PrepareStart),
         );
     }
 }
@@ -138,6 +143,45 @@ fn why_invalid_rotation(
                 )
             })
         })
+}
+
+/// Deepest `ChildOf` chain walked: the hierarchy's walks up a chain stop here, so a loop of
+/// parents (two entities each other's `ChildOf`) cannot hang a step before it is quarantined.
+pub(crate) const MAX_HIERARCHY_DEPTH: u32 = 1 << 16;
+
+/// Quarantines every entity of a `ChildOf` loop (each is its own ancestor), checked for the
+/// entities whose parent changed: a loop has no root, so no pose or volume reaches it, and the
+/// walks up its chain would never end.
+fn quarantine_parent_cycles(
+    changed: Query<Entity, (Changed<ChildOf>, Without<Quarantined>)>,
+    parents: Query<&ChildOf>,
+    mut commands: Commands,
+) {
+    for e in &changed {
+        let mut up = e;
+        for _ in 0..MAX_HIERARCHY_DEPTH {
+            let Ok(p) = parents.get(up) else {
+                break;
+            };
+            up = p.parent();
+            if up == e {
+                // Quarantine the whole loop, not only the link that closed it.
+                let mut member = e;
+                loop {
+                    quarantine(
+                        &mut commands,
+                        member,
+                        "its ChildOf chain loops back to it".into(),
+                    );
+                    member = parents.get(member).map_or(e, |p| p.parent());
+                    if member == e {
+                        break;
+                    }
+                }
+                break;
+            }
+        }
+    }
 }
 
 /// Marks `entity` as quarantined and says why in the log.
