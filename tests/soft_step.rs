@@ -6,7 +6,7 @@ use bevy_app::App;
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
 use urto::dynamics::solver::SoftStepSettings;
-use urto::plugins::SoftStepPlugin;
+use urto::plugins::{SoftStepPlugin, SpeculativeMargin};
 use urto::prelude::*;
 
 fn get<T: Component + Copy>(app: &App, e: Entity) -> T {
@@ -579,5 +579,46 @@ fn with_the_soft_step_50_dominoes_topple_in_order_each_within_2_s_of_the_one_bef
     for &d in &dominoes {
         let up = get::<Rotation>(&app, d).0 * Vec3::Z;
         assert!(up.x > 0.5, "a domino fell sideways or backwards: up {up}");
+    }
+}
+
+#[test]
+fn with_the_soft_step_a_nan_or_negative_rolling_resistance_counts_as_none_and_stays_in_its_body() {
+    // A bad lever arm is no resistance: the ball rolls as a free one does, within 1 %.
+    let free = rolled(None);
+    for bad in [f32::NAN, -1.0, f32::INFINITY] {
+        let distance = rolled(Some(bad));
+        assert!(
+            distance.is_finite() && (distance / free - 1.0).abs() < 0.01,
+            "RollingResistance({bad}): rolled {distance} m, a free ball {free} m"
+        );
+    }
+}
+
+#[test]
+fn with_the_soft_step_an_unusable_speculative_margin_leaves_a_dropped_ball_resting_within_1_cm() {
+    for margin in [
+        SpeculativeMargin {
+            distance: f32::NAN,
+            reach_ratio: f32::INFINITY,
+        },
+        SpeculativeMargin {
+            distance: -1.0,
+            reach_ratio: -1.0,
+        },
+    ] {
+        let mut app = soft_step_app_on_ground();
+        app.insert_resource(margin);
+        let ball = app
+            .world_mut()
+            .spawn((
+                Collider::sphere(0.5),
+                Position::new(0.0, 0.0, 2.0),
+                Velocity::default(),
+            ))
+            .id();
+        urto::step(app.world_mut(), 180).unwrap();
+        let z = get::<Position>(&app, ball).0.z;
+        assert!((z - 0.5).abs() < 0.01, "{margin:?}: ball at {z}");
     }
 }
