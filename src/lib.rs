@@ -48,10 +48,13 @@ pub use settings::{ContactSettings, Gravity, Integration, PhysicsTimestep, Setti
 pub mod prelude {
     pub use crate::components::*;
     pub use crate::dynamics::Integrator;
-    pub use crate::plugins::{CollisionEnded, CollisionStarted, UrtoPlugins};
+    pub use crate::dynamics::solver::SoftStepSettings;
+    pub use crate::plugins::{CollisionEnded, CollisionStarted, SoftStepPlugin, UrtoPlugins};
     pub use crate::schedule::{PhysicsSchedule, PhysicsSet, SubstepSchedule, SubstepSet};
     pub use crate::settings::*;
     pub use crate::stats::{PhysicsStats, Stage};
+    /// `UrtoPlugins::default().set(..)` and `.disable::<..>()` need the trait in scope.
+    pub use bevy_app::PluginGroup;
 }
 
 /// The README's code blocks, compiled and run as doctests so that the README stays true.

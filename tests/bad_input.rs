@@ -197,7 +197,7 @@ fn u32_max_solver_iterations_end_after_at_most_256_sweeps() {
 #[test]
 fn a_childof_loop_is_quarantined_whole_and_the_step_ends() {
     use bevy_ecs::hierarchy::ChildOf;
-    let mut app = common::app();
+    let mut app = common::legacy_app();
     app.insert_resource(Gravity::EARTH_Z_UP);
     let a = app
         .world_mut()

@@ -93,7 +93,7 @@ fn tunnelled(app: &mut App, balls: &[Entity], steps: u32) -> usize {
 fn no_bullet_passes_a_1cm_wall_with_ccd_and_most_do_without() {
     for as_mesh in [false, true] {
         let run = |marked: bool| {
-            let mut app = common::app();
+            let mut app = common::legacy_app();
             app.insert_resource(CcdSettings {
                 auto_speed_ratio: None,
                 ..Default::default()

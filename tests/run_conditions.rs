@@ -29,7 +29,7 @@ fn an_empty_world_runs_no_effect() {
 
 #[test]
 fn bodies_without_colliders_pay_nothing_for_collision_and_without_gravity_do_not_fall() {
-    let mut app = common::app();
+    let mut app = common::legacy_app();
     let body = app
         .world_mut()
         .spawn((Position::new(0.0, 0.0, 5.0), Velocity::new(1.0, 0.0, 0.0)))

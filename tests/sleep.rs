@@ -72,7 +72,7 @@ fn resting_balls_fall_asleep_and_cost_nothing() {
 #[test]
 fn sleeping_is_off_by_default() {
     assert!(!SleepSettings::default().enabled);
-    let mut app = common::app();
+    let mut app = common::legacy_app();
     app.insert_resource(Gravity::EARTH_Z_UP);
     app.world_mut()
         .spawn((Collider::half_space(Vec3::Z), Static));

@@ -20,8 +20,13 @@ fn soft_step_app_with(settings: SoftStepSettings) -> App {
     app
 }
 
+/// The solver with its defaults, switched on inside the group (the other way in than
+/// [`soft_step_app_with`], which adds it beside the group).
 fn soft_step_app() -> App {
-    soft_step_app_with(SoftStepSettings::default())
+    let mut app = App::new();
+    app.add_plugins(UrtoPlugins::default().build().enable::<SoftStepPlugin>())
+        .insert_resource(Gravity::EARTH_Z_UP);
+    app
 }
 
 /// [`soft_step_app`] with a ground plane through the origin.

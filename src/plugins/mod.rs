@@ -46,6 +46,9 @@ use bevy_app::{PluginGroup, PluginGroupBuilder};
 
 /// Every stage of urto in schedule order; `app.add_plugins(UrtoPlugins::default())`.
 ///
+/// [`SoftStepPlugin`] (the rigid-body solver) is in the group but disabled: enable it with
+/// `UrtoPlugins::default().build().enable::<SoftStepPlugin>()` (or add it beside the group).
+///
 /// The rerun recording is not in the group because it needs a destination that can fail to
 /// open: add [`RerunDebugPlugin`](crate::debug::RerunDebugPlugin) separately.
 #[derive(Debug, Clone, Default)]
@@ -77,8 +80,12 @@ impl PluginGroup for UrtoPlugins {
             .add(BroadPhasePlugin::default())
             .add(CcdPlugin)
             .add(NarrowPhasePlugin)
+            .add(SoftStepPlugin::default())
             .add(ResponsePlugin)
             .add(SleepPlugin)
             .add(TransformSyncPlugin)
+            // In the group but off until it becomes the default (issue 10): `.enable::<..>()` or
+            // adding it beside the group switches contacts that turn bodies on.
+            .disable::<SoftStepPlugin>()
     }
 }

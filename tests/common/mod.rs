@@ -126,3 +126,23 @@ pub fn app_with(dt: f32, substeps: u32) -> App {
 pub fn app() -> App {
     app_with(1.0 / 60.0, 1)
 }
+
+/// An app at 60 Hz with the legacy pipeline (the selected integrator and the impulse response
+/// in every substep) instead of the rigid-body solver: for the tests of the lecture's response.
+pub fn legacy_app() -> App {
+    legacy_app_with(1.0 / 60.0, 1)
+}
+
+/// [`legacy_app`] with the given step.
+pub fn legacy_app_with(dt: f32, substeps: u32) -> App {
+    use bevy_app::PluginGroup;
+    let mut app = App::new();
+    app.add_plugins(
+        UrtoPlugins::with_timestep(
+            PhysicsTimestep::new(dt, substeps).expect("valid test timestep"),
+        )
+        .build()
+        .disable::<urto::plugins::SoftStepPlugin>(),
+    );
+    app
+}

@@ -100,6 +100,17 @@ pub struct SoftStepSolver {
     sources: Vec<u32>,
 }
 
+impl SoftStepSolver {
+    /// A solver with these settings (unusable ones step with the defaults; see
+    /// [`SoftStepSettings::validated`]); insert it to change the settings of a running app.
+    pub fn new(settings: SoftStepSettings) -> Self {
+        Self {
+            solver: Solver::new(settings),
+            ..Default::default()
+        }
+    }
+}
+
 /// Run condition of the stages the soft step replaces.
 pub(crate) fn legacy_solver(solver: Option<Res<SoftStepSolver>>) -> bool {
     solver.is_none()
