@@ -79,6 +79,10 @@ impl Bv for Aabb {
         self.union(other)
     }
 
+    fn grown(&self, margin: f32) -> Self {
+        self.expanded(margin)
+    }
+
     #[inline]
     fn overlaps(&self, other: &Self, rel: &RelativePose) -> bool {
         self.overlap_in::<false>(other, rel).is_some()

@@ -274,6 +274,15 @@ impl<const AXES: usize> Bv for Kdop<AXES> {
         }
     }
 
+    fn grown(&self, margin: f32) -> Self {
+        // Slab `i` measures `d_i · x`, so a point `margin` away moves it by up to `margin |d_i|`.
+        let pad = Self::DIRECTIONS.map(|d| margin * d.length());
+        Self {
+            min: std::array::from_fn(|i| self.min[i] - pad[i]),
+            max: std::array::from_fn(|i| self.max[i] + pad[i]),
+        }
+    }
+
     #[inline]
     fn overlaps(&self, other: &Self, rel: &KdopRelative<AXES>) -> bool {
         self.overlap_in::<false>(other, rel).is_some()

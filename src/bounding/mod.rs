@@ -69,6 +69,11 @@ pub trait Bv: Copy + Debug + PartialEq + Send + Sync + 'static {
     #[must_use]
     fn merged(&self, other: &Self) -> Self;
 
+    /// A BV holding every point within `margin` (≥ 0) of this one: pair queries that look for
+    /// triangles *near* each other (speculative contacts) test one side's BVs grown by it.
+    #[must_use]
+    fn grown(&self, margin: f32) -> Self;
+
     /// Conservative overlap test of `self` (in A's frame) and `other` (in B's frame).
     fn overlaps(&self, other: &Self, rel: &Self::Relative) -> bool;
 

@@ -146,6 +146,14 @@ impl Bv for Obb {
         Self::fit_points(corners)
     }
 
+    fn grown(&self, margin: f32) -> Self {
+        // The box of the grown box's faces holds the rounded box (the Minkowski sum).
+        Self {
+            half_extents: self.half_extents + Vec3::splat(margin),
+            ..*self
+        }
+    }
+
     #[inline]
     fn overlaps(&self, other: &Self, rel: &RelativePose) -> bool {
         self.overlap_in::<false>(other, rel).is_some()

@@ -106,6 +106,10 @@ impl Bv for BoundingSphere {
         Self::new(center, radius).padded()
     }
 
+    fn grown(&self, margin: f32) -> Self {
+        Self::new(self.center, self.radius + margin)
+    }
+
     #[inline]
     fn overlaps(&self, other: &Self, rel: &RelativePose) -> bool {
         let reach = self.radius + other.radius + rel.slack;

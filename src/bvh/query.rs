@@ -51,18 +51,26 @@ pub(crate) fn children_to_visit<B: Bv>(a: &Bvh<B>, b: &Bvh<B>, p: NodePair) -> [
     }
 }
 
-/// Tests the BVs of `pair` and queues it when they overlap.
+/// Tests the BVs of `pair` (B's grown by `margin` when positive) and queues it when they
+/// overlap.
 #[inline(always)]
 fn test_and_queue<B: Bv, Q: PairQueue>(
     a: &Bvh<B>,
     b: &Bvh<B>,
     rel: &B::Relative,
+    margin: f32,
     pair: NodePair,
     queue: &mut Q,
     stats: &mut QueryStats,
 ) {
     stats.bv_tests += 1;
-    let (bva, bvb) = (&a.nodes[pair.a as usize].bv, &b.nodes[pair.b as usize].bv);
+    let bva = &a.nodes[pair.a as usize].bv;
+    let grown;
+    let mut bvb = &b.nodes[pair.b as usize].bv;
+    if margin > 0.0 {
+        grown = bvb.grown(margin);
+        bvb = &grown;
+    }
     if Q::RANKED {
         if let Some(rank) = bva.overlap_estimate(bvb, rel) {
             queue.push(pair, rank);
@@ -77,14 +85,22 @@ fn test_and_queue<B: Bv, Q: PairQueue>(
 fn traverse<B: Bv, Q: PairQueue>(
     a: &Bvh<B>,
     b: &Bvh<B>,
-    rel: &B::Relative,
+    (rel, margin): (&B::Relative, f32),
     queue: &mut Q,
     leaf_test: &mut impl FnMut(u32, u32) -> bool,
     on_hit: &mut impl FnMut(u32, u32) -> ControlFlow<()>,
 ) -> QueryStats {
     let mut stats = QueryStats::default();
     queue.clear();
-    test_and_queue(a, b, rel, NodePair { a: 0, b: 0 }, queue, &mut stats);
+    test_and_queue(
+        a,
+        b,
+        rel,
+        margin,
+        NodePair { a: 0, b: 0 },
+        queue,
+        &mut stats,
+    );
     while let Some(pair) = queue.pop() {
         stats.nodes_visited += 1;
         let (na, nb) = (&a.nodes[pair.a as usize], &b.nodes[pair.b as usize]);
@@ -100,7 +116,7 @@ fn traverse<B: Bv, Q: PairQueue>(
             continue;
         }
         for child in children_to_visit(a, b, pair) {
-            test_and_queue(a, b, rel, child, queue, &mut stats);
+            test_and_queue(a, b, rel, margin, child, queue, &mut stats);
         }
     }
     stats
@@ -110,17 +126,17 @@ fn traverse<B: Bv, Q: PairQueue>(
 fn traverse_in_order<B: Bv>(
     a: &Bvh<B>,
     b: &Bvh<B>,
-    pose_b_in_a: &Isometry,
+    (pose_b_in_a, margin): (&Isometry, f32),
     order: TraversalOrder,
     scratch: &mut QueryScratch,
     leaf_test: &mut impl FnMut(u32, u32) -> bool,
     on_hit: &mut impl FnMut(u32, u32) -> ControlFlow<()>,
 ) -> QueryStats {
-    let rel = B::relative(pose_b_in_a);
+    let rel = (&B::relative(pose_b_in_a), margin);
     match order {
-        TraversalOrder::DepthFirst => traverse(a, b, &rel, &mut scratch.stack, leaf_test, on_hit),
-        TraversalOrder::BreadthFirst => traverse(a, b, &rel, &mut scratch.fifo, leaf_test, on_hit),
-        TraversalOrder::Priority => traverse(a, b, &rel, &mut scratch.ranked, leaf_test, on_hit),
+        TraversalOrder::DepthFirst => traverse(a, b, rel, &mut scratch.stack, leaf_test, on_hit),
+        TraversalOrder::BreadthFirst => traverse(a, b, rel, &mut scratch.fifo, leaf_test, on_hit),
+        TraversalOrder::Priority => traverse(a, b, rel, &mut scratch.ranked, leaf_test, on_hit),
     }
 }
 
@@ -143,7 +159,7 @@ impl<B: Bv> Bvh<B> {
         let stats = traverse_in_order(
             self,
             other,
-            pose_b_in_a,
+            (pose_b_in_a, 0.0),
             order,
             scratch,
             &mut leaf_test,
@@ -164,6 +180,23 @@ impl<B: Bv> Bvh<B> {
         pose_b_in_a: &Isometry,
         order: TraversalOrder,
         scratch: &mut QueryScratch,
+        leaf_test: impl FnMut(u32, u32) -> bool,
+        out: &mut Vec<[u32; 2]>,
+    ) -> QueryStats {
+        self.pairs_within(other, pose_b_in_a, 0.0, order, scratch, leaf_test, out)
+    }
+
+    /// [`Bvh::intersecting_pairs`] for triangles that may be up to `margin` apart: `other`'s BVs
+    /// are grown by `margin` before each test, so `leaf_test` sees every pair of triangles whose
+    /// leaves come within `margin` of each other (speculative contacts look this far ahead).
+    #[allow(clippy::too_many_arguments)]
+    pub fn pairs_within(
+        &self,
+        other: &Bvh<B>,
+        pose_b_in_a: &Isometry,
+        margin: f32,
+        order: TraversalOrder,
+        scratch: &mut QueryScratch,
         mut leaf_test: impl FnMut(u32, u32) -> bool,
         out: &mut Vec<[u32; 2]>,
     ) -> QueryStats {
@@ -171,7 +204,7 @@ impl<B: Bv> Bvh<B> {
         traverse_in_order(
             self,
             other,
-            pose_b_in_a,
+            (pose_b_in_a, margin),
             order,
             scratch,
             &mut leaf_test,

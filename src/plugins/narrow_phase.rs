@@ -8,7 +8,7 @@
 //!
 //! With the rigid-body solver each pair is tested looking ahead by the sum of its two bodies'
 //! speculative margins ([`speculative_contact_with_scratch`]: grown spheres and boxes, raised
-//! half-spaces; two meshes only once they touch), so manifolds may hold points still apart
+//! half-spaces, the gaps between two meshes' triangles), so manifolds may hold points still apart
 //! (negative depth). A pair is always computed with its lower collider first, so which shape is
 //! grown and which face is the reference never follow the broad phase's (archetype) order.
 //!

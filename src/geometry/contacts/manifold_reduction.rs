@@ -5,13 +5,24 @@
 //! `btPersistentManifold::sortCachedPoints`).
 //!
 //! The deepest point keeps the penetration a solver must resolve; the area-maximising ones keep
-//! the manifold wide enough to stop the body from rocking. Exact duplicates (a zero-size box's
+//! the manifold wide enough to stop the body from rocking. Points within [`FRONT_WINDOW`] of the
+//! deepest (the *front*: what the body rests on) are preferred over points farther apart while
+//! they span at least [`FRONT_PREFERENCE`] as much: a speculative manifold (`speculative.rs`)
+//! also holds points still centimetres apart, and a ring of them just outside a torus's resting
+//! ring would otherwise win on area and leave the torus on one real point. Exact duplicates (a zero-size box's
 //! collapsed face) add no distance and are dropped, and so are points that add less area than
 //! [`MIN_AREA_FRACTION`] of the square of the first two points' distance (nearly collinear points,
 //! such as the two sides of a sliver clipped from a zero-width face).
 
 use crate::geometry::{ContactPoint, MAX_MANIFOLD_POINTS};
 use glam::Vec3;
+
+/// Points at most this much shallower than the deepest form the front (m; Box2D's linear slop).
+pub(crate) const FRONT_WINDOW: f32 = 0.005;
+
+/// A front point is chosen over a point outside the front while its measure (squared distance,
+/// or area) reaches this fraction of the other's: half the distance, a quarter of the area.
+pub(crate) const FRONT_PREFERENCE: f32 = 0.25;
 
 /// A third or fourth point must add at least this fraction of `|p1 - p0|²` in area (that is, lie
 /// farther than this fraction of `|p1 - p0|` from the hull so far) to be kept.
@@ -30,8 +41,11 @@ pub(crate) fn spread_points(
     };
     chosen[0] = deepest;
     let p0 = points[deepest].point;
+    let front_depth = points[deepest].depth - FRONT_WINDOW;
+    let in_front = |p: &ContactPoint| p.depth >= front_depth;
 
-    let Some(far) = argmax(points, |p| (p.point - p0).length_squared()).filter(|&i| i != deepest)
+    let Some(far) =
+        pick(points, in_front, |p| (p.point - p0).length_squared()).filter(|&i| i != deepest)
     else {
         return (chosen, 1);
     };
@@ -43,7 +57,7 @@ pub(crate) fn spread_points(
     let p1 = points[far].point;
 
     let signed_area = |a: Vec3, b: Vec3, c: Vec3| (b - a).cross(c - a).dot(normal);
-    let Some(third) = argmax(points, |p| signed_area(p0, p1, p.point).abs()) else {
+    let Some(third) = pick(points, in_front, |p| signed_area(p0, p1, p.point).abs()) else {
         return (chosen, 2);
     };
     let third_area = signed_area(p0, p1, points[third].point);
@@ -66,7 +80,7 @@ pub(crate) fn spread_points(
             .max(-signed_area(b, c, q))
             .max(-signed_area(c, a, q))
     };
-    match argmax(points, outside) {
+    match pick(points, in_front, outside) {
         Some(fourth) if outside(&points[fourth]) > min_area => {
             chosen[3] = fourth;
             (chosen, 4)
@@ -75,12 +89,28 @@ pub(crate) fn spread_points(
     }
 }
 
-/// Index of the first point maximising `key` (NaN keys never win), or `None` when empty.
+/// The point maximising `key` among those `in_front`, unless a point outside the front has a
+/// key more than 1 / [`FRONT_PREFERENCE`] times larger: then that one.
+fn pick(
+    points: &[ContactPoint],
+    in_front: impl Fn(&ContactPoint) -> bool,
+    key: impl Fn(&ContactPoint) -> f32,
+) -> Option<usize> {
+    let any = argmax(points, &key)?;
+    let front = argmax(points, |p| if in_front(p) { key(p) } else { f32::NAN });
+    match front {
+        Some(f) if key(&points[f]) >= FRONT_PREFERENCE * key(&points[any]) => Some(f),
+        _ => Some(any),
+    }
+}
+
+/// Index of the first point maximising `key` (NaN keys never win), or `None` when empty or
+/// every key is NaN.
 fn argmax(points: &[ContactPoint], key: impl Fn(&ContactPoint) -> f32) -> Option<usize> {
     let mut best: Option<(usize, f32)> = None;
     for (i, p) in points.iter().enumerate() {
         let k = key(p);
-        if best.is_none_or(|(_, b)| k > b) {
+        if !k.is_nan() && best.is_none_or(|(_, b)| k > b) {
             best = Some((i, k));
         }
     }
@@ -157,5 +187,28 @@ mod tests {
         ];
         let (idx, n) = spread_points(&sliver, Vec3::Z);
         assert_eq!((n, idx[0], idx[1]), (2, 0, 1));
+    }
+
+    #[test]
+    fn a_resting_ring_beats_a_wider_ring_2cm_apart() {
+        // Eight points on a ring of radius 1 resting (depth 1 mm), eight on a ring of radius
+        // 1.2 still 2 cm apart: the four kept points are all on the resting ring.
+        let ring = |r: f32, depth: f32, turn: f32| {
+            (0..8).map(move |k| {
+                let a = (k as f32 + turn) * std::f32::consts::FRAC_PI_4;
+                at(r * a.cos(), r * a.sin(), depth)
+            })
+        };
+        let points: Vec<_> = ring(1.0, 0.001, 0.0).chain(ring(1.2, -0.02, 0.5)).collect();
+        let (idx, n) = spread_points(&points, Vec3::Z);
+        assert_eq!(n, 4);
+        assert!(idx.iter().all(|&i| i < 8), "{idx:?}");
+        // A far point is still taken when the front is one point (a box landing on a corner).
+        let corner = [
+            at(0.0, 0.0, 0.001),
+            at(1.0, 0.0, -0.03),
+            at(0.0, 1.0, -0.03),
+        ];
+        assert_eq!(spread_points(&corner, Vec3::Z).1, 3);
     }
 }

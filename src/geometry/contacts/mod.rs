@@ -55,6 +55,7 @@ mod sphere_cuboid;
 mod sphere_halfspace;
 mod sphere_sphere;
 mod triangle_cuboid;
+mod triangle_distance;
 mod trimesh_cuboid;
 mod trimesh_halfspace;
 mod trimesh_sphere;
@@ -68,10 +69,13 @@ pub use sphere_cuboid::contact_sphere_cuboid;
 pub use sphere_halfspace::contact_sphere_halfspace;
 pub use sphere_sphere::contact_sphere_sphere;
 pub use triangle_cuboid::contact_triangle_cuboid;
+pub use triangle_distance::closest_points_triangle_triangle;
 pub use trimesh_cuboid::contact_trimesh_cuboid;
 pub use trimesh_halfspace::contact_trimesh_halfspace;
 pub use trimesh_sphere::contact_trimesh_sphere;
-pub use trimesh_trimesh::{contact_triangle_triangle, contact_trimesh_trimesh};
+pub use trimesh_trimesh::{
+    contact_triangle_triangle, contact_trimesh_trimesh, contact_trimesh_trimesh_within,
+};
 
 use crate::geometry::{ContactManifold, Isometry, Shape};
 use glam::Vec3;

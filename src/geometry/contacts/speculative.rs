@@ -8,10 +8,11 @@
 //! separation is the margin minus its depth against the grown shape. For a ball this is exact;
 //! for a box it is exact across faces and errs on the early side near edges and corners (a
 //! grown box is not a rounded one), which only makes a contact speculative sooner. A half-space
-//! grows by moving its boundary out (exact). Meshes are not grown: two meshes report
-//! penetration only (a mesh–mesh distance query is issue 14's GJK work).
+//! grows by moving its boundary out (exact). Two meshes are not grown: their hierarchies are
+//! descended with boxes grown by the margin, and triangle pairs that do not cross report their
+//! exact gap (`trimesh_trimesh.rs`).
 
-use super::{ContactScratch, contact_with_scratch};
+use super::{ContactScratch, contact_trimesh_trimesh_within, contact_with_scratch};
 use crate::geometry::{ContactManifold, ContactPoint, Cuboid, Isometry, Shape, Sphere};
 
 /// The shape grown by `margin`, or `None` if it cannot be grown.
@@ -82,6 +83,9 @@ pub fn speculative_contact_with_scratch(
     scratch: &mut ContactScratch,
 ) -> Option<ContactManifold> {
     if margin > 0.0 && margin.is_finite() {
+        if let (Shape::TriMesh(ma), Shape::TriMesh(mb)) = (a, b) {
+            return contact_trimesh_trimesh_within(pose_a, ma, pose_b, mb, margin, scratch);
+        }
         if let Some(ga) = grown(a, margin) {
             let m = contact_with_scratch(&ga, pose_a, b, pose_b, scratch)?;
             let rim = cuboid_of(a).map(|c| (c, pose_a));
@@ -177,6 +181,26 @@ mod tests {
             assert!((p.depth + 0.03).abs() < 1e-5, "{}", p.depth);
         }
         assert!(speculative_contact(&ground, &Isometry::default(), &b, &at, 0.02).is_none());
+    }
+
+    #[test]
+    fn a_mesh_box_above_a_mesh_floor_reports_its_gap_at_its_corners() {
+        use crate::geometry::{MeshCollider, TriMesh};
+        let mesh = |m: TriMesh| Shape::TriMesh(MeshCollider::new(m).unwrap());
+        let floor = mesh(TriMesh::grid_floor(4.0, 8).unwrap());
+        let b = mesh(TriMesh::cuboid(Vec3::splat(0.5)).unwrap());
+        let at = Isometry::from_translation(Vec3::new(0.1, 0.2, 0.53));
+        let c = speculative_contact(&floor, &Isometry::default(), &b, &at, 0.05).unwrap();
+        assert!(c.normal.abs_diff_eq(Vec3::Z, 1e-5), "{}", c.normal);
+        assert!(c.points().len() >= 3);
+        for p in c.points() {
+            assert!((p.depth + 0.03).abs() < 1e-5, "{}", p.depth);
+            assert!((p.point.z - 0.015).abs() < 1e-5, "{}", p.point);
+        }
+        // Swapped: the same gap, the normal turned round; beyond the margin: nothing.
+        let back = speculative_contact(&b, &at, &floor, &Isometry::default(), 0.05).unwrap();
+        assert!(back.normal.abs_diff_eq(-Vec3::Z, 1e-5));
+        assert!(speculative_contact(&floor, &Isometry::default(), &b, &at, 0.02).is_none());
     }
 
     #[test]

@@ -31,10 +31,23 @@
 //!
 //! The computation is symmetric: the meshes are put in a canonical order first, so
 //! `contact(b, a)` is exactly `contact(a, b)` flipped.
+//!
+//! # Speculative contacts
+//!
+//! [`contact_trimesh_trimesh_within`] also reports triangles still apart by up to a margin, so
+//! that a solver detecting once per step finds two meshes before they touch (Catto 2013; the
+//! other shapes grow by the margin instead, `speculative.rs`). B's hierarchy boxes are grown by
+//! the margin in the descent ([`Bvh::pairs_within`](crate::bvh::Bvh::pairs_within)), and a leaf
+//! pair that does not intersect gives its gap (`triangle_distance.rs`): the normal along the
+//! closest points, the depth minus the gap, the point midway, the side of the triangle whose
+//! plane the gap is more nearly square to. In the merge a pair weighs its depth plus the margin
+//! (what it would reach into the shapes grown by the margin), so crossing pairs weigh more than
+//! near ones and near ones more than far ones.
 
 use super::FALLBACK_NORMAL;
 use super::mesh_scratch::{ContactScratch, push_contribution};
 use super::polygon_clip::ClipPolygon;
+use super::triangle_distance::closest_points_triangle_triangle;
 use crate::bvh::TraversalOrder;
 use crate::geometry::{
     ContactManifold, ContactPoint, Isometry, MeshCollider, TriTriIntersection, Triangle,
@@ -66,12 +79,31 @@ pub fn contact_trimesh_trimesh(
     b: &MeshCollider,
     scratch: &mut ContactScratch,
 ) -> Option<ContactManifold> {
+    contact_trimesh_trimesh_within(pose_a, a, pose_b, b, 0.0, scratch)
+}
+
+/// [`contact_trimesh_trimesh`] that also finds the triangles up to `margin` apart (speculative
+/// contacts, module notes): their points have negative depths (minus the gap). `None` when no
+/// two triangles come within `margin`. A margin that is not a positive number counts as 0.
+pub fn contact_trimesh_trimesh_within(
+    pose_a: &Isometry,
+    a: &MeshCollider,
+    pose_b: &Isometry,
+    b: &MeshCollider,
+    margin: f32,
+    scratch: &mut ContactScratch,
+) -> Option<ContactManifold> {
+    let margin = if margin > 0.0 && margin.is_finite() {
+        margin
+    } else {
+        0.0
+    };
     if canonical_order(pose_a, a, pose_b, b) == Ordering::Less {
-        let m = contact_in_order(pose_b, b, pose_a, a, scratch);
+        let m = contact_in_order(pose_b, b, pose_a, a, margin, scratch);
         scratch.flip_hits();
         m.map(ContactManifold::flipped)
     } else {
-        contact_in_order(pose_a, a, pose_b, b, scratch)
+        contact_in_order(pose_a, a, pose_b, b, margin, scratch)
     }
 }
 
@@ -119,6 +151,7 @@ fn contact_in_order(
     a: &MeshCollider,
     pose_b: &Isometry,
     b: &MeshCollider,
+    margin: f32,
     scratch: &mut ContactScratch,
 ) -> Option<ContactManifold> {
     scratch.begin_query();
@@ -130,9 +163,10 @@ fn contact_in_order(
         points,
         ..
     } = scratch;
-    let stats = a.bvh().intersecting_pairs(
+    let stats = a.bvh().pairs_within(
         b.bvh(),
         &b_in_a,
+        margin,
         TraversalOrder::DepthFirst,
         query,
         |ta, tb| {
@@ -147,17 +181,18 @@ fn contact_in_order(
             let tb = tb.transformed(&b_in_a);
             // Exact on the same coordinates (min/max do not round), so it rejects no touching
             // pair, and it spares the exact test most of a leaf pair's triangle pairs.
-            if !ta.aabb().intersects(&tb.aabb()) {
+            if !ta.aabb().expanded(margin).intersects(&tb.aabb()) {
                 return false;
             }
-            let Some(c) = pair_contact(&ta, &tb) else {
+            let Some(c) = pair_contact(&ta, &tb).or_else(|| gap_contact(&ta, &tb, margin)) else {
                 return false;
             };
             let point = ContactPoint {
                 point: c.point,
                 depth: c.depth,
             };
-            push_contribution(contributions, points, c.normal, c.depth, c.side, &[point]);
+            let weight = c.depth + margin;
+            push_contribution(contributions, points, c.normal, weight, c.side, &[point]);
             true
         },
         hits,
@@ -193,6 +228,29 @@ fn pair_contact(ta: &Triangle, tb: &Triangle) -> Option<PairContact> {
         normal,
         depth,
         point,
+        side,
+    })
+}
+
+/// The speculative estimate of two disjoint triangles at most `margin` apart (module notes), or
+/// `None` when they are farther apart, or so close that the gap has no direction (the exact
+/// test then calls them touching or apart; rounding alone separates the two).
+fn gap_contact(ta: &Triangle, tb: &Triangle, margin: f32) -> Option<PairContact> {
+    if margin <= 0.0 {
+        return None;
+    }
+    let (p, q) = closest_points_triangle_triangle(ta, tb);
+    let gap = p.distance(q);
+    if gap > margin {
+        return None;
+    }
+    let normal = ((q - p) / gap).try_normalize()?;
+    let squareness = |n: Option<Vec3>| n.map_or(0.0, |n| n.dot(normal).abs());
+    let side = u8::from(squareness(tb.normal()) > squareness(ta.normal()));
+    Some(PairContact {
+        normal,
+        depth: -gap,
+        point: (p + q) * 0.5,
         side,
     })
 }
