@@ -1,5 +1,7 @@
-//! The main example: balls under gravity dropped on a ground plane, bouncing by the slides'
-//! reflection rule (with restitution) and off each other, recorded to `bouncing_balls.rrd`.
+//! The main example: balls under gravity dropped on a ground plane, bouncing with restitution
+//! off it and off each other, recorded to `bouncing_balls.rrd`. Contacts turn them (the
+//! rigid-body solver, urto's default): friction sets a sliding ball rolling, and a 1 cm
+//! rolling resistance brings it to rest, as it would a real ball.
 //!
 //! ```text
 //! cargo run --release --example bouncing_balls -- --help
@@ -73,6 +75,7 @@ fn main() -> Result<(), Box<dyn Error>> {
                     Velocity::new(rng.next() - 0.5, rng.next() - 0.5, 0.0),
                     Mass(radius.powi(3) * 4.19 * 1000.0),
                     Restitution(0.5 + 0.45 * rng.next()),
+                    RollingResistance(0.01),
                 ))
                 .id(),
         );

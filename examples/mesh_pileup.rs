@@ -199,16 +199,17 @@ fn main() -> Result<(), Box<dyn Error>> {
     // fastest body still moves, and whether anything went NaN.
     let (mut sunk, mut fastest, mut bad) = (0.0f32, 0.0f32, 0);
     for &b in &bodies {
-        let (Some(p), Some(v), Some(c)) = (
+        let (Some(p), Some(v), Some(c), Some(pose)) = (
             world.get::<Position>(b),
             world.get::<Velocity>(b),
             world.get::<Collider>(b),
+            world.get::<GlobalPose>(b),
         ) else {
             continue;
         };
         if let Shape::TriMesh(m) = &c.shape {
             for v in m.mesh().vertices() {
-                let w = p.0 + *v;
+                let w = pose.0.transform_point(*v);
                 sunk = sunk.max(floor_height(w.x, w.y) - w.z);
             }
         }

@@ -141,9 +141,11 @@ fn tally_impacts(impacts: Res<CcdImpacts>, mut tally: ResMut<ImpactTally>) {
 }
 
 /// The app of one run. Automatic sweeping of fast unmarked bodies is off, so only the balls
-/// marked [`Ccd`] (in the continuous run) are swept.
+/// marked [`Ccd`] (in the continuous run) are swept. The game runs the lecture's pipeline, whose
+/// discrete detection in each substep is what lets balls through: the rigid-body solver (the
+/// default) looks ahead by each ball's motion and stops these balls without CCD.
 fn build_app(args: &Args, recording: Option<RerunDebugPlugin>) -> Result<App, Box<dyn Error>> {
-    let mut app = support::game_app(
+    let mut app = support::lecture_game_app(
         args.substeps,
         Gravity::new(to_world(Vec2::NEG_Y * TABLE_GRAVITY))?,
         ContactSettings {

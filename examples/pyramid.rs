@@ -16,7 +16,6 @@ use glam::{Quat, Vec3};
 use std::error::Error;
 use support::{RecordingArgs, StepTimer};
 use urto::debug::RerunDebugPlugin;
-use urto::plugins::SoftStepPlugin;
 use urto::prelude::*;
 
 /// A pyramid of boxes struck by a ball, recorded for the rerun viewer.
@@ -40,7 +39,7 @@ const HALF: f32 = 0.25;
 fn main() -> Result<(), Box<dyn Error>> {
     let args = Args::parse();
     let mut app = App::new();
-    app.add_plugins((UrtoPlugins::default(), SoftStepPlugin::default()))
+    app.add_plugins(UrtoPlugins::default())
         .add_plugins(RerunDebugPlugin::new(args.recording.config("pyramid", 1))?)
         .insert_resource(Gravity::EARTH_Z_UP);
     app.world_mut()

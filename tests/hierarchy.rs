@@ -226,16 +226,14 @@ fn a_part_with_its_own_velocity_is_quarantined() {
 /// link's motion; without the part's own velocity it would only be pushed aside.
 #[test]
 fn a_turning_kinematic_link_bats_a_ball_at_its_own_speed() {
-    bats_a_ball_at_its_own_speed(common::app());
+    bats_a_ball_at_its_own_speed(common::legacy_app());
 }
 
 /// The same with the rigid-body solver, where the link's contact becomes an immovable solver
 /// body moving at the link's velocity there.
 #[test]
 fn with_the_soft_step_a_turning_kinematic_link_bats_a_ball_at_its_own_speed() {
-    let mut app = common::app();
-    app.add_plugins(urto::plugins::SoftStepPlugin::default());
-    bats_a_ball_at_its_own_speed(app);
+    bats_a_ball_at_its_own_speed(common::app());
 }
 
 fn bats_a_ball_at_its_own_speed(mut app: App) {

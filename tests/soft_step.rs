@@ -13,18 +13,18 @@ fn get<T: Component + Copy>(app: &App, e: Entity) -> T {
     *app.world().get::<T>(e).expect("component present")
 }
 
+/// The group with the solver's settings replaced (`PluginGroup::set`).
 fn soft_step_app_with(settings: SoftStepSettings) -> App {
     let mut app = App::new();
-    app.add_plugins((UrtoPlugins::default(), SoftStepPlugin { settings }))
+    app.add_plugins(UrtoPlugins::default().set(SoftStepPlugin { settings }))
         .insert_resource(Gravity::EARTH_Z_UP);
     app
 }
 
-/// The solver with its defaults, switched on inside the group (the other way in than
-/// [`soft_step_app_with`], which adds it beside the group).
+/// The solver with its defaults: the group as it comes.
 fn soft_step_app() -> App {
     let mut app = App::new();
-    app.add_plugins(UrtoPlugins::default().build().enable::<SoftStepPlugin>())
+    app.add_plugins(UrtoPlugins::default())
         .insert_resource(Gravity::EARTH_Z_UP);
     app
 }
@@ -310,7 +310,7 @@ fn with_the_soft_step_a_ball_falling_at_40_m_s_penetrates_the_ground_less_than_1
 #[test]
 fn with_the_soft_step_a_spring_oscillates_with_the_analytic_period_within_1_percent() {
     let mut app = App::new();
-    app.add_plugins((UrtoPlugins::default(), SoftStepPlugin::default()));
+    app.add_plugins(UrtoPlugins::default());
     let (k, m) = (40.0f32, 2.0f32);
     let body = app
         .world_mut()
@@ -351,7 +351,7 @@ fn with_the_soft_step_a_spring_oscillates_with_the_analytic_period_within_1_perc
 /// A box spinning about its intermediate axis in free flight, with the gyroscopic term on or off.
 fn spun_box(gyroscopic: bool) -> (f32, f32) {
     let mut app = App::new();
-    app.add_plugins((UrtoPlugins::default(), SoftStepPlugin::default()))
+    app.add_plugins(UrtoPlugins::default())
         .insert_resource(urto::settings::RotationSettings { gyroscopic });
     let b = app
         .world_mut()

@@ -26,6 +26,25 @@ pub fn game_app(
     Ok(app)
 }
 
+/// [`game_app`] with the lecture's pipeline (integration and impulse response in every substep)
+/// in place of the rigid-body solver: for the games that show what that pipeline does.
+pub fn lecture_game_app(
+    substeps: u32,
+    gravity: Gravity,
+    contacts: ContactSettings,
+) -> Result<App, Box<dyn Error>> {
+    let mut app = App::new();
+    let timestep = PhysicsTimestep::new(1.0 / 60.0, substeps)?;
+    app.add_plugins(
+        UrtoPlugins::with_timestep(timestep)
+            .build()
+            .disable::<SoftStepPlugin>(),
+    )
+    .insert_resource(gravity)
+    .insert_resource(contacts);
+    Ok(app)
+}
+
 /// The recording options every game takes.
 #[derive(clap::Args, Debug)]
 pub struct RecordingArgs {

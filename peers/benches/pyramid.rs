@@ -99,7 +99,7 @@ impl Urto {
             ..Default::default()
         };
         let mut app = App::new();
-        app.add_plugins((UrtoPlugins::default(), SoftStepPlugin { settings }))
+        app.add_plugins(UrtoPlugins::default().set(SoftStepPlugin { settings }))
             .insert_resource(Gravity::new(Vec3::new(0.0, 0.0, -9.81)).expect("finite"));
         app.world_mut().spawn((
             Collider::cuboid(100.0, 100.0, 0.5),

@@ -46,8 +46,10 @@ use bevy_app::{PluginGroup, PluginGroupBuilder};
 
 /// Every stage of urto in schedule order; `app.add_plugins(UrtoPlugins::default())`.
 ///
-/// [`SoftStepPlugin`] (the rigid-body solver) is in the group but disabled: enable it with
-/// `UrtoPlugins::default().build().enable::<SoftStepPlugin>()` (or add it beside the group).
+/// [`SoftStepPlugin`] (the rigid-body solver: contacts that turn bodies) is in the group and on.
+/// Change its settings with `UrtoPlugins::default().set(SoftStepPlugin { settings })`; the
+/// lecture's pipeline (integration and impulse response in every substep, bodies that contacts
+/// do not turn) runs with `UrtoPlugins::default().build().disable::<SoftStepPlugin>()`.
 ///
 /// The rerun recording is not in the group because it needs a destination that can fail to
 /// open: add [`RerunDebugPlugin`](crate::debug::RerunDebugPlugin) separately.
@@ -84,8 +86,5 @@ impl PluginGroup for UrtoPlugins {
             .add(ResponsePlugin)
             .add(SleepPlugin)
             .add(TransformSyncPlugin)
-            // In the group but off until it becomes the default (issue 10): `.enable::<..>()` or
-            // adding it beside the group switches contacts that turn bodies on.
-            .disable::<SoftStepPlugin>()
     }
 }

@@ -11,14 +11,14 @@
 mod charts;
 mod text;
 
-use crate::common::app_with;
+use crate::common::{app_with, legacy_app_with};
 use crate::{Config, Context, SectionResult};
 use charts::{plot, record};
 use glam::Vec3;
 use std::time::Instant;
 use text::section;
 use urto::dynamics::solver::SoftStepSettings;
-use urto::plugins::SoftStepPlugin;
+use urto::plugins::SoftStepSolver;
 use urto::prelude::*;
 
 /// Drop height of the ball's bottom above the plane (m).
@@ -178,7 +178,11 @@ pub fn run(ctx: &mut Context) -> SectionResult {
 
 /// Drops the ball with `setting` and collects its apexes.
 fn drop_ball(setting: Setting) -> BounceRun {
-    let mut app = app_with(setting.dt, setting.substeps);
+    let mut app = if setting.soft_step {
+        app_with(setting.dt, setting.substeps)
+    } else {
+        legacy_app_with(setting.dt, setting.substeps)
+    };
     app.insert_resource(Gravity::EARTH_Z_UP)
         .insert_resource(Integration(setting.integrator));
     if setting.soft_step {
@@ -188,7 +192,7 @@ fn drop_ball(setting: Setting) -> BounceRun {
             restitution_threshold: threshold,
             ..Default::default()
         };
-        app.add_plugins(SoftStepPlugin { settings });
+        app.insert_resource(SoftStepSolver::new(settings));
     }
     let world = app.world_mut();
     world.spawn((Collider::half_space(Vec3::Z), Static, Restitution(E)));

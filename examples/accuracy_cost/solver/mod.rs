@@ -85,8 +85,7 @@ fn stack(substeps: u32, relax: u32, seconds: f32) -> StackRun {
         ..Default::default()
     };
     let mut app = App::new();
-    app.add_plugins(UrtoPlugins::default())
-        .add_plugins(SoftStepPlugin { settings })
+    app.add_plugins(UrtoPlugins::default().set(SoftStepPlugin { settings }))
         .insert_resource(Gravity::EARTH_Z_UP);
     app.world_mut()
         .spawn((Collider::half_space(Vec3::Z), Static, Friction(0.6)));

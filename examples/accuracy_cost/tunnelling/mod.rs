@@ -10,11 +10,15 @@
 //! centre in the band `[-(t/2 + r), 0)` before the wall's mid-plane (past the mid-plane the
 //! nearest face is the far one, and the ball is pushed on through). With substep travel
 //! `s = v·dt/n` the band is hit with probability `min(1, (t/2 + r)/s)`.
+//!
+//! The runs use the lecture's pipeline (detection in every substep), whose substeps this section
+//! prices. The rigid-body solver, urto's default, detects once per step with speculative
+//! contacts that look ahead by the body's own size, and sweeps faster bodies by CCD.
 
 mod charts;
 mod text;
 
-use crate::common::app_with;
+use crate::common::legacy_app_with;
 use crate::{Config, Context, SectionResult};
 use bevy_ecs::world::EntityWorldMut;
 use charts::{plot, record};
@@ -185,7 +189,7 @@ fn shoot(
     balls: usize,
     decorate: &dyn Fn(&mut EntityWorldMut),
 ) -> TunnelRun {
-    let mut app = app_with(DT, substeps);
+    let mut app = legacy_app_with(DT, substeps);
     // Only marked balls are swept: the substep rows measure substeps alone.
     app.insert_resource(CcdSettings {
         auto_speed_ratio: None,

@@ -181,7 +181,10 @@ fn contact_in_order(
             let tb = tb.transformed(&b_in_a);
             // Exact on the same coordinates (min/max do not round), so it rejects no touching
             // pair, and it spares the exact test most of a leaf pair's triangle pairs.
-            if !ta.aabb().expanded(margin).intersects(&tb.aabb()) {
+            if !ta.aabb().expanded(margin).intersects(&tb.aabb())
+                || beyond_plane(&tb, &ta, margin)
+                || beyond_plane(&ta, &tb, margin)
+            {
                 return false;
             }
             let Some(c) = pair_contact(&ta, &tb).or_else(|| gap_contact(&ta, &tb, margin)) else {
@@ -230,6 +233,23 @@ fn pair_contact(ta: &Triangle, tb: &Triangle) -> Option<PairContact> {
         point,
         side,
     })
+}
+
+/// True when every corner of `t` lies farther than `margin` on one side of `base`'s plane: the
+/// triangles neither cross nor come within `margin` (a separating plane, six dot products, that
+/// spares the exact tests the pairs the boxes let through on slanted surfaces). Exact for
+/// `margin` 0 up to the rounding of the plane, so a touching pair is kept: corners on the plane
+/// are not beyond it.
+fn beyond_plane(t: &Triangle, base: &Triangle, margin: f32) -> bool {
+    let Some(n) = base.normal() else {
+        return false;
+    };
+    let offset = n.dot(base.a);
+    let s = t.vertices().map(|v| n.dot(v) - offset);
+    // Rounding of the plane's offset at these coordinates, so no touching pair is lost.
+    let slack = 4.0 * f32::EPSILON * (offset.abs() + s.iter().fold(0.0f32, |m, x| m.max(x.abs())));
+    let reach = margin + slack;
+    s.iter().all(|&d| d > reach) || s.iter().all(|&d| d < -reach)
 }
 
 /// The speculative estimate of two disjoint triangles at most `margin` apart (module notes), or

@@ -1,31 +1,32 @@
 //! The rigid-body solver in the ECS: contacts turn bodies.
 //!
-//! [`SoftStepPlugin`], added next to [`UrtoPlugins`](crate::UrtoPlugins), hands integration and
-//! contact response to the core [`Solver`] (soft-step substeps, contacts with lever arms,
-//! friction, restitution, springs; see [`crate::dynamics::solver`]): the Integrate stage and
-//! the legacy response stand aside (their systems run only without this plugin's resource),
-//! the broad and narrow phases find the contacts once per step at the step's start, looking
-//! ahead by each body's speculative margin ([`SpeculativeMargin`]), and one system in the
-//! Response set gathers the bodies, calls [`Solver::step`] and writes positions, rotations and
-//! velocities back. Continuous collision sweeps the solver's motion afterwards; collision
+//! [`SoftStepPlugin`], in [`UrtoPlugins`](crate::UrtoPlugins) and on by default, hands
+//! integration and contact response to the core [`Solver`] (soft-step substeps, contacts with
+//! lever arms, friction, restitution, springs; see [`crate::dynamics::solver`]): the Integrate
+//! stage and the legacy response stand aside (their systems run only without this plugin's
+//! resource), the broad and narrow phases find the contacts once per step at the step's start,
+//! looking ahead by each body's speculative margin ([`SpeculativeMargin`]), and one system in
+//! the Response set gathers the bodies, calls [`Solver::step`] and writes positions, rotations
+//! and velocities back. Continuous collision sweeps the solver's motion afterwards; collision
 //! messages, sleeping, hierarchies and validation work as before.
 //!
-//! It is opt-in until it is the default (issue 10); without it the legacy pipeline runs (the
-//! selected [`Integration`](crate::settings::Integration) method, bodies that do not turn on
-//! contact):
+//! Its settings are set in the group; disabling it brings back the lecture's pipeline (the
+//! selected [`Integration`](crate::settings::Integration) method, bodies that contacts do not
+//! turn):
 //!
 //! ```
 //! # use bevy_app::App;
 //! # use urto::prelude::*;
-//! # use urto::plugins::SoftStepPlugin;
-//! let mut app = App::new();
-//! app.add_plugins((UrtoPlugins::default(), SoftStepPlugin::default()));
+//! # use urto::dynamics::solver::SoftStepSettings;
+//! let settings = SoftStepSettings { substeps: 8, ..Default::default() };
+//! App::new().add_plugins(UrtoPlugins::default().set(SoftStepPlugin { settings }));
+//! // The lecture's pipeline instead:
+//! App::new().add_plugins(UrtoPlugins::default().build().disable::<SoftStepPlugin>());
 //! ```
 //!
 //! Not done yet (issue 10's later stages): sleeping is per body, not per island (an awake body
-//! approaching a sleeper wakes it); two meshes are found only once they touch; springs pull
-//! centres of mass. Bodies are ordered by entity (creation order)
-//! and contacts by collider pair, never by archetype iteration.
+//! approaching a sleeper wakes it); springs pull centres of mass. Bodies are ordered by entity
+//! (creation order) and contacts by collider pair, never by archetype iteration.
 
 mod contact_inputs;
 mod lookahead;
@@ -51,7 +52,8 @@ use bevy_ecs::query::{QueryItem, ROQueryItem};
 use glam::{Quat, Vec3};
 use std::time::Instant;
 
-/// Opt-in: the soft-step rigid-body solver replaces integration and the legacy response.
+/// The soft-step rigid-body solver, in place of integration and the legacy response (in
+/// [`UrtoPlugins`](crate::UrtoPlugins), on by default).
 #[derive(Debug, Clone, Default)]
 pub struct SoftStepPlugin {
     /// The solver's tunables (Box2D v3's defaults, stiffer contacts; see
