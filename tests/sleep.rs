@@ -68,18 +68,66 @@ fn resting_balls_fall_asleep_and_cost_nothing() {
     assert_eq!(ended, 0, "falling asleep ends no collision");
 }
 
-/// Sleeping is opt-in: by default nothing sleeps.
+/// Sleeping is on by default; turned off, a resting ball never sleeps and is integrated every
+/// step (the lecture's pipeline, whose integrate stage counts its bodies).
 #[test]
-fn sleeping_is_off_by_default() {
-    assert!(!SleepSettings::default().enabled);
+fn sleeping_is_on_by_default_and_off_when_disabled() {
+    assert!(SleepSettings::default().enabled);
     let mut app = common::legacy_app();
-    app.insert_resource(Gravity::EARTH_Z_UP);
+    app.insert_resource(Gravity::EARTH_Z_UP)
+        .insert_resource(SleepSettings {
+            enabled: false,
+            ..Default::default()
+        });
     app.world_mut()
         .spawn((Collider::half_space(Vec3::Z), Static));
     let b = ball(&mut app, Vec3::new(0.0, 0.0, 0.6));
     urto::step(app.world_mut(), 120).unwrap();
     assert!(!asleep(&app, b));
     assert_eq!(counter(&app, "integrate/bodies"), 1.0);
+}
+
+fn crate_box(app: &mut App, z: f32) -> Entity {
+    app.world_mut()
+        .spawn((
+            Collider::cuboid(0.5, 0.5, 0.5),
+            Position::new(0.0, 0.0, z),
+            Velocity::default(),
+        ))
+        .id()
+}
+
+/// A stack of three boxes falls asleep as one island (one key for all three, in the same step),
+/// and a push on the bottom box wakes the whole stack before the next step moves anything.
+#[test]
+fn a_stack_sleeps_and_wakes_as_one_island_within_one_step() {
+    let mut app = sleepy_app();
+    let stack: Vec<Entity> = (0..3)
+        .map(|i| crate_box(&mut app, 0.5 + i as f32))
+        .collect();
+    let states = |app: &App| -> Vec<SleepState> {
+        stack
+            .iter()
+            .map(|&e| *app.world().get::<SleepState>(e).unwrap())
+            .collect()
+    };
+    let mut slept_at = None;
+    for step in 0..180 {
+        urto::step(app.world_mut(), 1).unwrap();
+        let s = states(&app);
+        let count = s.iter().filter(|s| s.asleep).count();
+        assert!(count == 0 || count == 3, "step {step}: {count} of 3 asleep");
+        if count == 3 {
+            slept_at = Some(step);
+            break;
+        }
+    }
+    assert!(slept_at.is_some(), "the stack never slept");
+    let s = states(&app);
+    assert!(s[0].island != 0 && s.iter().all(|x| x.island == s[0].island));
+    app.world_mut().get_mut::<Velocity>(stack[0]).unwrap().0 = Vec3::new(0.5, 0.0, 0.0);
+    urto::step(app.world_mut(), 1).unwrap();
+    assert!(states(&app).iter().all(|s| !s.asleep && s.island == 0));
 }
 
 /// A ball dropped on a sleeping ball wakes it: the two then move as two awake bodies would.

@@ -246,6 +246,9 @@ pub struct SleepState {
     pub still_for: f32,
     /// Where it fell asleep: moving it elsewhere wakes it.
     pub at: Vec3,
+    /// The island it fell asleep with (0: none): waking one body of it wakes all of them
+    /// ([`crate::dynamics::islands`]).
+    pub island: u64,
 }
 
 impl SleepState {

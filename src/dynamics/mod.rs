@@ -1,9 +1,10 @@
-//! Dynamics: integrators (linear and rotational), forces and collision response (plain Rust,
-//! no ECS).
+//! Dynamics: integrators (linear and rotational), forces, collision response, the rigid-body
+//! solver and islands (plain Rust, no ECS).
 
 pub mod forces;
 pub mod free_rotation;
 pub mod integrators;
+pub mod islands;
 pub mod response;
 pub mod rotation;
 pub mod solver;

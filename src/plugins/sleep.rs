@@ -1,21 +1,29 @@
 //! Sleeping: bodies that have come to rest stop costing time until something wakes them (the
-//! usual engine technique; Box2D and rapier do the same with islands).
+//! usual engine technique; Box2D, rapier and Jolt do the same).
 //!
-//! At the end of each step a dynamic body slower than [`SleepSettings::speed`] for
-//! [`SleepSettings::time`] (its centre, and its surface turning at `|ω|` times its reach) falls
-//! asleep: its velocity and angular velocity become exactly zero, integration skips
-//! it, and the narrow phase skips its pairs with static and other sleeping bodies (their contact
-//! is kept for the collision messages). It wakes when an awake body's contact moves it faster
-//! than the sleep speed (see the response), when game code moves it, sets its velocity or
-//! angular velocity or pushes it with a [`Force`], [`Torque`] or [`ForceAtPoint`], when gravity changes, or when a body it touched disappears.
-//! Without islands a body sleeps on its own stillness alone, which is enough for piles and
-//! stacks: a body kept moving by its neighbours never stays still long enough.
+//! Bodies sleep by islands ([`crate::dynamics::islands`]): at the end of each step the awake
+//! dynamic bodies are grouped by the step's contacts, and an island whose every body has been
+//! slower than [`SleepSettings::speed`] for [`SleepSettings::time`] (its centre, and its surface
+//! turning at `|ω|` times its reach) falls asleep as a whole: velocities and angular velocities
+//! become exactly zero, the solver skips its bodies, and the narrow phase skips their pairs with
+//! static and other sleeping bodies (the contact is kept for the collision messages). An island
+//! touching a moving kinematic body or a body on a spring never sleeps; one that comes to rest
+//! against a sleeping island joins it.
+//!
+//! A body wakes when an awake body's contact moves it faster than the sleep speed (see the
+//! response and the solver), when game code moves it, sets its velocity or angular velocity or
+//! pushes it with a [`Force`], [`Torque`] or [`ForceAtPoint`], when gravity changes, or when a
+//! contact of it ends (a body it touched moved away or disappeared); its whole island wakes with
+//! it, before the next step simulates anything.
 
 use crate::components::*;
+use crate::dynamics::islands::{IslandBuilder, Stillness, islands_to_sleep};
 use crate::plugins::core::PrepareStart;
+use crate::plugins::narrow_phase::Contacts;
 use crate::schedule::{PhysicsSchedule, PhysicsSet};
 use crate::settings::{Gravity, PhysicsTimestep, SleepSettings};
 use bevy_app::prelude::*;
+use bevy_ecs::entity::EntityHashMap;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 
@@ -28,13 +36,17 @@ impl Plugin for SleepPlugin {
         app.init_resource::<SleepSettings>()
             .add_systems(
                 PhysicsSchedule,
-                wake_on_game_changes
+                (wake_on_game_changes, wake_islands)
+                    .chain()
                     .run_if(sleep_enabled)
                     .in_set(PrepareStart),
             )
             .add_systems(
                 PhysicsSchedule,
-                fall_asleep.run_if(sleep_enabled).in_set(PhysicsSet::Finish),
+                (wake_islands, fall_asleep)
+                    .chain()
+                    .run_if(sleep_enabled)
+                    .in_set(PhysicsSet::Finish),
             );
     }
 }
@@ -99,7 +111,31 @@ fn wake_on_game_changes(mut bodies: Query<Sleeper>, gravity: Option<Res<Gravity>
     }
 }
 
+/// Wakes every sleeping body whose island has an awake member (woken by a contact or by game
+/// code since the last look), and forgets the island of the bodies so woken.
+fn wake_islands(mut bodies: Query<&mut SleepState>, mut woken: Local<Vec<u64>>) {
+    woken.clear();
+    woken.extend(
+        bodies
+            .iter()
+            .filter(|s| !s.asleep && s.island != 0)
+            .map(|s| s.island),
+    );
+    if woken.is_empty() {
+        return;
+    }
+    woken.sort_unstable();
+    woken.dedup();
+    for mut s in &mut bodies {
+        if s.island != 0 && woken.binary_search(&s.island).is_ok() {
+            s.wake();
+            s.island = 0;
+        }
+    }
+}
+
 type Candidate<'a> = (
+    Entity,
     &'a mut SleepState,
     &'a Position,
     &'a mut Velocity,
@@ -114,35 +150,148 @@ type CandidateFilter = (
     Without<Spring>,
 );
 
-/// Counts how long each awake dynamic body has been still, and puts it to sleep after
-/// [`SleepSettings::time`] with its velocity set to exactly zero.
+/// What a body in a contact is to the islands.
+#[derive(Clone, Copy, Debug)]
+enum Slot {
+    /// An awake dynamic body, at this index of the step's islands.
+    Awake(usize),
+    /// A sleeping body, of this island.
+    Asleep(u64),
+    /// A kinematic body; moving ones keep what they touch awake.
+    Kinematic { moving: bool },
+}
+
+/// The islands of the step and the buffers of [`fall_asleep`], kept from step to step.
+#[derive(Default)]
+struct IslandScratch {
+    islands: IslandBuilder,
+    slots: EntityHashMap<Slot>,
+    awake: Vec<Entity>,
+    stillness: Vec<Stillness>,
+    /// Per awake body: the sleeping island it rests against (0: none).
+    joins: Vec<u64>,
+    asleep: Vec<bool>,
+    /// Per island root: the key its bodies sleep with.
+    keys: Vec<u64>,
+    last_key: u64,
+}
+
+/// Counts how long each awake dynamic body has been still, groups the awake bodies into islands
+/// by the step's contacts, and puts to sleep the islands still for [`SleepSettings::time`].
 fn fall_asleep(
     mut bodies: Query<Candidate, CandidateFilter>,
+    never_sleep: Query<(), (With<Spring>, Without<Static>)>,
+    contacts: Option<Res<Contacts>>,
     settings: Res<SleepSettings>,
     timestep: Res<PhysicsTimestep>,
+    mut scratch: Local<IslandScratch>,
 ) {
-    let dt = timestep.dt();
-    for (mut sleep, p, mut v, m, mut w, volume) in &mut bodies {
-        if sleep.asleep || m.inverse() == 0.0 {
+    let s = &mut *scratch;
+    count_stillness(&mut bodies, settings.speed, timestep.dt(), s);
+    s.islands.reset(s.awake.len());
+    s.joins.clear();
+    s.joins.resize(s.awake.len(), 0);
+    if let Some(contacts) = contacts {
+        for pair in &contacts.pairs {
+            link_contact(s, pair.a, pair.b, &never_sleep);
+            link_contact(s, pair.b, pair.a, &never_sleep);
+        }
+    }
+    islands_to_sleep(&mut s.islands, &s.stillness, settings.time, &mut s.asleep);
+    assign_island_keys(s);
+    for (i, &e) in s.awake.iter().enumerate() {
+        if !s.asleep[i] {
             continue;
         }
-        // A turning body's surface moves at up to |ω| times its reach (Box2D's sleep test).
-        let turning = w.as_ref().map_or(0.0, |w| w.0.length()) * volume.reach();
-        if v.0.length().max(turning) >= settings.speed {
-            if sleep.still_for != 0.0 {
-                sleep.still_for = 0.0;
-            }
-            continue;
-        }
-        sleep.still_for += dt;
-        if sleep.still_for >= settings.time {
+        let key = s.keys[s.islands.root(i)];
+        if let Ok((_, mut sleep, p, mut v, _, mut w, _)) = bodies.get_mut(e) {
             sleep.asleep = true;
             sleep.at = p.0;
+            sleep.island = key;
             // Not a change by game code: the wake-up check compares values, not change ticks.
             v.bypass_change_detection().0 = Vec3::ZERO;
             if let Some(w) = w.as_mut() {
                 w.bypass_change_detection().0 = Vec3::ZERO;
             }
+        }
+    }
+}
+
+/// Lists the awake dynamic bodies with their stillness (counting it on) and every body's slot.
+fn count_stillness(
+    bodies: &mut Query<Candidate, CandidateFilter>,
+    speed: f32,
+    dt: f32,
+    s: &mut IslandScratch,
+) {
+    s.slots.clear();
+    s.awake.clear();
+    s.stillness.clear();
+    for (e, mut sleep, _, v, m, w, volume) in bodies.iter_mut() {
+        let spin = w.as_ref().map_or(0.0, |w| w.0.length());
+        if m.inverse() == 0.0 {
+            let moving = v.0 != Vec3::ZERO || spin != 0.0;
+            s.slots.insert(e, Slot::Kinematic { moving });
+            continue;
+        }
+        if sleep.asleep {
+            s.slots.insert(e, Slot::Asleep(sleep.island));
+            continue;
+        }
+        // A turning body's surface moves at up to |ω| times its reach (Box2D's sleep test).
+        if v.0.length().max(spin * volume.reach()) >= speed {
+            if sleep.still_for != 0.0 {
+                sleep.still_for = 0.0;
+            }
+        } else {
+            sleep.still_for += dt;
+        }
+        s.slots.insert(e, Slot::Awake(s.awake.len()));
+        s.awake.push(e);
+        s.stillness.push(Stillness {
+            still_for: sleep.still_for,
+            restless: false,
+        });
+    }
+}
+
+/// The contact of `body` with `other`, seen from `body`'s side: links two awake bodies, joins a
+/// sleeping island, or makes `body` restless next to a body that never sleeps.
+fn link_contact(
+    s: &mut IslandScratch,
+    body: Entity,
+    other: Entity,
+    never_sleep: &Query<(), (With<Spring>, Without<Static>)>,
+) {
+    let Some(&Slot::Awake(i)) = s.slots.get(&body) else {
+        return;
+    };
+    match s.slots.get(&other) {
+        Some(&Slot::Awake(j)) => s.islands.link(i, j),
+        Some(&Slot::Asleep(key)) if key != 0 => s.joins[i] = key,
+        Some(&Slot::Kinematic { moving: true }) => s.stillness[i].restless = true,
+        None if never_sleep.contains(other) => s.stillness[i].restless = true,
+        _ => {}
+    }
+}
+
+/// The key of each island about to sleep: the sleeping island it rests against, if any (it
+/// joins it, so they wake together), else a new one.
+fn assign_island_keys(s: &mut IslandScratch) {
+    let n = s.awake.len();
+    s.keys.clear();
+    s.keys.resize(n, 0);
+    for i in 0..n {
+        if s.asleep[i] && s.joins[i] != 0 {
+            let r = s.islands.root(i);
+            s.keys[r] = s.joins[i];
+        }
+    }
+    for i in 0..n {
+        let r = s.islands.root(i);
+        if s.asleep[i] && s.keys[r] == 0 {
+            s.last_key += 1;
+            s.keys[r] = s.last_key;
         }
     }
 }
