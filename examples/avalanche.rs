@@ -290,6 +290,8 @@ impl Pour {
                 Rotation(Quat::from_euler(EulerRot::XYZ, turn[0], turn[1], turn[2])),
                 Velocity(throw),
                 Mass(mass),
+                // A 1 cm lever arm against rolling, so balls come to rest and the pile sleeps.
+                RollingResistance(0.01),
                 kind.color(),
             ));
             if last {

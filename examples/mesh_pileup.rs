@@ -132,6 +132,7 @@ fn main() -> Result<(), Box<dyn Error>> {
                     position,
                     Velocity::default(),
                     LinearDrag(0.8),
+                    RollingResistance(0.01),
                 ))
                 .id(),
         );

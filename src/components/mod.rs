@@ -233,8 +233,9 @@ pub struct GlobalPose(pub Isometry);
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 pub struct StepStartPose(pub Isometry);
 
-/// Whether a dynamic body sleeps (with [`SleepSettings`](crate::settings::SleepSettings) on): a
-/// body slower than the settings' speed for their time falls asleep; it is then neither
+/// Whether a dynamic body sleeps (with [`SleepSettings`](crate::settings::SleepSettings) on, the
+/// default): a body whose whole island has been slower than the settings' speed for their time
+/// falls asleep with it; it is then neither
 /// integrated nor tested against other sleeping or static bodies, and it wakes when something
 /// awake hits it, when the game moves it, sets its velocity or pushes it with a [`Force`], or
 /// when gravity changes.

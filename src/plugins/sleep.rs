@@ -150,13 +150,12 @@ type CandidateFilter = (
     Without<Spring>,
 );
 
-/// What a body in a contact is to the islands.
+/// What a body in a contact is to the islands (sleeping bodies have no slot: they are looked
+/// up only when a contact names them, so a sleeping island costs no work per step here).
 #[derive(Clone, Copy, Debug)]
 enum Slot {
     /// An awake dynamic body, at this index of the step's islands.
     Awake(usize),
-    /// A sleeping body, of this island.
-    Asleep(u64),
     /// A kinematic body; moving ones keep what they touch awake.
     Kinematic { moving: bool },
 }
@@ -193,8 +192,8 @@ fn fall_asleep(
     s.joins.resize(s.awake.len(), 0);
     if let Some(contacts) = contacts {
         for pair in &contacts.pairs {
-            link_contact(s, pair.a, pair.b, &never_sleep);
-            link_contact(s, pair.b, pair.a, &never_sleep);
+            link_contact(s, (pair.a, pair.b), &bodies, &never_sleep);
+            link_contact(s, (pair.b, pair.a), &bodies, &never_sleep);
         }
     }
     islands_to_sleep(&mut s.islands, &s.stillness, settings.time, &mut s.asleep);
@@ -235,7 +234,6 @@ fn count_stillness(
             continue;
         }
         if sleep.asleep {
-            s.slots.insert(e, Slot::Asleep(sleep.island));
             continue;
         }
         // A turning body's surface moves at up to |ω| times its reach (Box2D's sleep test).
@@ -259,8 +257,8 @@ fn count_stillness(
 /// sleeping island, or makes `body` restless next to a body that never sleeps.
 fn link_contact(
     s: &mut IslandScratch,
-    body: Entity,
-    other: Entity,
+    (body, other): (Entity, Entity),
+    bodies: &Query<Candidate, CandidateFilter>,
     never_sleep: &Query<(), (With<Spring>, Without<Static>)>,
 ) {
     let Some(&Slot::Awake(i)) = s.slots.get(&body) else {
@@ -268,10 +266,16 @@ fn link_contact(
     };
     match s.slots.get(&other) {
         Some(&Slot::Awake(j)) => s.islands.link(i, j),
-        Some(&Slot::Asleep(key)) if key != 0 => s.joins[i] = key,
-        Some(&Slot::Kinematic { moving: true }) => s.stillness[i].restless = true,
-        None if never_sleep.contains(other) => s.stillness[i].restless = true,
-        _ => {}
+        Some(&Slot::Kinematic { moving }) => s.stillness[i].restless |= moving,
+        None => {
+            if let Ok((_, sleep, ..)) = bodies.get(other) {
+                if sleep.asleep && sleep.island != 0 {
+                    s.joins[i] = sleep.island;
+                }
+            } else if never_sleep.contains(other) {
+                s.stillness[i].restless = true;
+            }
+        }
     }
 }
 

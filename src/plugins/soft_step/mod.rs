@@ -24,9 +24,10 @@
 //! App::new().add_plugins(UrtoPlugins::default().build().disable::<SoftStepPlugin>());
 //! ```
 //!
-//! Not done yet (issue 10's later stages): sleeping is per body, not per island (an awake body
-//! approaching a sleeper wakes it); springs pull centres of mass. Bodies are ordered by entity
-//! (creation order) and contacts by collider pair, never by archetype iteration.
+//! Bodies sleep by islands (`plugins/sleep.rs`); a sleeping body is an immovable one to the
+//! solver, and an awake one approaching it wakes its island. Not done yet: springs pull centres
+//! of mass. Bodies are ordered by entity (creation order) and contacts by collider pair, never
+//! by archetype iteration.
 
 mod contact_inputs;
 mod lookahead;
