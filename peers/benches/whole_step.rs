@@ -3,23 +3,23 @@
 //! Every scene is described once ([`Scene`]: balls with a position and a velocity, static planes,
 //! gravity, friction, restitution) and built from that description in both engines, so both start
 //! from the same state. Both step at dt = 1/60 with gravity 9.81 m/s² down Z where there is
-//! gravity. urto runs its defaults (one substep, 8 velocity + 4 position sweeps); rapier runs its
-//! defaults (4 solver iterations, no `parallel` feature: single-threaded like urto). urto bodies
-//! translate only, so rapier's bodies have `lock_rotations()`; friction and restitution are equal
-//! on every collider in both engines (the pair values are then equal too, whatever the combine
-//! rule); every ball has a mass of 1 kg in both.
+//! gravity. urto runs its defaults (the rigid-body solver: one collision detection per step, 4
+//! soft substeps; sleeping by islands); rapier runs its defaults (4 solver iterations, no
+//! `parallel` feature: single-threaded like urto). Bodies turn in both engines (rotations
+//! unlocked); friction and restitution are equal on every collider in both engines (the pair
+//! values are then equal too, whatever the combine rule); every ball has a mass of 1 kg in both.
 //!
 //! Scenes (see `peers/README.md` for the numbers), each with its static planes built two ways in
 //! both engines: `half_spaces` (urto `Collider::half_space`, rapier `SharedShape::halfspace`;
 //! unbounded, so both engines pair every ball with every plane) and `slabs` (a 1 m thick box
 //! behind each face: urto `Collider::cuboid`, rapier `SharedShape::cuboid`).
 //! - `resting_*`: N = 1,000 and 10,000 balls on a ground, apart on a grid; time per step after
-//!   120 settling steps. Each engine with and without sleeping (urto: off by default,
-//!   `SleepSettings { enabled: true, .. }`; rapier: on by default, `can_sleep(false)`).
+//!   120 settling steps. Each engine with and without sleeping (both on by default; off: urto
+//!   `SleepSettings { enabled: false, .. }`, rapier `can_sleep(false)`).
 //! - `falling_pile_*`: 1,000 balls dropped in a grid, with small random horizontal velocities,
 //!   into an open box (a ground and four walls); one criterion iteration is the first 300 steps
-//!   of a fresh scene (the build is not timed), so divide by 300 for a step. Rapier with and
-//!   without sleeping; urto with one substep and with 4 (see [`URTO_PILE_VARIANTS`]).
+//!   of a fresh scene (the build is not timed), so divide by 300 for a step. Each engine with and
+//!   without sleeping.
 //! - `sparse_movers_*`: 10,000 balls flying with random velocities, no gravity, elastic and
 //!   frictionless, in a big closed box; time per step after 300 steps.
 //!
@@ -264,17 +264,17 @@ fn sparse_movers(n: usize, walls: Walls) -> Scene {
 
 // ---------------------------------------------------------------- urto
 
-/// urto with `UrtoPlugins` defaults (60 Hz, one substep), the scene's friction and restitution as
-/// the contact defaults (every collider then has them).
-fn urto_app(scene: &Scene) -> (App, Vec<bevy_ecs::entity::Entity>) {
-    urto_app_substeps(scene, 1)
-}
-
-/// The same with `substeps` substeps per step (dt stays 1/60).
-fn urto_app_substeps(scene: &Scene, substeps: u32) -> (App, Vec<bevy_ecs::entity::Entity>) {
+/// urto with `UrtoPlugins` defaults (60 Hz, the rigid-body solver), the scene's friction and
+/// restitution as the contact defaults (every collider then has them), sleeping on (the
+/// default) or off.
+fn urto_app(scene: &Scene, can_sleep: bool) -> (App, Vec<bevy_ecs::entity::Entity>) {
     let mut app = App::new();
-    let timestep = urto::PhysicsTimestep::new(DT, substeps).expect("valid timestep");
+    let timestep = urto::PhysicsTimestep::new(DT, 1).expect("valid timestep");
     app.add_plugins(UrtoPlugins::with_timestep(timestep));
+    app.insert_resource(SleepSettings {
+        enabled: can_sleep,
+        ..Default::default()
+    });
     app.insert_resource(ContactSettings {
         default_restitution: scene.restitution,
         default_friction: scene.friction,
@@ -378,7 +378,7 @@ struct Rapier {
 
 impl Rapier {
     /// The scene with rapier's default parameters (dt = 1/60, 4 solver iterations); rotations
-    /// locked; `can_sleep` on (rapier's default) or off.
+    /// free; `can_sleep` on (rapier's default) or off.
     fn new(scene: &Scene, can_sleep: bool) -> Self {
         let mut world = RapierWorld::new(rv(scene.gravity), DT);
         for p in &scene.planes {
@@ -401,7 +401,6 @@ impl Rapier {
                 let body = rp::RigidBodyBuilder::dynamic()
                     .translation(rv(b.pos))
                     .linvel(rv(b.vel))
-                    .lock_rotations()
                     .can_sleep(can_sleep);
                 let c = rp::ColliderBuilder::ball(RADIUS)
                     .mass(1.0)
@@ -489,11 +488,8 @@ fn initial_speed(scene: &Scene) -> f32 {
 /// The rapier variants of a scene: `(label, can_sleep)`.
 const RAPIER_SLEEP_VARIANTS: [(&str, bool); 2] = [("rapier", true), ("rapier (no sleep)", false)];
 
-/// The urto variants of `falling_pile`: `(label, substeps)`. One substep is the comparison the
-/// scenes are set up for; with it urto's pile has not come to rest after 300 steps (nor after
-/// 900), with 4 it has, like rapier's (whose 4 default solver iterations are 4 solver substeps
-/// inside one collision detection), so the 4-substep row is the like-for-like quality point.
-const URTO_PILE_VARIANTS: [(&str, u32); 2] = [("urto", 1), ("urto (4 substeps)", 4)];
+/// The urto variants of a scene: `(label, can_sleep)`.
+const URTO_SLEEP_VARIANTS: [(&str, bool); 2] = [("urto", true), ("urto (no sleep)", false)];
 
 /// The wall kinds to run: `PEERS_WALLS` = `half_spaces`, `slabs` or `both` (default).
 fn wall_kinds() -> Vec<Walls> {
@@ -523,35 +519,16 @@ fn bench_resting(c: &mut Criterion) {
                 .sample_size(if n > 1000 { 10 } else { 30 })
                 .throughput(Throughput::Elements(n as u64));
 
-            // urto's default (no sleeping): the work of every step.
-            let (mut app, balls) = urto_app(&scene);
-            urto_step(&mut app, settle - 60);
-            let stages = urto_step_staged(&mut app, 60);
-            sanity(&name, "urto", &scene, settle, urto_state(&app, &balls));
-            eprintln!("[urto stages] µs per step, mean of the last 60: {stages}");
-            group.bench_function(BenchmarkId::new("urto", n), |b| {
-                b.iter(|| urto_step(&mut app, 1))
-            });
-            drop(app);
-
-            // urto with its opt-in sleeping: the balls are asleep after the settling steps.
-            let (mut app, balls) = urto_app(&scene);
-            app.insert_resource(SleepSettings {
-                enabled: true,
-                ..Default::default()
-            });
-            urto_step(&mut app, settle);
-            sanity(
-                &name,
-                "urto (sleeping)",
-                &scene,
-                settle,
-                urto_state(&app, &balls),
-            );
-            group.bench_function(BenchmarkId::new("urto (sleeping)", n), |b| {
-                b.iter(|| urto_step(&mut app, 1))
-            });
-            drop(app);
+            for (label, can_sleep) in URTO_SLEEP_VARIANTS {
+                let (mut app, balls) = urto_app(&scene, can_sleep);
+                urto_step(&mut app, settle - 60);
+                let stages = urto_step_staged(&mut app, 60);
+                sanity(&name, label, &scene, settle, urto_state(&app, &balls));
+                eprintln!("[urto stages] µs per step, mean of the last 60: {stages}");
+                group.bench_function(BenchmarkId::new(label, n), |b| {
+                    b.iter(|| urto_step(&mut app, 1))
+                });
+            }
 
             for (label, can_sleep) in RAPIER_SLEEP_VARIANTS {
                 let mut r = Rapier::new(&scene, can_sleep);
@@ -590,8 +567,8 @@ fn bench_falling_pile(c: &mut Criterion) {
 
         // The sanity runs go on to PILE_CHECK_STEPS (not timed): has the pile come to rest?
         let more = PILE_CHECK_STEPS - PILE_STEPS;
-        for (label, substeps) in URTO_PILE_VARIANTS {
-            let (mut app, balls) = urto_app_substeps(&scene, substeps);
+        for (label, can_sleep) in URTO_SLEEP_VARIANTS {
+            let (mut app, balls) = urto_app(&scene, can_sleep);
             let stages = urto_step_staged(&mut app, PILE_STEPS);
             sanity(&name, label, &scene, PILE_STEPS, urto_state(&app, &balls));
             eprintln!("[urto stages] µs per step, mean of {PILE_STEPS}: {stages}");
@@ -619,12 +596,12 @@ fn bench_falling_pile(c: &mut Criterion) {
             .sampling_mode(SamplingMode::Flat)
             .measurement_time(Duration::from_secs(8))
             .throughput(Throughput::Elements(u64::from(PILE_STEPS)));
-        for (label, substeps) in URTO_PILE_VARIANTS {
+        for (label, can_sleep) in URTO_SLEEP_VARIANTS {
             group.bench_function(BenchmarkId::new(label, n), |b| {
                 b.iter_custom(|iters| {
                     timed_runs(
                         iters,
-                        || urto_app_substeps(&scene, substeps).0,
+                        || urto_app(&scene, can_sleep).0,
                         |app| urto_step(app, PILE_STEPS),
                     )
                 })
@@ -661,7 +638,7 @@ fn bench_sparse_movers(c: &mut Criterion) {
             .sample_size(10)
             .throughput(Throughput::Elements(n as u64));
 
-        let (mut app, balls) = urto_app(&scene);
+        let (mut app, balls) = urto_app(&scene, true);
         urto_step(&mut app, before - 60);
         let stages = urto_step_staged(&mut app, 60);
         sanity(&name, "urto", &scene, before, urto_state(&app, &balls));

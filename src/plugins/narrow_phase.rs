@@ -28,7 +28,8 @@ use crate::bounding::Aabb;
 use crate::bvh::QueryStats;
 use crate::components::*;
 use crate::geometry::contacts::{
-    ContactScratch, NO_TRIANGLE, contact_with_scratch, speculative_contact_with_scratch,
+    ContactScratch, ManifoldCache, NO_TRIANGLE, contact_with_scratch,
+    speculative_contact_with_scratch,
 };
 use crate::geometry::{ContactManifold, Shape};
 use crate::hierarchy::{BvTree, HierarchyStats, PairScratch, descend_pairs};
@@ -114,6 +115,8 @@ pub struct OverlappingLeaves {
 #[derive(Resource, Default)]
 struct NarrowPhaseScratch {
     contact: ContactScratch,
+    /// Mesh pairs' contacts, reused while the pair barely moves (`manifold_cache.rs`).
+    cache: ManifoldCache,
     pairs: PairScratch<Entity, Entity>,
     leaf_pairs: Vec<(Entity, Entity)>,
     /// Nodes whose volume the descent read, while [`HierarchyVisits`] is enabled.
@@ -142,7 +145,7 @@ impl Plugin for NarrowPhasePlugin {
 }
 
 type Node<'a> = (
-    Option<&'a Collider>,
+    Option<Ref<'a, Collider>>,
     &'a GlobalPose,
     &'a BoundingVolume,
     Option<&'a Children>,
@@ -219,6 +222,7 @@ fn compute_contacts(
     }
     let record = debug.enabled;
     scratch.contact.set_record_hits(record);
+    scratch.cache.begin_step();
     debug.pairs.clear();
     visits.clear();
     let lookahead = lookahead.get();
@@ -316,17 +320,40 @@ impl NarrowPhaseScratch {
         } else {
             ((&ca.shape, &ga.0), (&cb.shape, &gb.0))
         };
-        let scratch = &mut self.contact;
-        let mut m = if margin > 0.0 {
-            speculative_contact_with_scratch(sa, pa, sb, pb, margin, scratch)
+        let involves_mesh = is_mesh(&ca.shape) || is_mesh(&cb.shape);
+        // A mesh pair that barely moved since its last test reuses it (not after a collider
+        // changed), with the triangle pairs it found for the debug view.
+        let cacheable = involves_mesh && !ca.is_changed() && !cb.is_changed();
+        let key = if swap { (lb, la) } else { (la, lb) };
+        let key = (key.0.to_bits(), key.1.to_bits());
+        let cached = if cacheable {
+            self.cache.get(key, pa, pb, sb.bounding_radius())
         } else {
-            contact_with_scratch(sa, pa, sb, pb, scratch)
+            None
+        };
+        let scratch = &mut self.contact;
+        let mut m = match cached {
+            Some(m) => {
+                scratch.set_hits(self.cache.hits_of(key));
+                m
+            }
+            None => {
+                let m = if margin > 0.0 {
+                    speculative_contact_with_scratch(sa, pa, sb, pb, margin, scratch)
+                } else {
+                    contact_with_scratch(sa, pa, sb, pb, scratch)
+                };
+                if involves_mesh {
+                    let hits = if debug.enabled { scratch.hits() } else { &[] };
+                    self.cache.insert(key, pa, pb, m.as_ref(), hits);
+                }
+                m
+            }
         };
         if swap {
             scratch.flip_hits();
             m = m.map(ContactManifold::flipped);
         }
-        let involves_mesh = is_mesh(&ca.shape) || is_mesh(&cb.shape);
         self.mesh_pairs += u64::from(involves_mesh);
         if let Some(manifold) = m {
             contacts.pairs.push(ContactPair {

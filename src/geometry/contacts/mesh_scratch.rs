@@ -97,6 +97,12 @@ impl ContactScratch {
         )
     }
 
+    /// Replaces the last query's hits (an answer that came from a cache brings its own).
+    pub(crate) fn set_hits(&mut self, hits: &[[u32; 2]]) {
+        self.hits.clear();
+        self.hits.extend_from_slice(hits);
+    }
+
     /// Swaps the sides of the recorded hits (the dispatch ran the pair in the other order).
     pub(crate) fn flip_hits(&mut self) {
         for h in &mut self.hits {

@@ -46,6 +46,7 @@
 mod closest_segment_points;
 mod cuboid_cuboid;
 mod cuboid_halfspace;
+mod manifold_cache;
 mod manifold_reduction;
 mod mesh_manifold;
 mod mesh_scratch;
@@ -63,6 +64,7 @@ mod trimesh_trimesh;
 
 pub use cuboid_cuboid::contact_cuboid_cuboid;
 pub use cuboid_halfspace::contact_cuboid_halfspace;
+pub use manifold_cache::{MAX_SHIFT, ManifoldCache};
 pub use mesh_scratch::{ContactScratch, NO_TRIANGLE};
 pub use speculative::{motion_bound, speculative_contact, speculative_contact_with_scratch};
 pub use sphere_cuboid::contact_sphere_cuboid;

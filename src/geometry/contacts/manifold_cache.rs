@@ -1,0 +1,179 @@
+//! Reusing a pair's contact while its two shapes have barely moved relative to each other:
+//! Jolt's body pair cache (`PhysicsSettings::mBodyPairCacheMaxDeltaPositionSq`, 1 mm), here
+//! for the pairs whose test is costly (a mesh against anything: hundreds of triangle pairs).
+//!
+//! An entry keeps B's pose in A's frame at the time of the test and the manifold in A's frame
+//! (or that the shapes were apart). While B has since moved, in A's frame, by less than
+//! [`MAX_SHIFT`] at any point of its reach, the entry answers instead of the test: its points are
+//! carried back to the world by A's pose now, and each depth is corrected by how far B's
+//! surface moved along the normal at that point (exact for a translation, first order for a
+//! turn), so the error stays below [`MAX_SHIFT`] however long the pair rests. Entries not asked
+//! for during a step are dropped at the start of the next.
+
+use crate::geometry::{ContactManifold, ContactPoint, Isometry};
+use std::collections::HashMap;
+
+/// Largest motion of B relative to A, at its reach, for which an entry is reused (m).
+pub const MAX_SHIFT: f32 = 1e-3;
+
+#[derive(Debug, Clone)]
+struct Entry {
+    b_in_a: Isometry,
+    /// The manifold in A's frame, or `None` for shapes that were apart.
+    manifold: Option<ContactManifold>,
+    /// The triangle pairs the test found (kept only when the caller records them).
+    hits: Vec<[u32; 2]>,
+    /// The step it was last asked for.
+    used: u64,
+}
+
+/// The cached contacts of shape pairs, keyed by the caller (two collider ids, in test order).
+#[derive(Debug, Default, Clone)]
+pub struct ManifoldCache {
+    entries: HashMap<(u64, u64), Entry>,
+    step: u64,
+    hits: u64,
+}
+
+impl ManifoldCache {
+    /// Starts a step: drops the entries nobody asked for during the last one.
+    pub fn begin_step(&mut self) {
+        let last = self.step;
+        self.entries.retain(|_, e| e.used >= last);
+        self.step += 1;
+    }
+
+    /// The cached contact of pair `key` if B (at `pose_b`, reaching `reach_b` from its origin)
+    /// moved less than [`MAX_SHIFT`] relative to A (at `pose_a`) since it was stored: `Some(m)`
+    /// with `m` the contact now (`None` inside: the shapes are apart), or `None` when the pair
+    /// must be tested.
+    pub fn get(
+        &mut self,
+        key: (u64, u64),
+        pose_a: &Isometry,
+        pose_b: &Isometry,
+        reach_b: f32,
+    ) -> Option<Option<ContactManifold>> {
+        let step = self.step;
+        let entry = self.entries.get_mut(&key)?;
+        let b_in_a = pose_a.inv_mul(pose_b);
+        let moved = b_in_a.translation - entry.b_in_a.translation;
+        // The turn's angle from its quaternion's vector part (`2 asin |v|`): precise for the small
+        // turns that matter here, where `acos` of the dot product is not.
+        let delta = b_in_a.rotation * entry.b_in_a.rotation.inverse();
+        let turned = 2.0 * delta.xyz().length().min(1.0).asin();
+        let shift = moved.length() + turned * reach_b.max(0.0);
+        if shift.is_nan() || shift >= MAX_SHIFT {
+            return None;
+        }
+        entry.used = step;
+        self.hits += 1;
+        let Some(local) = &entry.manifold else {
+            return Some(None);
+        };
+        let mut now = ContactManifold::new(pose_a.transform_vector(local.normal));
+        for p in local.points() {
+            // Where the point of B that was at `p` at the test is now (A's frame).
+            let carried = b_in_a.transform_point(entry.b_in_a.inverse_transform_point(p.point));
+            let motion = carried - p.point;
+            now.push(ContactPoint {
+                point: pose_a.transform_point(p.point + motion * 0.5),
+                depth: p.depth - motion.dot(local.normal),
+            });
+        }
+        Some(Some(now))
+    }
+
+    /// Stores the contact of pair `key` just tested (world frame), for [`get`](Self::get), with
+    /// the triangle pairs it found (for debug views; empty when not recorded).
+    pub fn insert(
+        &mut self,
+        key: (u64, u64),
+        pose_a: &Isometry,
+        pose_b: &Isometry,
+        manifold: Option<&ContactManifold>,
+        hits: &[[u32; 2]],
+    ) {
+        let to_local = |m: &ContactManifold| {
+            let mut local = ContactManifold::new(pose_a.inverse_transform_vector(m.normal));
+            for p in m.points() {
+                local.push(ContactPoint {
+                    point: pose_a.inverse_transform_point(p.point),
+                    depth: p.depth,
+                });
+            }
+            local
+        };
+        let entry = Entry {
+            b_in_a: pose_a.inv_mul(pose_b),
+            manifold: manifold.map(to_local),
+            hits: hits.to_vec(),
+            used: self.step,
+        };
+        self.entries.insert(key, entry);
+    }
+
+    /// The triangle pairs stored with pair `key` (empty without an entry).
+    pub fn hits_of(&self, key: (u64, u64)) -> &[[u32; 2]] {
+        self.entries.get(&key).map_or(&[], |e| &e.hits)
+    }
+
+    /// How many times an entry answered, since the cache was made.
+    pub fn hits(&self) -> u64 {
+        self.hits
+    }
+
+    /// The number of entries kept.
+    pub fn len(&self) -> usize {
+        self.entries.len()
+    }
+
+    /// True when no entry is kept.
+    pub fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::contacts::contact;
+    use crate::geometry::{MeshCollider, Shape, TriMesh};
+    use glam::{Quat, Vec3};
+
+    #[test]
+    fn a_resting_mesh_is_answered_from_the_cache_within_1mm_and_retested_beyond() {
+        let floor =
+            Shape::TriMesh(MeshCollider::new(TriMesh::grid_floor(4.0, 8).unwrap()).unwrap());
+        let body =
+            Shape::TriMesh(MeshCollider::new(TriMesh::cuboid(Vec3::splat(0.5)).unwrap()).unwrap());
+        let ground = Isometry::from_translation(Vec3::new(0.3, -0.2, 0.0));
+        // Off the floor's grid lines, so no face of the box lies along a floor edge.
+        let at = |dz: f32, turn: f32| {
+            Isometry::new(
+                Vec3::new(0.43, -0.27, 0.49 + dz),
+                Quat::from_rotation_z(turn),
+            )
+        };
+        let mut cache = ManifoldCache::default();
+        cache.begin_step();
+        let first = contact(&floor, &ground, &body, &at(0.0, 0.0));
+        assert!(first.is_some());
+        cache.insert((1, 2), &ground, &at(0.0, 0.0), first.as_ref(), &[[3, 4]]);
+        // Sunk 0.4 mm and turned a little: reused, the depth following the sink exactly.
+        cache.begin_step();
+        let moved = at(-0.0004, 0.0005);
+        let reused = cache.get((1, 2), &ground, &moved, 0.87).unwrap().unwrap();
+        let truth = contact(&floor, &ground, &body, &moved).unwrap();
+        assert!((reused.max_depth() - truth.max_depth()).abs() < 1e-4);
+        assert!(reused.normal.abs_diff_eq(truth.normal, 1e-5));
+        assert_eq!(cache.hits(), 1);
+        assert_eq!(cache.hits_of((1, 2)), &[[3, 4]]);
+        // 2 mm away, or after a step nobody asked: tested again.
+        assert!(cache.get((1, 2), &ground, &at(0.002, 0.0), 0.87).is_none());
+        cache.begin_step();
+        cache.begin_step();
+        assert!(cache.get((1, 2), &ground, &moved, 0.87).is_none());
+        assert!(cache.is_empty());
+    }
+}
