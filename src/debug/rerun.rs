@@ -26,7 +26,8 @@
 //! | `log` | quarantine warnings | `TextLog` |
 //!
 //! Bodies are coloured by kind (a part of a compound by its root's kind) unless they carry a
-//! [`DebugColor`], and labelled with their [`Name`] when they have one.
+//! [`DebugColor`]; sleeping bodies take a muted colour of their island (`sleep_colors.rs`);
+//! bodies are labelled with their [`Name`] when they have one.
 //!
 //! Conversion to rerun's types happens here and only here: the rest of urto never sees rerun.
 
@@ -34,6 +35,7 @@ mod grid_cells;
 mod layout;
 mod meshes;
 mod scene_graph;
+mod sleep_colors;
 
 use layout::default_layout;
 use meshes::{LoggedMeshes, record_meshes, record_overlapping_leaves};
@@ -448,6 +450,7 @@ type BodyView<'a> = (
     Option<&'a Velocity>,
     Option<&'a DebugColor>,
     Option<&'a Name>,
+    Option<&'a SleepState>,
 );
 
 /// What decides a body's colour: whether it (or, for a part, its root) is static, its mass, and
@@ -488,10 +491,12 @@ fn record_bodies(
     let mut batch = ShapeBatch::default();
     let (mut bv_centers, mut bv_half) = (Vec::new(), Vec::new());
     let (mut origins, mut vectors) = (Vec::new(), Vec::new());
-    for (e, c, g, bv, v, tint, name) in &bodies {
+    for (e, c, g, bv, v, tint, name, sleep) in &bodies {
         let (p, r) = (g.0.translation, g.0.rotation);
-        let color = match tint {
-            Some(t) if !kinds.get(e).is_ok_and(|k| k.2) => t.0,
+        let quarantined = kinds.get(e).is_ok_and(|k| k.2);
+        let color = match (tint, sleep) {
+            (_, Some(s)) if s.asleep && !quarantined => sleep_colors::sleeping_color(s.island),
+            (Some(t), _) if !quarantined => t.0,
             _ => kind_color(e, &parents, &kinds),
         };
         batch.push(&c.shape, p, r, color, name, rec.config.plane_half_size);
