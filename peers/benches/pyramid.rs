@@ -3,7 +3,8 @@
 //!
 //! The scene: `ROWS` rows of unit boxes (1 kg, 1 m, 1 cm apart in each row) on a static 1 m slab;
 //! friction 0.6, no restitution, dt = 1/60, gravity 9.81 m/s² down Z. urto runs its soft-step
-//! defaults (4 substeps, contacts at 60 Hz, 120 Hz against immovable bodies); rapier runs its
+//! defaults (4 substeps, contacts at 60 Hz, 120 Hz against immovable bodies, sleeping by
+//! islands), also with sleeping off; rapier runs its
 //! defaults (4 solver iterations, TGS-soft, sleeping on, single-threaded). One criterion iteration
 //! is the first `STEPS` steps of a fresh scene (the build is not timed): divide by `STEPS` for a
 //! step.
@@ -23,7 +24,6 @@ use rapier3d::prelude as rp;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 use urto::dynamics::solver::SoftStepSettings;
-use urto::plugins::SoftStepPlugin;
 use urto::prelude::*;
 
 #[path = "common/rapier_world.rs"]
@@ -88,19 +88,28 @@ struct Urto {
     bodies: Vec<bevy_ecs::entity::Entity>,
 }
 
-/// urto's defaults, and with one relax pass per substep (Box2D's count) to show what the
-/// default's second pass costs.
-const URTO_VARIANTS: [(&str, u32); 2] = [("urto_soft_step", 2), ("urto_soft_step_relax_1", 1)];
+/// urto's defaults (sleeping by islands), the same awake, and awake with one relax pass per
+/// substep (Box2D's count) to show what the default's second pass costs: `(label, relax
+/// passes, sleeping)`.
+const URTO_VARIANTS: [(&str, u32, bool); 3] = [
+    ("urto", 2, true),
+    ("urto (no sleep)", 2, false),
+    ("urto (no sleep, relax 1)", 1, false),
+];
 
 impl Urto {
-    fn new(start: &[Vec3], relax_iterations: u32) -> Self {
+    fn new(start: &[Vec3], relax_iterations: u32, can_sleep: bool) -> Self {
         let settings = SoftStepSettings {
             relax_iterations,
             ..Default::default()
         };
         let mut app = App::new();
         app.add_plugins(UrtoPlugins::default().set(SoftStepPlugin { settings }))
-            .insert_resource(Gravity::new(Vec3::new(0.0, 0.0, -9.81)).expect("finite"));
+            .insert_resource(Gravity::new(Vec3::new(0.0, 0.0, -9.81)).expect("finite"))
+            .insert_resource(SleepSettings {
+                enabled: can_sleep,
+                ..Default::default()
+            });
         app.world_mut().spawn((
             Collider::cuboid(100.0, 100.0, 0.5),
             Position::new(0.0, 0.0, -0.5),
@@ -213,8 +222,8 @@ fn bench_pyramid(c: &mut Criterion) {
     let n = start.len();
 
     let mut default_run = None;
-    for (label, relax) in URTO_VARIANTS {
-        let mut v = Urto::new(&start, relax);
+    for (label, relax, can_sleep) in URTO_VARIANTS {
+        let mut v = Urto::new(&start, relax, can_sleep);
         v.step(STEPS);
         let (drift, sag) = quality(&start, &v.positions());
         let turned = {
@@ -230,8 +239,15 @@ fn bench_pyramid(c: &mut Criterion) {
                 })
                 .count()
         };
+        let asleep = {
+            let w = v.app.world();
+            v.bodies
+                .iter()
+                .filter(|&&b| w.get::<SleepState>(b).is_some_and(|s| s.asleep))
+                .count()
+        };
         eprintln!(
-            "[sanity] pyramid {rows} rows ({n} boxes) {label} after {STEPS} steps: largest drift {:.1} mm, top sag {:.1} mm, boxes turned > 0.01 rad {turned}, asleep 0 (no islands yet)",
+            "[sanity] pyramid {rows} rows ({n} boxes) {label} after {STEPS} steps: largest drift {:.1} mm, top sag {:.1} mm, boxes turned > 0.01 rad {turned}, asleep {asleep}",
             drift * 1e3,
             sag * 1e3
         );
@@ -258,9 +274,15 @@ fn bench_pyramid(c: &mut Criterion) {
         .sampling_mode(SamplingMode::Flat)
         .measurement_time(Duration::from_secs(10))
         .throughput(Throughput::Elements(u64::from(STEPS)));
-    for (label, relax) in URTO_VARIANTS {
+    for (label, relax, can_sleep) in URTO_VARIANTS {
         group.bench_function(BenchmarkId::new(label, n), |b| {
-            b.iter_custom(|iters| timed(iters, || Urto::new(&start, relax), |u| u.step(STEPS)))
+            b.iter_custom(|iters| {
+                timed(
+                    iters,
+                    || Urto::new(&start, relax, can_sleep),
+                    |u| u.step(STEPS),
+                )
+            })
         });
     }
     for (label, can_sleep) in RAPIER_VARIANTS {
