@@ -393,8 +393,16 @@ fn mesh_mesh_matches_brute_force_pairs() {
                         let ta = a.mesh().triangle(ta as usize).unwrap();
                         let tb = b.mesh().triangle(tb as usize).unwrap().transformed(&rel);
                         let c = contact_triangle_triangle(&ta, &tb).expect("they intersect");
-                        // The normal is A's triangle's (side 0) or B's reversed (side 1).
-                        let side = u8::from(Some(c.normal) != ta.normal());
+                        // The normal is A's triangle's (side 0), B's reversed (side 1), or an
+                        // edge axis filed with the triangle whose plane it is squarer to.
+                        let square = |n: Option<Vec3>| n.map_or(0.0, |n| n.dot(c.normal).abs());
+                        let side = if Some(c.normal) == ta.normal() {
+                            0
+                        } else if Some(-c.normal) == tb.normal() {
+                            1
+                        } else {
+                            u8::from(square(tb.normal()) > square(ta.normal()))
+                        };
                         (pose_a.transform_vector(c.normal), c.max_depth(), side)
                     })
                     .collect();

@@ -52,6 +52,8 @@ pub(crate) struct Contribution {
     pub first: u32,
     /// Number of its points.
     pub count: u32,
+    /// Still apart (a speculative gap: every point of it has a negative depth).
+    pub apart: bool,
 }
 
 /// The average normal of the module notes over `contributions`, or `None` when there is none.
@@ -91,8 +93,13 @@ pub(crate) fn merge_contributions(
     kept: &mut Vec<ContactPoint>,
     pose: &Isometry,
 ) -> Option<ContactManifold> {
-    let side = heavier_side(contributions)?;
-    let on_side = |c: &&Contribution| c.side == side;
+    // Where the shapes touch, the gaps still open around the contact do not steer the normal (a
+    // box on a box sees its side faces' gaps to the lower box's sides, askew); their points are
+    // kept when they agree with it. Only when everything is apart do the gaps decide.
+    let touching = contributions.iter().any(|c| !c.apart);
+    let steers = |c: &Contribution| !(touching && c.apart);
+    let side = heavier_side(contributions.iter().filter(|c| steers(c)))?;
+    let on_side = |c: &&Contribution| steers(c) && c.side == side;
     let first = average_normal(contributions.iter().filter(on_side))?;
     let min_cos = MAX_DEVIATION_DEGREES.to_radians().cos();
     let inlier = |c: &&Contribution| on_side(c) && c.normal.dot(first) >= min_cos;
@@ -104,7 +111,8 @@ pub(crate) fn merge_contributions(
     };
     kept.clear();
     for c in contributions {
-        if (keep_side && on_side(&c)) || inlier(&c) {
+        let agreeing_gap = !steers(c) && c.normal.dot(normal) >= min_cos;
+        if (keep_side && on_side(&c)) || inlier(&c) || agreeing_gap {
             let run = c.first as usize..(c.first + c.count) as usize;
             kept.extend_from_slice(&points[run]);
         }
@@ -114,9 +122,9 @@ pub(crate) fn merge_contributions(
 
 /// The side carrying the larger summed depth (the larger count when every depth is zero); ties
 /// go to the lower side. `None` without contributions.
-fn heavier_side(contributions: &[Contribution]) -> Option<u8> {
-    let first = contributions.first()?.side;
-    if contributions.iter().all(|c| c.side == first) {
+fn heavier_side<'a>(contributions: impl Iterator<Item = &'a Contribution> + Clone) -> Option<u8> {
+    let first = contributions.clone().next()?.side;
+    if contributions.clone().all(|c| c.side == first) {
         return Some(first);
     }
     let mut depth = [0.0f32; 2];
@@ -167,6 +175,7 @@ mod tests {
             side: 0,
             first: index,
             count: 1,
+            apart: false,
         }
     }
 
@@ -242,6 +251,6 @@ mod tests {
         c[2].depth = 0.1;
         let m = merge_contributions(&c, &points, &mut kept, &Isometry::IDENTITY).unwrap();
         assert!((m.normal - c[2].normal).length() < 1e-6);
-        assert_eq!(heavier_side(&c), Some(1));
+        assert_eq!(heavier_side(c.iter()), Some(1));
     }
 }

@@ -128,6 +128,7 @@ pub(crate) fn push_contribution(
         side,
         first: pool.len() as u32,
         count: points.len() as u32,
+        apart: !points.is_empty() && points.iter().all(|p| p.depth < 0.0),
     });
     pool.extend_from_slice(points);
 }
