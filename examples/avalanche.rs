@@ -380,8 +380,9 @@ impl Tally {
             end.inside, end.on_rim, end.below, end.broken
         );
         println!(
-            "  {} settled (speed < {SETTLED} m/s), {} still moving (fastest {:.2} m/s); highest body centre {:.2} m above the bottom (rim: {BOWL_DEPTH} m)",
+            "  {} settled (speed < {SETTLED} m/s), {} of them asleep, {} still moving (fastest {:.2} m/s); highest body centre {:.2} m above the bottom (rim: {BOWL_DEPTH} m)",
             end.settled,
+            end.asleep,
             pour.bodies.len() - end.settled,
             end.fastest,
             end.pile_top
@@ -418,6 +419,7 @@ struct Ending {
     below: usize,
     broken: usize,
     settled: usize,
+    asleep: usize,
     fastest: f32,
     pile_top: f32,
 }
@@ -447,6 +449,7 @@ impl Ending {
             }
             let speed = v.0.length();
             end.settled += usize::from(speed < SETTLED);
+            end.asleep += usize::from(SleepState::is_asleep(world.get::<SleepState>(e)));
             end.fastest = end.fastest.max(speed);
         }
         end

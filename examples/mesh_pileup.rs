@@ -198,7 +198,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     );
     // Where the bodies ended: how far any vertex got below the floor surface, how fast the
     // fastest body still moves, and whether anything went NaN.
-    let (mut sunk, mut fastest, mut bad) = (0.0f32, 0.0f32, 0);
+    let (mut sunk, mut fastest, mut bad, mut asleep) = (0.0f32, 0.0f32, 0, 0);
     for &b in &bodies {
         let (Some(p), Some(v), Some(c), Some(pose)) = (
             world.get::<Position>(b),
@@ -215,10 +215,11 @@ fn main() -> Result<(), Box<dyn Error>> {
             }
         }
         fastest = fastest.max(v.0.length());
+        asleep += usize::from(SleepState::is_asleep(world.get::<SleepState>(b)));
         bad += usize::from(!p.0.is_finite() || world.get::<Quarantined>(b).is_some());
     }
     println!(
-        "  at the end: deepest vertex {:.1} mm below the floor, fastest body {fastest:.2} m/s, {bad} NaN or quarantined",
+        "  at the end: deepest vertex {:.1} mm below the floor, fastest body {fastest:.2} m/s, {asleep} asleep, {bad} NaN or quarantined",
         sunk * 1e3
     );
     println!(
