@@ -130,6 +130,29 @@ fn a_stack_sleeps_and_wakes_as_one_island_within_one_step() {
     assert!(states(&app).iter().all(|s| !s.asleep && s.island == 0));
 }
 
+/// Despawning the bottom box of a sleeping stack of three wakes the two above it (the middle one
+/// lost a contact; the top one is in its island), and they fall: the top box ends at least
+/// 0.9 m lower within a second.
+#[test]
+fn despawning_the_bottom_of_a_sleeping_stack_wakes_the_whole_island() {
+    let mut app = sleepy_app();
+    let stack: Vec<Entity> = (0..3)
+        .map(|i| crate_box(&mut app, 0.5 + i as f32))
+        .collect();
+    urto::step(app.world_mut(), 180).unwrap();
+    assert!(stack.iter().all(|&b| asleep(&app, b)), "the stack slept");
+    let top_before = z(&app, stack[2]);
+    app.world_mut().despawn(stack[0]);
+    urto::step(app.world_mut(), 1).unwrap();
+    assert!(!asleep(&app, stack[1]) && !asleep(&app, stack[2]));
+    urto::step(app.world_mut(), 60).unwrap();
+    assert!(
+        z(&app, stack[2]) < top_before - 0.9,
+        "{}",
+        z(&app, stack[2])
+    );
+}
+
 /// A ball dropped on a sleeping ball wakes it: the two then move as two awake bodies would.
 #[test]
 fn a_falling_ball_wakes_the_one_it_hits() {
