@@ -86,7 +86,12 @@ fn stack(substeps: u32, relax: u32, seconds: f32) -> StackRun {
     };
     let mut app = App::new();
     app.add_plugins(UrtoPlugins::default().set(SoftStepPlugin { settings }))
-        .insert_resource(Gravity::EARTH_Z_UP);
+        .insert_resource(Gravity::EARTH_Z_UP)
+        // The stack must stay awake: asleep, it would neither drift nor cost what is measured.
+        .insert_resource(SleepSettings {
+            enabled: false,
+            ..Default::default()
+        });
     app.world_mut()
         .spawn((Collider::half_space(Vec3::Z), Static, Friction(0.6)));
     let start: Vec<Vec3> = (0..BOXES)
