@@ -3,7 +3,7 @@
 //! the directory has no `main.rs`).
 #![allow(dead_code)]
 
-use bevy_app::App;
+use bevy_app::{App, PluginGroupBuilder};
 use bevy_ecs::message::{MessageCursor, Messages};
 use bevy_ecs::prelude::*;
 use std::error::Error;
@@ -18,12 +18,7 @@ pub fn game_app(
     gravity: Gravity,
     contacts: ContactSettings,
 ) -> Result<App, Box<dyn Error>> {
-    let mut app = App::new();
-    let timestep = PhysicsTimestep::new(1.0 / 60.0, substeps)?;
-    app.add_plugins(UrtoPlugins::with_timestep(timestep))
-        .insert_resource(gravity)
-        .insert_resource(contacts);
-    Ok(app)
+    app_with(substeps, gravity, contacts, |group| group)
 }
 
 /// [`game_app`] with the lecture's pipeline (integration and impulse response in every substep)
@@ -33,15 +28,23 @@ pub fn lecture_game_app(
     gravity: Gravity,
     contacts: ContactSettings,
 ) -> Result<App, Box<dyn Error>> {
+    app_with(substeps, gravity, contacts, |group| {
+        group.disable::<SoftStepPlugin>()
+    })
+}
+
+/// The app of [`game_app`] with `UrtoPlugins` changed by `choose` before it is added.
+fn app_with(
+    substeps: u32,
+    gravity: Gravity,
+    contacts: ContactSettings,
+    choose: impl FnOnce(PluginGroupBuilder) -> PluginGroupBuilder,
+) -> Result<App, Box<dyn Error>> {
     let mut app = App::new();
     let timestep = PhysicsTimestep::new(1.0 / 60.0, substeps)?;
-    app.add_plugins(
-        UrtoPlugins::with_timestep(timestep)
-            .build()
-            .disable::<SoftStepPlugin>(),
-    )
-    .insert_resource(gravity)
-    .insert_resource(contacts);
+    app.add_plugins(choose(UrtoPlugins::with_timestep(timestep).build()))
+        .insert_resource(gravity)
+        .insert_resource(contacts);
     Ok(app)
 }
 

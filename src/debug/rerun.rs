@@ -26,17 +26,18 @@
 //! | `log` | quarantine warnings | `TextLog` |
 //!
 //! Bodies are coloured by kind (a part of a compound by its root's kind) unless they carry a
-//! [`DebugColor`]; sleeping bodies take a muted colour of their island (`sleep_colors.rs`);
+//! [`DebugColor`]; sleeping bodies take a muted colour of their island (`body_colors.rs`);
 //! bodies are labelled with their [`Name`] when they have one.
 //!
 //! Conversion to rerun's types happens here and only here: the rest of urto never sees rerun.
 
+mod body_colors;
 mod grid_cells;
 mod layout;
 mod meshes;
 mod scene_graph;
-mod sleep_colors;
 
+use body_colors::{KindView, STATIC, body_color};
 use layout::default_layout;
 use meshes::{LoggedMeshes, record_meshes, record_overlapping_leaves};
 
@@ -272,10 +273,6 @@ impl Drop for RerunRecording {
     }
 }
 
-const DYNAMIC: [u8; 3] = [230, 126, 34];
-const KINEMATIC: [u8; 3] = [52, 152, 219];
-const STATIC: [u8; 3] = [149, 165, 166];
-const QUARANTINED: [u8; 3] = [231, 76, 60];
 const BV: [u8; 3] = [46, 204, 113];
 const VELOCITY: [u8; 3] = [241, 196, 15];
 const CONTACT: [u8; 3] = [217, 70, 239];
@@ -453,30 +450,6 @@ type BodyView<'a> = (
     Option<&'a SleepState>,
 );
 
-/// What decides a body's colour: whether it (or, for a part, its root) is static, its mass, and
-/// whether it is quarantined.
-type KindView<'a> = (Has<Static>, Option<&'a Mass>, Has<Quarantined>);
-
-/// The colour of `e`'s kind: quarantined red, else its root's kind (a wheel is drawn like its
-/// car).
-fn kind_color(e: Entity, parents: &Query<&ChildOf>, kinds: &Query<KindView>) -> [u8; 3] {
-    if matches!(kinds.get(e), Ok((_, _, true))) {
-        return QUARANTINED;
-    }
-    let mut root = e;
-    for _ in 0..crate::plugins::validation::MAX_HIERARCHY_DEPTH {
-        match parents.get(root) {
-            Ok(p) => root = p.parent(),
-            Err(_) => break,
-        }
-    }
-    match kinds.get(root) {
-        Ok((true, ..)) => STATIC,
-        Ok((_, Some(m), _)) if m.inverse() == 0.0 => KINEMATIC,
-        _ => DYNAMIC,
-    }
-}
-
 /// Moving bodies, their bounding volumes and velocities.
 fn record_bodies(
     rec: Res<RerunRecording>,
@@ -493,12 +466,7 @@ fn record_bodies(
     let (mut origins, mut vectors) = (Vec::new(), Vec::new());
     for (e, c, g, bv, v, tint, name, sleep) in &bodies {
         let (p, r) = (g.0.translation, g.0.rotation);
-        let quarantined = kinds.get(e).is_ok_and(|k| k.2);
-        let color = match (tint, sleep) {
-            (_, Some(s)) if s.asleep && !quarantined => sleep_colors::sleeping_color(s.island),
-            (Some(t), _) if !quarantined => t.0,
-            _ => kind_color(e, &parents, &kinds),
-        };
+        let color = body_color(e, tint, sleep, &parents, &kinds);
         batch.push(&c.shape, p, r, color, name, rec.config.plane_half_size);
         if bv.0.is_finite() {
             bv_centers.push(arr(bv.0.center()));

@@ -1,6 +1,7 @@
 //! Meshes in the recording: each mesh body's triangles logged once and moved by its pose, and
 //! the hierarchy leaves through which two meshes touched.
 
+use super::body_colors::kind_tint;
 use super::*;
 
 /// The entity path of each mesh body logged so far (sorted by entity: deterministic).
@@ -49,12 +50,7 @@ pub(super) fn record_meshes(
             .entry(entity)
             .or_insert_with(|| mesh_path(mesh, entity));
         if fresh {
-            let tint = match (own_tint, is_static, mass) {
-                (Some(t), ..) => t.0,
-                (None, true, _) => STATIC,
-                (None, false, Some(m)) if m.inverse() == 0.0 => KINEMATIC,
-                _ => DYNAMIC,
-            };
+            let tint = own_tint.map_or_else(|| kind_tint(is_static, mass), |t| t.0);
             log_mesh(stream, path, mesh, tint);
         }
         let moved = fresh || g.is_changed();

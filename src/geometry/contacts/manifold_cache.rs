@@ -62,7 +62,9 @@ impl ManifoldCache {
         // turns that matter here, where `acos` of the dot product is not.
         let delta = b_in_a.rotation * entry.b_in_a.rotation.inverse();
         let turned = 2.0 * delta.xyz().length().min(1.0).asin();
-        let shift = moved.length() + turned * reach_b.max(0.0);
+        // A reach that is no length (NaN, negative) cannot bound the motion: never a hit.
+        let reach = if reach_b >= 0.0 { reach_b } else { f32::NAN };
+        let shift = moved.length() + turned * reach;
         if shift.is_nan() || shift >= MAX_SHIFT {
             return None;
         }

@@ -183,12 +183,19 @@ mod tests {
         assert!(speculative_contact(&ground, &Isometry::default(), &b, &at, 0.02).is_none());
     }
 
-    #[test]
-    fn a_mesh_box_above_a_mesh_floor_reports_its_gap_at_its_corners() {
+    /// A 4 m mesh floor of 8 × 8 cells and a unit mesh box.
+    fn mesh_floor_and_box() -> (Shape, Shape) {
         use crate::geometry::{MeshCollider, TriMesh};
         let mesh = |m: TriMesh| Shape::TriMesh(MeshCollider::new(m).unwrap());
-        let floor = mesh(TriMesh::grid_floor(4.0, 8).unwrap());
-        let b = mesh(TriMesh::cuboid(Vec3::splat(0.5)).unwrap());
+        (
+            mesh(TriMesh::grid_floor(4.0, 8).unwrap()),
+            mesh(TriMesh::cuboid(Vec3::splat(0.5)).unwrap()),
+        )
+    }
+
+    #[test]
+    fn a_mesh_box_above_a_mesh_floor_reports_its_gap_at_its_corners() {
+        let (floor, b) = mesh_floor_and_box();
         let at = Isometry::from_translation(Vec3::new(0.1, 0.2, 0.53));
         let c = speculative_contact(&floor, &Isometry::default(), &b, &at, 0.05).unwrap();
         assert!(c.normal.abs_diff_eq(Vec3::Z, 1e-5), "{}", c.normal);
@@ -201,6 +208,38 @@ mod tests {
         let back = speculative_contact(&b, &at, &floor, &Isometry::default(), 0.05).unwrap();
         assert!(back.normal.abs_diff_eq(-Vec3::Z, 1e-5));
         assert!(speculative_contact(&floor, &Isometry::default(), &b, &at, 0.02).is_none());
+    }
+
+    #[test]
+    fn bad_margins_and_poses_of_two_meshes_give_the_touching_answer_or_none_never_a_panic() {
+        let (floor, b) = mesh_floor_and_box();
+        let sunk = Isometry::from_translation(Vec3::new(0.13, 0.21, 0.49));
+        let at = Isometry::default();
+        let touching = speculative_contact(&floor, &at, &b, &sunk, 0.0);
+        assert!(touching.is_some());
+        for margin in [f32::NAN, -1.0, f32::NEG_INFINITY, f32::INFINITY] {
+            // Not a positive finite number: no lookahead, the touching answer exactly.
+            assert_eq!(
+                speculative_contact(&floor, &at, &b, &sunk, margin),
+                touching
+            );
+        }
+        let nan = Isometry::from_translation(Vec3::new(f32::NAN, 0.0, 0.5));
+        for margin in [0.0, 0.05] {
+            let _ = speculative_contact(&floor, &at, &b, &nan, margin);
+        }
+        let mut cache = super::super::ManifoldCache::default();
+        cache.begin_step();
+        cache.insert((1, 2), &at, &sunk, touching.as_ref(), &[]);
+        assert!(
+            cache.get((1, 2), &at, &nan, 1.0).is_none(),
+            "a NaN pose is never a hit"
+        );
+        assert!(
+            cache.get((1, 2), &at, &sunk, f32::NAN).is_none(),
+            "nor a NaN reach"
+        );
+        assert!(cache.get((1, 2), &at, &sunk, 1.0).is_some());
     }
 
     #[test]

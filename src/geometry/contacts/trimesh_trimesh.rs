@@ -56,6 +56,9 @@ use crate::geometry::{
 use glam::Vec3;
 use std::cmp::Ordering;
 
+/// The unit normals of a pair's two triangles (`None` for a zero-area one).
+type Normals = (Option<Vec3>, Option<Vec3>);
+
 /// One intersecting triangle pair's estimate: normal from A to B, depth, point, and whose
 /// triangle gave the normal (0: A's, 1: B's, 2: neither).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -110,7 +113,8 @@ pub fn contact_trimesh_trimesh_within(
 /// The estimate of the module notes for two triangles in one frame, as a one-point manifold
 /// (normal from `ta` to `tb`), or `None` when they do not meet.
 pub fn contact_triangle_triangle(ta: &Triangle, tb: &Triangle) -> Option<ContactManifold> {
-    pair_contact(ta, tb).map(|c| ContactManifold::single(c.normal, c.point, c.depth))
+    pair_contact(ta, tb, (ta.normal(), tb.normal()))
+        .map(|c| ContactManifold::single(c.normal, c.point, c.depth))
 }
 
 /// `Greater` or `Equal` when `a` should play shape A: more triangles first, then the numbers of
@@ -181,13 +185,18 @@ fn contact_in_order(
             let tb = tb.transformed(&b_in_a);
             // Exact on the same coordinates (min/max do not round), so it rejects no touching
             // pair, and it spares the exact test most of a leaf pair's triangle pairs.
-            if !ta.aabb().expanded(margin).intersects(&tb.aabb())
-                || beyond_plane(&tb, &ta, margin)
-                || beyond_plane(&ta, &tb, margin)
+            if !ta.aabb().expanded(margin).intersects(&tb.aabb()) {
+                return false;
+            }
+            let normals = (ta.normal(), tb.normal());
+            if beyond_plane(&tb, &ta, normals.0, margin)
+                || beyond_plane(&ta, &tb, normals.1, margin)
             {
                 return false;
             }
-            let Some(c) = pair_contact(&ta, &tb).or_else(|| gap_contact(&ta, &tb, margin)) else {
+            let Some(c) =
+                pair_contact(&ta, &tb, normals).or_else(|| gap_contact(&ta, &tb, normals, margin))
+            else {
                 return false;
             };
             let point = ContactPoint {
@@ -205,13 +214,15 @@ fn contact_in_order(
 }
 
 /// The per-pair estimate of the module notes.
-fn pair_contact(ta: &Triangle, tb: &Triangle) -> Option<PairContact> {
+/// `normals` are the two triangles' unit normals (computed once per pair by the caller: each is
+/// an `f64` normalisation).
+fn pair_contact(ta: &Triangle, tb: &Triangle, normals: Normals) -> Option<PairContact> {
     let point = match tri_tri_intersection(ta, tb) {
         TriTriIntersection::Disjoint => return None,
         TriTriIntersection::Segment(p, q) => (p + q) * 0.5,
         TriTriIntersection::Coplanar | TriTriIntersection::Degenerate => shared_point(ta, tb),
     };
-    let (na, nb) = (ta.normal(), tb.normal());
+    let (na, nb) = normals;
     let a_behind_b = nb.map(|n| depth_behind(ta, tb, n));
     let b_behind_a = na.map(|n| depth_behind(tb, ta, n));
     let (normal, depth, side): (Vec3, f32, u8) = match (na, nb, a_behind_b, b_behind_a) {
@@ -228,7 +239,7 @@ fn pair_contact(ta: &Triangle, tb: &Triangle) -> Option<PairContact> {
         ),
     };
     let (normal, depth, side) = match shallower_edge_axis(ta, tb) {
-        Some((n, d)) if d < SLIVER_RATIO * depth => (n, d, squarer_side(ta, tb, n)),
+        Some((n, d)) if d < SLIVER_RATIO * depth => (n, d, squarer_side(normals, n)),
         _ => (normal, depth, side),
     };
     Some(PairContact {
@@ -247,9 +258,9 @@ const SLIVER_RATIO: f32 = 0.25;
 
 /// The side (0: A's, 1: B's) whose triangle's plane `normal` is more nearly square to, ties to
 /// A: how a normal that is neither triangle's is filed for the merge's choice of side.
-pub(crate) fn squarer_side(ta: &Triangle, tb: &Triangle, normal: Vec3) -> u8 {
+fn squarer_side((na, nb): Normals, normal: Vec3) -> u8 {
     let squareness = |n: Option<Vec3>| n.map_or(0.0, |n| n.dot(normal).abs());
-    u8::from(squareness(tb.normal()) > squareness(ta.normal()))
+    u8::from(squareness(nb) > squareness(na))
 }
 
 /// The shallowest of the 9 edge–edge separating axes of two crossing triangles (`ea × eb`), as
@@ -300,8 +311,8 @@ fn shallower_edge_axis(ta: &Triangle, tb: &Triangle) -> Option<(Vec3, f32)> {
 /// spares the exact tests the pairs the boxes let through on slanted surfaces). Exact for
 /// `margin` 0 up to the rounding of the plane, so a touching pair is kept: corners on the plane
 /// are not beyond it.
-fn beyond_plane(t: &Triangle, base: &Triangle, margin: f32) -> bool {
-    let Some(n) = base.normal() else {
+fn beyond_plane(t: &Triangle, base: &Triangle, base_normal: Option<Vec3>, margin: f32) -> bool {
+    let Some(n) = base_normal else {
         return false;
     };
     let offset = n.dot(base.a);
@@ -315,7 +326,7 @@ fn beyond_plane(t: &Triangle, base: &Triangle, margin: f32) -> bool {
 /// The speculative estimate of two disjoint triangles at most `margin` apart (module notes), or
 /// `None` when they are farther apart, or so close that the gap has no direction (the exact
 /// test then calls them touching or apart; rounding alone separates the two).
-fn gap_contact(ta: &Triangle, tb: &Triangle, margin: f32) -> Option<PairContact> {
+fn gap_contact(ta: &Triangle, tb: &Triangle, normals: Normals, margin: f32) -> Option<PairContact> {
     if margin <= 0.0 {
         return None;
     }
@@ -325,7 +336,7 @@ fn gap_contact(ta: &Triangle, tb: &Triangle, margin: f32) -> Option<PairContact>
         return None;
     }
     let normal = ((q - p) / gap).try_normalize()?;
-    let side = squarer_side(ta, tb, normal);
+    let side = squarer_side(normals, normal);
     Some(PairContact {
         normal,
         depth: -gap,
