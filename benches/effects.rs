@@ -11,11 +11,16 @@
 //! turning (what a scene that never spins pays: one look per body), and every body tumbling
 //! with and without the gyroscopic term.
 //!
+//! A third group, `sleeping/N`, is the ground-contact scene (row 6) once every body has fallen
+//! asleep: what a sleeping scene costs per step (rapier's sleeping step is the yardstick; see
+//! `peers/`), next to the same scene awake.
+//!
 //! Sizes: `URTO_BENCH_BODIES` (default `10000`). Quick run:
 //! `URTO_BENCH_BODIES=1000 cargo bench --bench effects -- --quick`.
 
 use bevy_app::App;
 use bevy_app::PluginGroup;
+use bevy_ecs::prelude::With;
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec3;
 use urto::plugins::{CcdSettings, RotationPlugin};
@@ -233,5 +238,40 @@ fn scene_turning_checked(n: usize, t: Turning) -> App {
     app
 }
 
-criterion_group!(benches, bench_effects, bench_rotation);
+/// The ground-contact scene with sleeping on, stepped until every body sleeps (checked).
+fn sleeping_scene(n: usize) -> App {
+    let mut app = scene(n, Effects::Contacts);
+    app.insert_resource(SleepSettings::default());
+    urto::step(app.world_mut(), 120).expect("UrtoPlugins");
+    let world = app.world_mut();
+    let asleep = world
+        .query_filtered::<(), With<Sleeping>>()
+        .iter(world)
+        .count();
+    eprintln!("[sleeping] {n} bodies: {asleep} asleep");
+    assert_eq!(asleep, n, "the scene must sleep to measure sleeping");
+    app
+}
+
+fn bench_sleeping(c: &mut Criterion) {
+    let sizes: Vec<usize> = std::env::var("URTO_BENCH_BODIES")
+        .ok()
+        .map(|s| s.split(',').filter_map(|x| x.trim().parse().ok()).collect())
+        .unwrap_or_else(|| vec![10_000]);
+    for n in sizes {
+        let mut group = c.benchmark_group(format!("sleeping/{n}"));
+        group.throughput(Throughput::Elements(n as u64));
+        let mut asleep = sleeping_scene(n);
+        group.bench_function(BenchmarkId::new("all asleep", n), |b| {
+            b.iter(|| urto::step(asleep.world_mut(), 1).expect("UrtoPlugins"))
+        });
+        let mut awake = scene(n, Effects::Contacts);
+        group.bench_function(BenchmarkId::new("awake (sleeping off)", n), |b| {
+            b.iter(|| urto::step(awake.world_mut(), 1).expect("UrtoPlugins"))
+        });
+        group.finish();
+    }
+}
+
+criterion_group!(benches, bench_effects, bench_rotation, bench_sleeping);
 criterion_main!(benches);

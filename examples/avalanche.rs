@@ -449,7 +449,7 @@ impl Ending {
             }
             let speed = v.0.length();
             end.settled += usize::from(speed < SETTLED);
-            end.asleep += usize::from(SleepState::is_asleep(world.get::<SleepState>(e)));
+            end.asleep += usize::from(world.get::<Sleeping>(e).is_some());
             end.fastest = end.fastest.max(speed);
         }
         end

@@ -215,7 +215,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             }
         }
         fastest = fastest.max(v.0.length());
-        asleep += usize::from(SleepState::is_asleep(world.get::<SleepState>(b)));
+        asleep += usize::from(world.get::<Sleeping>(b).is_some());
         bad += usize::from(!p.0.is_finite() || world.get::<Quarantined>(b).is_some());
     }
     println!(

@@ -196,9 +196,10 @@ impl Default for ContactSettings {
 
 /// Sleeping (on by default): islands of bodies that stay slower than `speed` for `time` seconds
 /// stop being simulated until something wakes them (see
-/// [`SleepState`](crate::components::SleepState) and [`crate::dynamics::islands`]). Resting
-/// scenes then cost a fraction of a moving one (10,000 resting balls: 7.0 → 0.87 ms a step,
-/// measured before islands). Turn it off (`enabled: false`) to watch a scene settle for ever.
+/// [`Sleeping`](crate::components::Sleeping) and [`crate::dynamics::islands`]): a sleeping
+/// body is left out of every per-step pass (`benches/effects.rs`, group `sleeping`, measures
+/// what a sleeping scene still costs). Turn it off (`enabled: false`) to watch a scene settle
+/// for ever; turning it off wakes every sleeping body.
 #[derive(Resource, Clone, Copy, Debug, PartialEq)]
 pub struct SleepSettings {
     /// Whether bodies may fall asleep.

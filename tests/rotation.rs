@@ -417,14 +417,14 @@ fn a_spinning_ball_stays_awake_and_setting_a_spin_wakes_a_sleeper() {
     let still = ball(&mut app, Vec3::new(3.0, 0.0, 0.5));
     urto::step(app.world_mut(), 120).unwrap();
     assert!(
-        !get::<SleepState>(&app, spinner).asleep,
+        app.world().get::<Sleeping>(spinner).is_none(),
         "a spinning top sleeps"
     );
-    assert!(get::<SleepState>(&app, still).asleep);
+    assert!(app.world().get::<Sleeping>(still).is_some());
     app.world_mut().get_mut::<AngularVelocity>(still).unwrap().0 = Vec3::X;
     urto::step(app.world_mut(), 1).unwrap();
     assert!(
-        !get::<SleepState>(&app, still).asleep,
+        app.world().get::<Sleeping>(still).is_none(),
         "a spin did not wake it"
     );
     assert_ne!(get::<Rotation>(&app, still).0, Quat::IDENTITY);

@@ -28,7 +28,7 @@ fn ball(app: &mut App, at: Vec3) -> Entity {
 }
 
 fn asleep(app: &App, e: Entity) -> bool {
-    app.world().get::<SleepState>(e).unwrap().asleep
+    app.world().get::<Sleeping>(e).is_some()
 }
 
 fn z(app: &App, e: Entity) -> f32 {
@@ -114,8 +114,7 @@ fn a_stack_sleeps_and_wakes_as_one_island_within_one_step() {
     let mut slept_at = None;
     for step in 0..180 {
         urto::step(app.world_mut(), 1).unwrap();
-        let s = states(&app);
-        let count = s.iter().filter(|s| s.asleep).count();
+        let count = stack.iter().filter(|&&b| asleep(&app, b)).count();
         assert!(count == 0 || count == 3, "step {step}: {count} of 3 asleep");
         if count == 3 {
             slept_at = Some(step);
@@ -127,7 +126,8 @@ fn a_stack_sleeps_and_wakes_as_one_island_within_one_step() {
     assert!(s[0].island != 0 && s.iter().all(|x| x.island == s[0].island));
     app.world_mut().get_mut::<Velocity>(stack[0]).unwrap().0 = Vec3::new(0.5, 0.0, 0.0);
     urto::step(app.world_mut(), 1).unwrap();
-    assert!(states(&app).iter().all(|s| !s.asleep && s.island == 0));
+    assert!(stack.iter().all(|&b| !asleep(&app, b)));
+    assert!(states(&app).iter().all(|s| s.island == 0));
 }
 
 /// Despawning the bottom box of a sleeping stack of three wakes the two above it (the middle one
@@ -227,4 +227,112 @@ fn removing_the_support_wakes_what_rested_on_it() {
         "fell to the ground: z = {}",
         z(&app, upper)
     );
+}
+
+/// Once a pile sleeps, no stage looks at it: the broad phase pairs none of its bodies (with
+/// scenery or with each other), the narrow phase tests nothing, the solver gets no body and
+/// the sleep check no candidate; and no position changes by a single bit.
+#[test]
+fn a_sleeping_pile_gets_zero_pairs_zero_solver_bodies_and_zero_sleep_candidates() {
+    let mut app = sleepy_app();
+    let mut bodies: Vec<Entity> = (0..12)
+        .map(|i| {
+            ball(
+                &mut app,
+                Vec3::new((i % 4) as f32 * 1.001, (i / 4) as f32 * 1.001, 0.5),
+            )
+        })
+        .collect();
+    bodies.extend((0..3).map(|i| crate_box(&mut app, 0.5 + i as f32)));
+    for b in &mut bodies[12..] {
+        app.world_mut().get_mut::<Position>(*b).unwrap().0.x = 10.0;
+    }
+    urto::step(app.world_mut(), 240).unwrap();
+    assert!(bodies.iter().all(|&b| asleep(&app, b)), "the pile slept");
+    let before: Vec<Vec3> = bodies.iter().map(|&b| position(&app, b)).collect();
+    urto::step(app.world_mut(), 30).unwrap();
+    for name in [
+        "broad_phase/pairs",
+        "broad_phase/static_pairs",
+        "narrow_phase/contacts",
+        "soft_step/bodies",
+        "sleep/awake_bodies",
+    ] {
+        assert_eq!(counter(&app, name), 0.0, "{name}");
+    }
+    assert!(counter(&app, "sleep/sleeping_islands") >= 1.0);
+    let after: Vec<Vec3> = bodies.iter().map(|&b| position(&app, b)).collect();
+    assert_eq!(before, after);
+}
+
+fn position(app: &App, e: Entity) -> Vec3 {
+    app.world().get::<Position>(e).unwrap().0
+}
+
+/// Validation leaves sleeping bodies out, so a bad value written to a sleeper must wake it: a
+/// NaN mass is quarantined within one step, and its sleeping neighbours stay finite.
+#[test]
+fn a_nan_mass_written_to_a_sleeping_body_is_quarantined_within_one_step() {
+    let mut app = sleepy_app();
+    let stack: Vec<Entity> = (0..3)
+        .map(|i| crate_box(&mut app, 0.5 + i as f32))
+        .collect();
+    urto::step(app.world_mut(), 240).unwrap();
+    assert!(stack.iter().all(|&b| asleep(&app, b)));
+    app.world_mut().get_mut::<Mass>(stack[1]).unwrap().0 = f32::NAN;
+    urto::step(app.world_mut(), 1).unwrap();
+    assert!(app.world().get::<Quarantined>(stack[1]).is_some());
+    urto::step(app.world_mut(), 60).unwrap();
+    for b in [stack[0], stack[2]] {
+        assert!(position(&app, b).is_finite());
+    }
+}
+
+/// Game code may wake a body by removing its marker: the whole island wakes before the next
+/// step simulates anything.
+#[test]
+fn removing_the_sleeping_marker_wakes_the_whole_island_within_one_step() {
+    let mut app = sleepy_app();
+    let stack: Vec<Entity> = (0..3)
+        .map(|i| crate_box(&mut app, 0.5 + i as f32))
+        .collect();
+    urto::step(app.world_mut(), 240).unwrap();
+    assert!(stack.iter().all(|&b| asleep(&app, b)));
+    app.world_mut().entity_mut(stack[2]).remove::<Sleeping>();
+    urto::step(app.world_mut(), 1).unwrap();
+    assert!(stack.iter().all(|&b| !asleep(&app, b)));
+    assert_eq!(counter(&app, "soft_step/awake_bodies"), 3.0);
+}
+
+/// Balls asleep on a ground wake when the ground is despawned (their dormant contacts end,
+/// reported as ended collisions), and fall at least 1 m within a second.
+#[test]
+fn despawning_the_ground_wakes_the_balls_asleep_on_it_and_they_fall_1m_within_1s() {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    let ground = app
+        .world_mut()
+        .spawn((Collider::half_space(Vec3::Z), Static))
+        .id();
+    let balls: Vec<Entity> = (0..4)
+        .map(|i| ball(&mut app, Vec3::new(i as f32 * 2.0, 0.0, 0.5)))
+        .collect();
+    urto::step(app.world_mut(), 120).unwrap();
+    assert!(balls.iter().all(|&b| asleep(&app, b)));
+    let mut ended = app
+        .world()
+        .resource::<Messages<CollisionEnded>>()
+        .get_cursor();
+    app.world_mut().despawn(ground);
+    let mut count = 0;
+    for _ in 0..60 {
+        urto::step(app.world_mut(), 1).unwrap();
+        count += ended
+            .read(app.world().resource::<Messages<CollisionEnded>>())
+            .count();
+    }
+    assert_eq!(count, balls.len());
+    for &b in &balls {
+        assert!(z(&app, b) < -0.5, "fell: z = {}", z(&app, b));
+    }
 }

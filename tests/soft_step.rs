@@ -472,7 +472,10 @@ fn with_the_soft_step_a_ball_dropped_on_a_sleeping_ball_wakes_it() {
         ))
         .id();
     urto::step(app.world_mut(), 60).unwrap();
-    assert!(get::<SleepState>(&app, below).asleep, "did not fall asleep");
+    assert!(
+        app.world().get::<Sleeping>(below).is_some(),
+        "did not fall asleep"
+    );
     app.world_mut().spawn((
         Collider::sphere(0.5),
         Position::new(0.3, 0.0, 3.0),
@@ -481,7 +484,7 @@ fn with_the_soft_step_a_ball_dropped_on_a_sleeping_ball_wakes_it() {
     let mut woke = false;
     for _ in 0..60 {
         urto::step(app.world_mut(), 1).unwrap();
-        woke |= !get::<SleepState>(&app, below).asleep;
+        woke |= app.world().get::<Sleeping>(below).is_none();
     }
     assert!(woke, "the ball below slept through the hit");
     let moved = get::<Position>(&app, below).0 - Vec3::new(0.0, 0.0, 0.5);

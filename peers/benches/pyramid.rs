@@ -243,7 +243,7 @@ fn bench_pyramid(c: &mut Criterion) {
             let w = v.app.world();
             v.bodies
                 .iter()
-                .filter(|&&b| w.get::<SleepState>(b).is_some_and(|s| s.asleep))
+                .filter(|&&b| w.get::<Sleeping>(b).is_some())
                 .count()
         };
         eprintln!(

@@ -332,7 +332,7 @@ fn urto_state(app: &App, balls: &[bevy_ecs::entity::Entity]) -> (Vec<Ball>, usiz
         .collect();
     let sleeping = balls
         .iter()
-        .filter(|&&e| world.get::<SleepState>(e).is_some_and(|s| s.asleep))
+        .filter(|&&e| world.get::<Sleeping>(e).is_some())
         .count();
     (state, world.resource::<Contacts>().pairs.len(), sleeping)
 }

@@ -26,8 +26,11 @@
 //! spread to their neighbours.
 
 mod angular;
+mod sleeping;
 
 pub use angular::{AngularDrag, AngularVelocity, ForceAtPoint, Inertia, LockedAxes, Torque};
+pub(crate) use sleeping::SleepTransitions;
+pub use sleeping::{SleepState, Sleeping, SleepingIslands};
 
 use crate::bounding::Aabb;
 use crate::geometry::{Isometry, MeshCollider, MeshColliderError, Shape, TriMesh};
@@ -232,38 +235,6 @@ pub struct GlobalPose(pub Isometry);
 /// it, don't write it.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 pub struct StepStartPose(pub Isometry);
-
-/// Whether a dynamic body sleeps (with [`SleepSettings`](crate::settings::SleepSettings) on, the
-/// default): a body whose whole island has been slower than the settings' speed for their time
-/// falls asleep with it; it is then neither
-/// integrated nor tested against other sleeping or static bodies, and it wakes when something
-/// awake hits it, when the game moves it, sets its velocity or pushes it with a [`Force`], or
-/// when gravity changes.
-#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
-pub struct SleepState {
-    /// Asleep: not simulated until woken.
-    pub asleep: bool,
-    /// Seconds the body has been slower than the sleep speed (awake bodies).
-    pub still_for: f32,
-    /// Where it fell asleep: moving it elsewhere wakes it.
-    pub at: Vec3,
-    /// The island it fell asleep with (0: none): waking one body of it wakes all of them
-    /// ([`crate::dynamics::islands`]).
-    pub island: u64,
-}
-
-impl SleepState {
-    /// True for a body that has a sleep state and is asleep (bodies without one never sleep).
-    pub fn is_asleep(state: Option<&Self>) -> bool {
-        state.is_some_and(|s| s.asleep)
-    }
-
-    /// Awake, with the stillness count restarted.
-    pub fn wake(&mut self) {
-        self.asleep = false;
-        self.still_for = 0.0;
-    }
-}
 
 /// Continuous collision for a fast body: instead of testing only where the step ends (where a
 /// bullet may already be past a thin wall: tunnelling), the body's motion during the step is

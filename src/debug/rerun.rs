@@ -447,7 +447,7 @@ type BodyView<'a> = (
     Option<&'a Velocity>,
     Option<&'a DebugColor>,
     Option<&'a Name>,
-    Option<&'a SleepState>,
+    (Has<Sleeping>, Option<&'a SleepState>),
 );
 
 /// Moving bodies, their bounding volumes and velocities.
@@ -464,9 +464,10 @@ fn record_bodies(
     let mut batch = ShapeBatch::default();
     let (mut bv_centers, mut bv_half) = (Vec::new(), Vec::new());
     let (mut origins, mut vectors) = (Vec::new(), Vec::new());
-    for (e, c, g, bv, v, tint, name, sleep) in &bodies {
+    for (e, c, g, bv, v, tint, name, (asleep, sleep)) in &bodies {
         let (p, r) = (g.0.translation, g.0.rotation);
-        let color = body_color(e, tint, sleep, &parents, &kinds);
+        let island = asleep.then(|| sleep.map_or(0, |s| s.island));
+        let color = body_color(e, tint, island, &parents, &kinds);
         batch.push(&c.shape, p, r, color, name, rec.config.plane_half_size);
         if bv.0.is_finite() {
             bv_centers.push(arr(bv.0.center()));

@@ -7,6 +7,9 @@
 //! - Bounded static scenery is in a hashed uniform grid (the slides' "object vs static scene"):
 //!   indexed once, queried with each moving body's volume; statics never enter the sort.
 //! - Unbounded scenery (grounds, walls) is paired with every moving body.
+//! - Sleeping bodies stay indexed where they are but are paired with nothing (neither scenery
+//!   nor other sleepers) until they wake: the plugin hears of each body falling asleep or
+//!   waking from the [`Sleeping`] marker's hooks, so a sleeping pile costs no pass here.
 //! - With the rigid-body solver, a moving body's volume in the sweep is grown by its speculative
 //!   margin ([`SpeculativeMargin`](crate::plugins::SpeculativeMargin)), and a new velocity
 //!   re-indexes it, so pairs are found while the bodies can still close in one step.
@@ -115,6 +118,7 @@ impl BroadPhaseIndex {
 impl Plugin for BroadPhasePlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<BroadPhasePairs>()
+            .init_resource::<SleepTransitions>()
             .insert_resource(BroadPhaseIndex::new(self))
             .add_systems(
                 SubstepSchedule,
@@ -151,11 +155,15 @@ type IndexedRow<'a> = (
 );
 type Root = (Without<ChildOf>, Without<Quarantined>);
 /// A moving body's margin follows its velocity, so a new velocity re-indexes it.
-type Moved = Or<(
-    Changed<BoundingVolume>,
-    Changed<Velocity>,
-    Changed<AngularVelocity>,
-)>;
+/// Sleeping bodies are left out: they do not move, and a write to one wakes it first.
+type Moved = (
+    Or<(
+        Changed<BoundingVolume>,
+        Changed<Velocity>,
+        Changed<AngularVelocity>,
+    )>,
+    Without<Sleeping>,
+);
 type NoLongerRoot = Or<(Added<Quarantined>, Changed<ChildOf>)>;
 
 /// Brings the structures in step with the world: registers new roots (in bulk), moves changed
@@ -171,6 +179,7 @@ fn sync_broad_phase(
     mut despawned: RemovedComponents<BoundingVolume>,
     mut released: RemovedComponents<Quarantined>,
     mut orphaned: RemovedComponents<ChildOf>,
+    mut transitions: ResMut<SleepTransitions>,
     lookahead: LookaheadParams,
     mut stats: ResMut<PhysicsStats>,
     mut commands: Commands,
@@ -178,6 +187,9 @@ fn sync_broad_phase(
     let start = Instant::now();
     let lookahead = lookahead.get();
     let index = &mut *index;
+    for (e, asleep) in transitions.0.drain(..) {
+        index.proxies.set_asleep(e, asleep);
+    }
     for e in despawned.read().chain(gone.iter()) {
         index.forget(e);
     }
@@ -301,17 +313,20 @@ fn find_candidate_pairs(
     let index = &mut *index;
     out.pairs.clear();
     let proxies = &index.proxies;
+    // Two sleeping bodies at rest against each other need no test until one wakes.
     out.pairs.extend(
         index
             .moving
             .pairs()
             .iter()
+            .filter(|p| !(proxies.is_asleep(p.a) && proxies.is_asleep(p.b)))
             .map(|p| (proxies.entity(p.a), proxies.entity(p.b))),
     );
     let moving_pairs = out.pairs.len();
     let mut cells = 0usize;
     if !index.grid.is_empty() || !proxies.unbounded().is_empty() {
-        for id in proxies.moving_ids() {
+        // Sleeping bodies are not paired with scenery: nothing moved.
+        for id in proxies.awake_moving_ids() {
             let (Some(aabb), e) = (index.moving.aabb(id), proxies.entity(id)) else {
                 continue;
             };

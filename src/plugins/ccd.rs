@@ -122,7 +122,12 @@ type Mover<'a> = (
     Has<Children>,
     Has<Ccd>,
 );
-type MovingRoot = (Without<Static>, Without<Quarantined>, Without<ChildOf>);
+type MovingRoot = (
+    Without<Static>,
+    Without<Quarantined>,
+    Without<ChildOf>,
+    Without<Sleeping>,
+);
 
 /// Radius of the sphere swept for a body at `p`: its collider's bounding radius (exact for a
 /// ball); for a compound body, the sphere about `p` holding its whole volume (parts included).

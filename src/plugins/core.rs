@@ -49,11 +49,11 @@ impl Plugin for PhysicsCorePlugin {
                 .chain(),
         );
         physics.add_systems((
-            begin_step.in_set(PhysicsSet::Prepare).before(PrepareStart),
+            begin_step.in_set(PhysicsSet::Prepare).before(PrepareWake),
             run_substeps.in_set(PhysicsSet::Substeps),
         ));
         physics.configure_sets(
-            (PrepareStart, PrepareIndex)
+            (PrepareWake, PrepareStart, PrepareIndex)
                 .chain()
                 .in_set(PhysicsSet::Prepare),
         );
@@ -97,7 +97,12 @@ impl Plugin for PhysicsCorePlugin {
     }
 }
 
-/// Anchor for Prepare's validation: it runs after the step's bookkeeping.
+/// Prepare's first part: sleeping bodies that game code touched wake, with their islands, so
+/// that everything after sees them awake (their `Sleeping` marker gone).
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct PrepareWake;
+
+/// Anchor for Prepare's validation: it runs after the step's bookkeeping and the wake-ups.
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct PrepareStart;
 
@@ -166,7 +171,7 @@ pub fn step(world: &mut World, n: u32) -> Result<(), StepError> {
         world
             .try_run_schedule(PhysicsSchedule)
             .map_err(|_| StepError::NoPhysicsSchedule)?;
-        crate::plugins::response::update_collision_messages(world);
+        crate::plugins::collision_messages::update_collision_messages(world);
     }
     Ok(())
 }

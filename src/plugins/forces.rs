@@ -76,9 +76,13 @@ fn gather_gravity(
     });
 }
 
+/// Bodies whose forces count: not quarantined, not asleep (a force on a sleeper wakes it
+/// first, `plugins/sleep.rs`).
+type Active = (Without<Quarantined>, Without<Sleeping>);
+
 /// Consumes every [`Force`]: it acts for this step, then reads zero until game code adds more.
 fn gather_user_forces(
-    mut bodies: Query<(Entity, &mut Force), Without<Quarantined>>,
+    mut bodies: Query<(Entity, &mut Force), Active>,
     mut gathered: ResMut<GatheredForces>,
     mut stats: ResMut<PhysicsStats>,
 ) {
@@ -93,7 +97,7 @@ fn gather_user_forces(
 }
 
 fn gather_drag(
-    bodies: Query<(Entity, &LinearDrag), Without<Quarantined>>,
+    bodies: Query<(Entity, &LinearDrag), Active>,
     mut gathered: ResMut<GatheredForces>,
     mut stats: ResMut<PhysicsStats>,
 ) {
@@ -108,7 +112,7 @@ fn gather_drag(
 }
 
 fn gather_springs(
-    bodies: Query<(Entity, &Spring), Without<Quarantined>>,
+    bodies: Query<(Entity, &Spring), Active>,
     mut gathered: ResMut<GatheredForces>,
     mut stats: ResMut<PhysicsStats>,
 ) {
@@ -119,7 +123,7 @@ fn gather_springs(
 
 /// Consumes every [`Torque`], as [`gather_user_forces`] does forces.
 fn gather_torques(
-    mut bodies: Query<(Entity, &mut Torque), Without<Quarantined>>,
+    mut bodies: Query<(Entity, &mut Torque), Active>,
     mut gathered: ResMut<GatheredForces>,
     mut stats: ResMut<PhysicsStats>,
 ) {
@@ -144,7 +148,7 @@ type PointForced<'a> = (
 /// Consumes every [`ForceAtPoint`]: its sum pushes the body, its moment about the body's centre
 /// of mass (where it is at the step's start) turns it.
 fn gather_point_forces(
-    mut bodies: Query<PointForced, Without<Quarantined>>,
+    mut bodies: Query<PointForced, Active>,
     mut gathered: ResMut<GatheredForces>,
     mut stats: ResMut<PhysicsStats>,
 ) {

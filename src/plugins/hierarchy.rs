@@ -79,9 +79,11 @@ type Flat = (Without<ChildOf>, Without<Children>);
 /// Parts and parents of compound bodies.
 type InHierarchy = Or<(With<ChildOf>, With<Children>)>;
 
+/// Sleeping bodies do not move (a write to one wakes it first), so they are left out.
 type LocalChanged = (
     Or<(Changed<Position>, Changed<Rotation>, Changed<ChildOf>)>,
     Without<Quarantined>,
+    Without<Sleeping>,
 );
 
 type FlatPose<'a> = (&'a Position, &'a Rotation, &'a mut GlobalPose);
@@ -185,7 +187,10 @@ type RefitNode<'a> = (
     Has<Quarantined>,
 );
 type FlatRefit<'a> = (Entity, &'a Collider, &'a GlobalPose, &'a mut BoundingVolume);
-type OwnChanged = Or<(Changed<GlobalPose>, Changed<Collider>, Changed<Children>)>;
+type OwnChanged = (
+    Or<(Changed<GlobalPose>, Changed<Collider>, Changed<Children>)>,
+    Without<Sleeping>,
+);
 
 /// Refits volumes: a collider outside any hierarchy from its own pose (one linear pass); in a
 /// hierarchy, every node whose own collider moved or whose children changed, and its ancestors,

@@ -50,14 +50,14 @@ struct IntegrationBuffers {
     scratch: IntegratorScratch,
 }
 
-type Moving<'a> = (
-    Entity,
-    &'a mut Position,
-    &'a mut Velocity,
-    &'a Mass,
-    Option<&'a SleepState>,
+type Moving<'a> = (Entity, &'a mut Position, &'a mut Velocity, &'a Mass);
+/// Sleeping bodies are not integrated: their archetypes are left out.
+type MovingFilter = (
+    Without<Static>,
+    Without<Quarantined>,
+    Without<ChildOf>,
+    Without<Sleeping>,
 );
-type MovingFilter = (Without<Static>, Without<Quarantined>, Without<ChildOf>);
 
 fn integrate_bodies(
     mut queries: ParamSet<(Query<Moving, MovingFilter>, Query<&Position>)>,
@@ -82,10 +82,7 @@ fn integrate_bodies(
         &mut b.scratch,
     );
     let mut bodies = queries.p0();
-    let awake = bodies
-        .iter_mut()
-        .filter(|(.., s)| !SleepState::is_asleep(*s));
-    for (i, (_, mut p, mut v, ..)) in awake.enumerate() {
+    for (i, (_, mut p, mut v, _)) in bodies.iter_mut().enumerate() {
         p.set_if_neq(Position(b.positions[i]));
         v.set_if_neq(Velocity(b.velocities[i]));
     }
@@ -106,9 +103,7 @@ fn gather_state(
     b.model.gravity = gathered.gravity;
     let needs_index = !gathered.only_gravity();
     b.index.clear();
-    // Sleeping bodies are not integrated (query order minus them = array order).
-    let awake = bodies.iter().filter(|(.., s)| !SleepState::is_asleep(*s));
-    for (i, (entity, p, v, m, _)) in awake.enumerate() {
+    for (i, (entity, p, v, m)) in bodies.iter().enumerate() {
         b.positions.push(p.0);
         b.velocities.push(v.0);
         b.model.inverse_mass.push(m.inverse());

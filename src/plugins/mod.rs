@@ -14,6 +14,7 @@
 
 pub mod broad_phase;
 pub mod ccd;
+mod collision_messages;
 pub mod core;
 pub mod forces;
 pub mod hierarchy;

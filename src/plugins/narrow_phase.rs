@@ -189,7 +189,7 @@ impl BvTree for EcsTree<'_, '_, '_, '_> {
 }
 
 /// Whether a body is static or asleep (see [`crate::plugins::sleep`]).
-pub(crate) type Dormancy<'a> = (Has<Static>, Option<&'a SleepState>);
+pub(crate) type Dormancy = (Has<Static>, Has<Sleeping>);
 
 /// What a root body's speculative margin depends on.
 type Motion<'a> = (

@@ -1,21 +1,23 @@
 //! The Response stage: impulses (restitution, Coulomb friction, warm-started from the previous
-//! substep's impulses of the same contact) and position correction for the contacts, and the
-//! collision started / ended messages game code listens to.
+//! substep's impulses of the same contact) and position correction for the contacts (the
+//! lecture's pipeline; the soft step replaces it by default), and the collision started / ended
+//! messages game code listens to (`collision_messages.rs`).
 
+pub use super::collision_messages::{CollisionEnded, CollisionStarted, ReportCollisions};
+use super::collision_messages::{add_collision_messages, report_collisions};
 use crate::components::*;
 use crate::dynamics::response::{
     ContactConstraint, SupportGraph, correct_positions, resting_displacements, solve_velocities,
 };
 use crate::geometry::ContactManifold;
 use crate::plugins::narrow_phase::{ContactPair, Contacts};
-use crate::plugins::sleep::{ContactSide, dormant, wakes};
+use crate::plugins::sleep::{ContactSide, Waker, wakes};
 use crate::plugins::soft_step::legacy_solver;
 use crate::schedule::{SubstepSchedule, SubstepSet};
 use crate::settings::{ContactSettings, PhysicsTimestep, SleepSettings};
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
 use bevy_ecs::entity::EntityHashMap;
-use bevy_ecs::message::Messages;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 use std::collections::HashMap;
@@ -25,47 +27,21 @@ use std::time::Instant;
 #[derive(Debug, Clone, Default)]
 pub struct ResponsePlugin;
 
-/// Two bodies started touching this step (`a < b`).
-#[derive(Message, Debug, Clone, Copy, PartialEq, Eq)]
-pub struct CollisionStarted {
-    /// One body.
-    pub a: Entity,
-    /// The other.
-    pub b: Entity,
-}
-
-/// Two bodies stopped touching this step (`a < b`).
-#[derive(Message, Debug, Clone, Copy, PartialEq, Eq)]
-pub struct CollisionEnded {
-    /// One body.
-    pub a: Entity,
-    /// The other.
-    pub b: Entity,
-}
-
 impl Plugin for ResponsePlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<ResponseBuffers>()
-            .init_resource::<TouchingPairs>()
-            .add_message::<CollisionStarted>()
-            .add_message::<CollisionEnded>()
-            .add_systems(
-                SubstepSchedule,
-                (
-                    resolve_contacts.run_if(legacy_solver),
-                    report_collisions.in_set(ReportCollisions),
-                )
-                    .chain()
-                    .run_if(any_with_component::<Collider>)
-                    .in_set(SubstepSet::Response),
-            );
+        add_collision_messages(app);
+        app.init_resource::<ResponseBuffers>().add_systems(
+            SubstepSchedule,
+            (
+                resolve_contacts.run_if(legacy_solver),
+                report_collisions.in_set(ReportCollisions),
+            )
+                .chain()
+                .run_if(any_with_component::<Collider>)
+                .in_set(SubstepSet::Response),
+        );
     }
 }
-
-/// The comparison of touching pairs that writes the collision messages, as a label: whatever
-/// adds contacts after the solve (continuous collision) runs before it.
-#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct ReportCollisions;
 
 /// Solver arrays reused from step to step. Index 0 is the shared immovable body (all statics).
 #[derive(Resource, Default)]
@@ -97,6 +73,7 @@ type Movable<'a> = (
     &'a mut Position,
     &'a mut Velocity,
     &'a Mass,
+    Has<Sleeping>,
     Option<&'a mut SleepState>,
 );
 type MovableFilter = (Without<Static>, Without<Quarantined>);
@@ -113,6 +90,7 @@ fn resolve_contacts(
     timestep: Res<PhysicsTimestep>,
     mut buffers: ResMut<ResponseBuffers>,
     mut stats: ResMut<PhysicsStats>,
+    mut waker: Waker,
 ) {
     if contacts.pairs.is_empty() {
         buffers.warm.clear();
@@ -186,10 +164,11 @@ fn resolve_contacts(
     b.remember_impulses();
     for i in 1..b.entities.len() {
         if b.inverse_mass[i] > 0.0
-            && let Ok((mut p, mut v, _, state)) = bodies.get_mut(b.entities[i])
+            && let Ok((mut p, mut v, _, asleep, mut state)) = bodies.get_mut(b.entities[i])
         {
-            if let Some(mut state) = state.filter(|s| s.asleep) {
-                state.wake(); // one of `waking`: the others were held immovable
+            if asleep {
+                // One of `waking`: the others were held immovable.
+                waker.wake(b.entities[i], state.as_deref_mut());
             }
             p.set_if_neq(Position(b.positions[i]));
             v.set_if_neq(Velocity(b.velocities[i]));
@@ -265,10 +244,10 @@ impl ResponseBuffers {
         wake_speed: f32,
     ) {
         let state = |e: Entity| {
-            bodies.get(e).ok().map(|(_, v, m, s)| ContactSide {
+            bodies.get(e).ok().map(|(_, v, m, asleep, _)| ContactSide {
                 velocity: v.0,
                 dynamic: m.inverse() > 0.0,
-                asleep: s.is_some_and(|s| s.asleep),
+                asleep,
             })
         };
         for c in contacts {
@@ -292,11 +271,11 @@ impl ResponseBuffers {
         if let Some(&i) = self.index.get(&e) {
             return i;
         }
-        let Ok((p, v, m, sleep)) = bodies.get(e) else {
+        let Ok((p, v, m, asleep, _)) = bodies.get(e) else {
             return 0;
         };
         // A sleeping body holds still like scenery unless it is being woken.
-        let held = sleep.is_some_and(|s| s.asleep) && self.waking.binary_search(&e).is_err();
+        let held = asleep && self.waking.binary_search(&e).is_err();
         let i = self.entities.len();
         self.index.insert(e, i);
         self.entities.push(e);
@@ -327,81 +306,4 @@ pub(crate) fn part_velocity(
     let in_root_start = root_start.inv_mul(&part_start).transform_point(local);
     let v = root_now.transform_vector(in_root_now - in_root_start) / step_dt;
     v.is_finite().then_some(v)
-}
-
-/// The sorted set of touching pairs at the end of the previous substep.
-#[derive(Resource, Default)]
-struct TouchingPairs(Vec<(Entity, Entity)>);
-
-/// A speculative contact (see [`crate::plugins::soft_step`]) counts as touching once a point is
-/// this close (m), or once the solver pushed along it (a fast body stopped at the surface within
-/// the step): Box2D's linear slop, so that a body resting a hair above its support under the
-/// soft contact does not flicker between touching and not.
-pub const TOUCHING_TOLERANCE: f32 = 0.005;
-
-/// Compares this substep's touching pairs with the last one's. Pairs of sleeping or static
-/// bodies were not tested (nothing moved) and still touch; when a pair ends, a sleeping body in
-/// it wakes (what it rested on moved away or vanished).
-fn report_collisions(
-    contacts: Res<Contacts>,
-    mut touching: ResMut<TouchingPairs>,
-    mut bodies: Query<(Has<Static>, Option<&mut SleepState>)>,
-    mut fresh: Local<Vec<(Entity, Entity)>>,
-    mut kept: Local<Vec<(Entity, Entity)>>,
-    mut started: MessageWriter<CollisionStarted>,
-    mut ended: MessageWriter<CollisionEnded>,
-) {
-    fresh.clear();
-    fresh.extend(
-        contacts
-            .pairs
-            .iter()
-            .filter(|c| c.normal_impulse > 0.0 || c.manifold.touching(TOUCHING_TOLERANCE))
-            .map(|c| (c.a.min(c.b), c.a.max(c.b))),
-    );
-    fresh.sort_unstable();
-    fresh.dedup();
-    // Each pair touching before is touching still, kept (asleep or static on both sides: not
-    // tested, nothing moved), or ended. Both lists are sorted, and so is their merge.
-    kept.clear();
-    for &(a, b) in &touching.0 {
-        if fresh.binary_search(&(a, b)).is_ok() {
-            continue;
-        }
-        if dormant(bodies.get(a).ok()) && dormant(bodies.get(b).ok()) {
-            kept.push((a, b));
-            continue;
-        }
-        ended.write(CollisionEnded { a, b });
-        for e in [a, b] {
-            if let Ok((_, Some(mut s))) = bodies.get_mut(e)
-                && s.asleep
-            {
-                s.wake();
-            }
-        }
-    }
-    for &(a, b) in fresh.iter() {
-        if touching.0.binary_search(&(a, b)).is_err() {
-            started.write(CollisionStarted { a, b });
-        }
-    }
-    let now = &mut touching.0;
-    now.clear();
-    now.extend_from_slice(&fresh);
-    now.extend_from_slice(&kept);
-    if !kept.is_empty() && !fresh.is_empty() {
-        now.sort_unstable();
-    }
-}
-
-/// Advances the collision message buffers once per standalone step (an `App` does this itself
-/// every frame), so unread messages live two steps, as Bevy's messages live two frames.
-pub(crate) fn update_collision_messages(world: &mut World) {
-    if let Some(mut m) = world.get_resource_mut::<Messages<CollisionStarted>>() {
-        m.update();
-    }
-    if let Some(mut m) = world.get_resource_mut::<Messages<CollisionEnded>>() {
-        m.update();
-    }
 }

@@ -70,8 +70,10 @@ struct RotationBuffers {
     parts: Vec<(Isometry, MassProperties)>,
 }
 
+/// Sleeping roots are left out: a write to one wakes it first.
 type ChangedRoot = (
     Without<ChildOf>,
+    Without<Sleeping>,
     Or<(
         Changed<Collider>,
         Changed<Mass>,
@@ -227,9 +229,14 @@ type Turning<'a> = (
     &'a Inertia,
     Option<&'a AngularDrag>,
     Option<&'a LockedAxes>,
-    Option<&'a SleepState>,
 );
-type TurningFilter = (Without<Static>, Without<Quarantined>, Without<ChildOf>);
+/// Sleeping bodies do not turn: their archetypes are left out.
+type TurningFilter = (
+    Without<Static>,
+    Without<Quarantined>,
+    Without<ChildOf>,
+    Without<Sleeping>,
+);
 /// Bodies whose angular velocity was written since the stage last ran.
 type Spun<'w, 's> = Query<'w, 's, (), (Changed<AngularVelocity>, TurningFilter)>;
 
@@ -272,10 +279,7 @@ fn gather_turning(bodies: &Query<Turning, TurningFilter>, b: &mut RotationBuffer
     b.slots.clear();
     b.bodies.clear();
     b.centers.clear();
-    for (slot, (e, _, r, w, inertia, drag, locked, sleep)) in bodies.iter().enumerate() {
-        if SleepState::is_asleep(sleep) {
-            continue;
-        }
+    for (slot, (e, _, r, w, inertia, drag, locked)) in bodies.iter().enumerate() {
         let torque = if b.torques.is_empty() {
             Vec3::ZERO
         } else {

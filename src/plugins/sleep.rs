@@ -5,26 +5,34 @@
 //! dynamic bodies are grouped by the step's contacts, and an island whose every body has been
 //! slower than [`SleepSettings::speed`] for [`SleepSettings::time`] (its centre, and its surface
 //! turning at `|ω|` times its reach) falls asleep as a whole: velocities and angular velocities
-//! become exactly zero, the solver skips its bodies, and the narrow phase skips their pairs with
-//! static and other sleeping bodies (the contact is kept for the collision messages). An island
-//! touching a moving kinematic body or a body on a spring never sleeps; one that comes to rest
-//! against a sleeping island joins it.
+//! become exactly zero and each body gets the [`Sleeping`] marker. The marker moves it to
+//! archetypes that every per-step query leaves out (`Without<Sleeping>`), and the broad phase
+//! stops pairing it with scenery and other sleepers, so a sleeping island costs no pass over its
+//! bodies; only the wake-up check below looks at them, through change ticks. The contacts of a
+//! sleeping island are kept (no collision ends by falling asleep). An island touching a moving
+//! kinematic body or a body on a spring never sleeps; one that comes to rest against a sleeping
+//! island joins it.
 //!
 //! A body wakes when an awake body's contact moves it faster than the sleep speed (see the
-//! response and the solver), when game code moves it, sets its velocity or angular velocity or
-//! pushes it with a [`Force`], [`Torque`] or [`ForceAtPoint`], when gravity changes, or when a
-//! contact of it ends (a body it touched moved away or disappeared); its whole island wakes with
-//! it, before the next step simulates anything.
+//! response and the solver), when game code moves or turns it, sets its velocity or angular
+//! velocity, pushes it with a [`Force`], [`Torque`] or [`ForceAtPoint`], changes its collider or
+//! removes its [`Sleeping`] marker, when gravity changes, or when a contact of it ends (a body it
+//! touched moved away or disappeared); its whole island wakes with it (members are kept per
+//! island in [`SleepingIslands`], as Box2D v3's `island.c` keeps them), before the next step
+//! simulates anything.
 
 use crate::components::*;
 use crate::dynamics::islands::{IslandBuilder, Stillness, islands_to_sleep};
-use crate::plugins::core::PrepareStart;
+use crate::plugins::core::PrepareWake;
 use crate::plugins::narrow_phase::Contacts;
 use crate::schedule::{PhysicsSchedule, PhysicsSet};
 use crate::settings::{Gravity, PhysicsTimestep, SleepSettings};
+use crate::stats::PhysicsStats;
 use bevy_app::prelude::*;
 use bevy_ecs::entity::EntityHashMap;
 use bevy_ecs::prelude::*;
+use bevy_ecs::system::SystemParam;
+use bevy_ecs::system::entity_command;
 use glam::Vec3;
 
 /// Puts still bodies to sleep and wakes them when game code touches them.
@@ -34,12 +42,13 @@ pub struct SleepPlugin;
 impl Plugin for SleepPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<SleepSettings>()
+            .init_resource::<SleepingIslands>()
             .add_systems(
                 PhysicsSchedule,
                 (wake_on_game_changes, wake_islands)
                     .chain()
                     .run_if(sleep_enabled)
-                    .in_set(PrepareStart),
+                    .in_set(PrepareWake),
             )
             .add_systems(
                 PhysicsSchedule,
@@ -47,6 +56,10 @@ impl Plugin for SleepPlugin {
                     .chain()
                     .run_if(sleep_enabled)
                     .in_set(PhysicsSet::Finish),
+            )
+            .add_systems(
+                PhysicsSchedule,
+                wake_everything.run_if(sleep_disabled).in_set(PrepareWake),
             );
     }
 }
@@ -55,12 +68,14 @@ fn sleep_enabled(settings: Res<SleepSettings>) -> bool {
     settings.enabled
 }
 
-/// Whether `e` takes part in no simulation this substep: static scenery or a sleeping body.
-pub(crate) fn dormant(state: Option<(bool, Option<&SleepState>)>) -> bool {
-    match state {
-        Some((is_static, sleep)) => is_static || SleepState::is_asleep(sleep),
-        None => false,
-    }
+fn sleep_disabled(settings: Option<Res<SleepSettings>>) -> bool {
+    settings.is_none_or(|s| !s.enabled)
+}
+
+/// Whether `e` takes part in no simulation this substep: static scenery or a sleeping body
+/// (`(is static, is asleep)`, `None` for no body).
+pub(crate) fn dormant(state: Option<(bool, bool)>) -> bool {
+    state.is_some_and(|(is_static, asleep)| is_static || asleep)
 }
 
 /// How a body in a contact stands for the wake-up rule: its velocity, whether it is dynamic,
@@ -83,67 +98,164 @@ pub(crate) fn wakes(a: ContactSide, b: ContactSide, n: Vec3, wake_speed: f32) ->
     ]
 }
 
-type Sleeper<'a> = (
-    &'a mut SleepState,
-    &'a Position,
-    &'a Velocity,
-    Option<&'a Force>,
-    Option<&'a AngularVelocity>,
-    Option<&'a Torque>,
-    Option<&'a ForceAtPoint>,
-);
+/// Wakes sleeping bodies from any system: the marker goes when the system's commands apply, and
+/// the body's island wakes with it at the next look at the woken islands.
+#[derive(SystemParam)]
+pub(crate) struct Waker<'w, 's> {
+    commands: Commands<'w, 's>,
+    islands: Option<ResMut<'w, SleepingIslands>>,
+}
 
-/// Wakes sleeping bodies that game code moved, set moving or pushed since the last step, and
-/// every body when gravity changed.
-fn wake_on_game_changes(mut bodies: Query<Sleeper>, gravity: Option<Res<Gravity>>) {
-    let gravity_changed = gravity.is_some_and(|g| g.is_changed());
-    for (mut sleep, p, v, force, w, torque, at_point) in &mut bodies {
-        if !sleep.asleep {
-            continue;
+impl Waker<'_, '_> {
+    /// Wakes `e`, whose sleep state is `state`.
+    pub fn wake(&mut self, e: Entity, state: Option<&mut SleepState>) {
+        if let Ok(mut entity) = self.commands.get_entity(e) {
+            entity.queue_silenced(entity_command::remove::<Sleeping>());
         }
-        let pushed = force.is_some_and(|f| f.0 != Vec3::ZERO)
-            || torque.is_some_and(|t| t.0 != Vec3::ZERO)
-            || at_point.is_some_and(|f| !f.is_empty());
-        let spun = w.is_some_and(|w| w.0 != Vec3::ZERO);
-        if gravity_changed || pushed || spun || v.0 != Vec3::ZERO || p.0 != sleep.at {
-            sleep.wake();
+        if let Some(state) = state {
+            if state.island != 0
+                && let Some(islands) = self.islands.as_mut()
+            {
+                islands.woken.push(state.island);
+            }
+            state.restart();
         }
     }
 }
 
-/// Wakes every sleeping body whose island has an awake member (woken by a contact or by game
-/// code since the last look), and forgets the island of the bodies so woken.
-fn wake_islands(mut bodies: Query<&mut SleepState>, mut woken: Local<Vec<u64>>) {
-    woken.clear();
-    woken.extend(
-        bodies
-            .iter()
-            .filter(|s| !s.asleep && s.island != 0)
-            .map(|s| s.island),
-    );
-    if woken.is_empty() {
+type Sleeper<'a> = (
+    Entity,
+    &'a mut SleepState,
+    (&'a Position, &'a Rotation, &'a Velocity),
+    Option<&'a AngularVelocity>,
+    (
+        Option<&'a Force>,
+        Option<&'a Torque>,
+        Option<&'a ForceAtPoint>,
+    ),
+    (
+        Ref<'a, Mass>,
+        Option<Ref<'a, Collider>>,
+        Option<Ref<'a, Inertia>>,
+        Option<Ref<'a, LinearDrag>>,
+        Option<Ref<'a, AngularDrag>>,
+        Option<Ref<'a, ChildOf>>,
+        Option<Ref<'a, Children>>,
+    ),
+);
+/// Sleeping bodies game code wrote to since the last step: the only per-body work a sleeping
+/// body costs (change ticks, no values). It covers everything validation checks, so that
+/// validation and the other stages can leave sleeping bodies out: a bad value written to a
+/// sleeper wakes it and is then validated.
+type Touched = (
+    With<Sleeping>,
+    Or<(
+        Changed<Position>,
+        Changed<Rotation>,
+        Changed<Velocity>,
+        Changed<AngularVelocity>,
+        Changed<Force>,
+        Changed<Torque>,
+        Changed<ForceAtPoint>,
+        Changed<Mass>,
+        Changed<Collider>,
+        Changed<Inertia>,
+        Changed<LinearDrag>,
+        Changed<AngularDrag>,
+        Changed<ChildOf>,
+        Changed<Children>,
+    )>,
+);
+
+/// Wakes sleeping bodies that game code moved, turned, set moving, pushed or reshaped since the
+/// last step, and every body when gravity changed. Values the physics itself writes when a body
+/// falls asleep (pose, velocities, a spent force) wake it only if they differ from what it
+/// slept with; a write to anything else (mass, collider, drag, parent) wakes it.
+#[allow(clippy::type_complexity)]
+fn wake_on_game_changes(
+    mut sleepers: ParamSet<(
+        Query<Sleeper, Touched>,
+        Query<(Entity, &mut SleepState), With<Sleeping>>,
+    )>,
+    gravity: Option<Res<Gravity>>,
+    mut waker: Waker,
+) {
+    if gravity.is_some_and(|g| g.is_changed()) {
+        for (e, mut sleep) in &mut sleepers.p1() {
+            waker.wake(e, Some(&mut sleep));
+        }
         return;
     }
-    woken.sort_unstable();
-    woken.dedup();
-    for mut s in &mut bodies {
-        if s.island != 0 && woken.binary_search(&s.island).is_ok() {
-            s.wake();
-            s.island = 0;
+    for (e, mut sleep, (p, r, v), w, (force, torque, at_point), settings) in &mut sleepers.p0() {
+        let pushed = force.is_some_and(|f| f.0 != Vec3::ZERO)
+            || torque.is_some_and(|t| t.0 != Vec3::ZERO)
+            || at_point.is_some_and(|f| !f.is_empty());
+        let spun = w.is_some_and(|w| w.0 != Vec3::ZERO);
+        let moved = p.0 != sleep.at || r.0 != sleep.orientation || v.0 != Vec3::ZERO;
+        let (mass, collider, inertia, drag, angular_drag, parent, children) = settings;
+        let changed = |c: Option<bool>| c.unwrap_or(false);
+        let rebuilt = mass.is_changed()
+            || changed(collider.map(|c| c.is_changed()))
+            || changed(inertia.map(|c| c.is_changed()))
+            || changed(drag.map(|c| c.is_changed()))
+            || changed(angular_drag.map(|c| c.is_changed()))
+            || changed(parent.map(|c| c.is_changed()))
+            || changed(children.map(|c| c.is_changed()));
+        if pushed || spun || moved || rebuilt {
+            waker.wake(e, Some(&mut sleep));
         }
+    }
+}
+
+/// Wakes the islands of the bodies woken since the last look (by contacts, by game code, by a
+/// removed [`Sleeping`] marker or a despawned member).
+fn wake_islands(
+    mut islands: ResMut<SleepingIslands>,
+    mut states: Query<&mut SleepState>,
+    mut commands: Commands,
+) {
+    let islands = &mut *islands;
+    islands.woken.sort_unstable();
+    islands.woken.dedup();
+    for key in islands.woken.drain(..) {
+        for e in islands.members.remove(&key).unwrap_or_default() {
+            if let Ok(mut state) = states.get_mut(e) {
+                state.restart();
+            }
+            if let Ok(mut entity) = commands.get_entity(e) {
+                entity.queue_silenced(entity_command::remove::<Sleeping>());
+            }
+        }
+    }
+}
+
+/// With sleeping switched off, nothing stays asleep.
+fn wake_everything(
+    mut sleepers: Query<(Entity, &mut SleepState), With<Sleeping>>,
+    islands: Option<ResMut<SleepingIslands>>,
+    mut commands: Commands,
+) {
+    for (e, mut state) in &mut sleepers {
+        state.restart();
+        commands.entity(e).remove::<Sleeping>();
+    }
+    if let Some(mut islands) = islands {
+        islands.members.clear();
+        islands.woken.clear();
     }
 }
 
 type Candidate<'a> = (
     Entity,
     &'a mut SleepState,
-    &'a Position,
+    (&'a Position, &'a Rotation),
     &'a mut Velocity,
     &'a Mass,
     Option<&'a mut AngularVelocity>,
     &'a BoundingVolume,
 );
 type CandidateFilter = (
+    Without<Sleeping>,
     Without<Static>,
     Without<Quarantined>,
     Without<ChildOf>,
@@ -172,18 +284,22 @@ struct IslandScratch {
     asleep: Vec<bool>,
     /// Per island root: the key its bodies sleep with.
     keys: Vec<u64>,
-    last_key: u64,
 }
 
 /// Counts how long each awake dynamic body has been still, groups the awake bodies into islands
 /// by the step's contacts, and puts to sleep the islands still for [`SleepSettings::time`].
+#[allow(clippy::too_many_arguments)]
 fn fall_asleep(
     mut bodies: Query<Candidate, CandidateFilter>,
+    sleepers: Query<&SleepState, With<Sleeping>>,
     never_sleep: Query<(), (With<Spring>, Without<Static>)>,
     contacts: Option<Res<Contacts>>,
     settings: Res<SleepSettings>,
     timestep: Res<PhysicsTimestep>,
+    mut islands: ResMut<SleepingIslands>,
     mut scratch: Local<IslandScratch>,
+    mut stats: ResMut<PhysicsStats>,
+    mut commands: Commands,
 ) {
     let s = &mut *scratch;
     count_stillness(&mut bodies, settings.speed, timestep.dt(), s);
@@ -192,21 +308,23 @@ fn fall_asleep(
     s.joins.resize(s.awake.len(), 0);
     if let Some(contacts) = contacts {
         for pair in &contacts.pairs {
-            link_contact(s, (pair.a, pair.b), &bodies, &never_sleep);
-            link_contact(s, (pair.b, pair.a), &bodies, &never_sleep);
+            link_contact(s, (pair.a, pair.b), &sleepers, &never_sleep);
+            link_contact(s, (pair.b, pair.a), &sleepers, &never_sleep);
         }
     }
     islands_to_sleep(&mut s.islands, &s.stillness, settings.time, &mut s.asleep);
-    assign_island_keys(s);
+    assign_island_keys(s, &mut islands.last_key);
     for (i, &e) in s.awake.iter().enumerate() {
         if !s.asleep[i] {
             continue;
         }
         let key = s.keys[s.islands.root(i)];
-        if let Ok((_, mut sleep, p, mut v, _, mut w, _)) = bodies.get_mut(e) {
-            sleep.asleep = true;
+        if let Ok((_, mut sleep, (p, r), mut v, _, mut w, _)) = bodies.get_mut(e) {
             sleep.at = p.0;
+            sleep.orientation = r.0;
             sleep.island = key;
+            islands.members.entry(key).or_default().push(e);
+            commands.entity(e).insert(Sleeping);
             // Not a change by game code: the wake-up check compares values, not change ticks.
             v.bypass_change_detection().0 = Vec3::ZERO;
             if let Some(w) = w.as_mut() {
@@ -214,6 +332,8 @@ fn fall_asleep(
             }
         }
     }
+    stats.set_counter("sleep/awake_bodies", s.awake.len() as f64);
+    stats.set_counter("sleep/sleeping_islands", islands.members.len() as f64);
 }
 
 /// Lists the awake dynamic bodies with their stillness (counting it on) and every body's slot.
@@ -231,9 +351,6 @@ fn count_stillness(
         if m.inverse() == 0.0 {
             let moving = v.0 != Vec3::ZERO || spin != 0.0;
             s.slots.insert(e, Slot::Kinematic { moving });
-            continue;
-        }
-        if sleep.asleep {
             continue;
         }
         // A turning body's surface moves at up to |ω| times its reach (Box2D's sleep test).
@@ -258,7 +375,7 @@ fn count_stillness(
 fn link_contact(
     s: &mut IslandScratch,
     (body, other): (Entity, Entity),
-    bodies: &Query<Candidate, CandidateFilter>,
+    sleepers: &Query<&SleepState, With<Sleeping>>,
     never_sleep: &Query<(), (With<Spring>, Without<Static>)>,
 ) {
     let Some(&Slot::Awake(i)) = s.slots.get(&body) else {
@@ -268,8 +385,8 @@ fn link_contact(
         Some(&Slot::Awake(j)) => s.islands.link(i, j),
         Some(&Slot::Kinematic { moving }) => s.stillness[i].restless |= moving,
         None => {
-            if let Ok((_, sleep, ..)) = bodies.get(other) {
-                if sleep.asleep && sleep.island != 0 {
+            if let Ok(sleep) = sleepers.get(other) {
+                if sleep.island != 0 {
                     s.joins[i] = sleep.island;
                 }
             } else if never_sleep.contains(other) {
@@ -281,7 +398,7 @@ fn link_contact(
 
 /// The key of each island about to sleep: the sleeping island it rests against, if any (it
 /// joins it, so they wake together), else a new one.
-fn assign_island_keys(s: &mut IslandScratch) {
+fn assign_island_keys(s: &mut IslandScratch, last_key: &mut u64) {
     let n = s.awake.len();
     s.keys.clear();
     s.keys.resize(n, 0);
@@ -294,8 +411,8 @@ fn assign_island_keys(s: &mut IslandScratch) {
     for i in 0..n {
         let r = s.islands.root(i);
         if s.asleep[i] && s.keys[r] == 0 {
-            s.last_key += 1;
-            s.keys[r] = s.last_key;
+            *last_key += 1;
+            s.keys[r] = *last_key;
         }
     }
 }

@@ -6,7 +6,7 @@
 //! propagation composes them exactly as urto's hierarchy does. Bodies without a `Transform`
 //! cost nothing, and a world with none does not run the system at all.
 
-use crate::components::{Position, Quarantined, Rotation};
+use crate::components::{Position, Quarantined, Rotation, Sleeping};
 use crate::schedule::{PhysicsSchedule, PhysicsSet};
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
@@ -30,6 +30,7 @@ impl Plugin for TransformSyncPlugin {
 type Moved = (
     Or<(Changed<Position>, Changed<Rotation>)>,
     Without<Quarantined>,
+    Without<Sleeping>,
 );
 
 fn sync_transforms(mut bodies: Query<(&Position, &Rotation, &mut Transform), Moved>) {

@@ -45,8 +45,10 @@ type BodyData<'a> = (
     Has<ChildOf>,
 );
 
+/// Sleeping bodies are left out: a write to one wakes it first (`plugins/sleep.rs`).
 type ChangedBody = (
     Without<Quarantined>,
+    Without<Sleeping>,
     Or<(
         Changed<Position>,
         Changed<Velocity>,
@@ -90,6 +92,7 @@ type AngularData<'a> = (
 
 type ChangedAngular = (
     Without<Quarantined>,
+    Without<Sleeping>,
     Or<(
         Changed<AngularVelocity>,
         Changed<Torque>,

@@ -4,7 +4,7 @@
 //! a viewer sees which bodies sleep and which sleep together (`crate::dynamics::islands`).
 
 use super::DebugColor;
-use crate::components::{Mass, Quarantined, SleepState, Static};
+use crate::components::{Mass, Quarantined, Static};
 use bevy_ecs::prelude::*;
 
 const DYNAMIC: [u8; 3] = [230, 126, 34];
@@ -25,20 +25,20 @@ pub(super) fn kind_tint(is_static: bool, mass: Option<&Mass>) -> [u8; 3] {
     }
 }
 
-/// The colour of `e`: quarantined red; asleep, its island's; else its own tint, or its root's
-/// kind (a wheel is drawn like its car).
+/// The colour of `e`: quarantined red; asleep (in island `sleeping`), its island's; else its
+/// own tint, or its root's kind (a wheel is drawn like its car).
 pub(super) fn body_color(
     e: Entity,
     tint: Option<&DebugColor>,
-    sleep: Option<&SleepState>,
+    sleeping: Option<u64>,
     parents: &Query<&ChildOf>,
     kinds: &Query<KindView>,
 ) -> [u8; 3] {
     if matches!(kinds.get(e), Ok((_, _, true))) {
         return QUARANTINED;
     }
-    match (tint, sleep) {
-        (_, Some(s)) if s.asleep => sleeping_color(s.island),
+    match (tint, sleeping) {
+        (_, Some(island)) => sleeping_color(island),
         (Some(t), _) => t.0,
         _ => {
             let mut root = e;

@@ -1,12 +1,13 @@
 //! Meshes in the recording: each mesh body's triangles logged once and moved by its pose, and
 //! the hierarchy leaves through which two meshes touched.
 
-use super::body_colors::kind_tint;
+use super::body_colors::{kind_tint, sleeping_color};
 use super::*;
 
-/// The entity path of each mesh body logged so far (sorted by entity: deterministic).
+/// The entity path of each mesh body logged so far and the colour it was last drawn with
+/// (sorted by entity: deterministic).
 #[derive(Resource, Default)]
-pub(super) struct LoggedMeshes(BTreeMap<Entity, String>);
+pub(super) struct LoggedMeshes(BTreeMap<Entity, (String, [u8; 3])>);
 
 type MeshBody<'a> = (
     Entity,
@@ -15,6 +16,7 @@ type MeshBody<'a> = (
     Has<Static>,
     Option<&'a Mass>,
     Option<&'a DebugColor>,
+    (Has<Sleeping>, Option<&'a SleepState>),
 );
 
 /// Mesh bodies: the triangles once per body (again only if its collider changes), the pose on
@@ -31,28 +33,38 @@ pub(super) fn record_meshes(
     set_time(stream, &stats);
     let mut statics_changed = false;
     for entity in removed.read() {
-        if let Some(path) = logged.0.remove(&entity) {
+        if let Some((path, _)) = logged.0.remove(&entity) {
             report(stream.log(path, &rerun::Clear::recursive()));
             statics_changed = true;
         }
     }
-    for (entity, collider, g, is_static, mass, own_tint) in &bodies {
+    for (entity, collider, g, is_static, mass, own_tint, (asleep, sleep)) in &bodies {
         let Shape::TriMesh(mesh) = &collider.shape else {
-            if let Some(path) = logged.0.remove(&entity) {
+            if let Some((path, _)) = logged.0.remove(&entity) {
                 report(stream.log(path, &rerun::Clear::recursive()));
                 statics_changed = true;
             }
             continue;
         };
         let fresh = collider.is_changed() || !logged.0.contains_key(&entity);
-        let path = logged
+        let (path, drawn) = logged
             .0
             .entry(entity)
-            .or_insert_with(|| mesh_path(mesh, entity));
+            .or_insert_with(|| (mesh_path(mesh, entity), [0; 3]));
+        // As the other bodies: a sleeping mesh takes its island's muted colour.
+        let tint = match (asleep, own_tint) {
+            (true, _) => sleeping_color(sleep.map_or(0, |s| s.island)),
+            (false, Some(t)) => t.0,
+            (false, None) => kind_tint(is_static, mass),
+        };
         if fresh {
-            let tint = own_tint.map_or_else(|| kind_tint(is_static, mass), |t| t.0);
             log_mesh(stream, path, mesh, tint);
+        } else if tint != *drawn {
+            let albedo = rerun::datatypes::Rgba32::from_rgb(tint[0], tint[1], tint[2]);
+            let recolored = rerun::Mesh3D::update_fields().with_albedo_factor(albedo);
+            report(stream.log(path.as_str(), &recolored));
         }
+        *drawn = tint;
         let moved = fresh || g.is_changed();
         if moved || !is_static {
             let pose = rerun::Transform3D::from_translation_rotation(

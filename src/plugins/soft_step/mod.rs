@@ -43,7 +43,7 @@ use crate::dynamics::solver::Solver;
 use crate::dynamics::solver::{BodyInput, ContactInput, SoftStepSettings, SolverBodies};
 use crate::plugins::forces::GatheredForces;
 use crate::plugins::narrow_phase::Contacts;
-use crate::plugins::sleep::{ContactSide, wakes};
+use crate::plugins::sleep::{ContactSide, Waker, wakes};
 use crate::schedule::{SubstepSchedule, SubstepSet};
 use crate::settings::{ContactSettings, PhysicsTimestep, RotationSettings, SleepSettings};
 use crate::stats::{PhysicsStats, Stage};
@@ -130,12 +130,23 @@ type Mover<'a> = (
     Option<&'a LockedAxes>,
     Option<&'a AngularDrag>,
     Option<&'a LinearDrag>,
+    Has<Sleeping>,
     Option<&'a mut SleepState>,
 );
 type MoverFilter = (Without<Static>, Without<Quarantined>, Without<ChildOf>);
+/// The awake movers, as entities only (a filter alone would match every entity of the world,
+/// resources and observers included: the components a mover has are named).
+type AwakeMover = (
+    MoverFilter,
+    Without<Sleeping>,
+    With<Velocity>,
+    With<AngularVelocity>,
+    With<Inertia>,
+);
 #[allow(clippy::too_many_arguments)]
 fn solve_soft_step(
     mut movers: Query<Mover, MoverFilter>,
+    awake: Query<Entity, AwakeMover>,
     poses: Query<(&GlobalPose, Option<&StepStartPose>)>,
     materials: Query<Material>,
     mut contacts: ResMut<Contacts>,
@@ -146,18 +157,28 @@ fn solve_soft_step(
     timestep: Res<PhysicsTimestep>,
     mut soft: ResMut<SoftStepSolver>,
     mut stats: ResMut<PhysicsStats>,
+    mut waker: Waker,
 ) {
     let start = Instant::now();
     let s = &mut *soft;
     let gyroscopic = rotation.is_none_or(|r| r.gyroscopic);
+    s.waking.clear();
     if let Some(sleep) = sleep.filter(|s| s.enabled) {
-        wake_touched_sleepers(&mut movers, &contacts, sleep.speed, &mut s.waking);
+        wake_touched_sleepers(
+            &mut movers,
+            &contacts,
+            sleep.speed,
+            &mut s.waking,
+            &mut waker,
+        );
     }
-    let awake = collect_entities(&movers, &contacts, &mut s.entities);
+    let held =
+        |asleep: bool, e: Entity, waking: &[Entity]| asleep && waking.binary_search(&e).is_err();
+    let awake = collect_entities(&awake, &contacts, &mut s.entities);
     s.bodies.clear();
     for &e in &s.entities {
         let input = match movers.get(e) {
-            Ok(m) if !SleepState::is_asleep(m.10) => body_input(m, &gathered, gyroscopic),
+            Ok(m) if !held(m.10, e, &s.waking) => body_input(m, &gathered, gyroscopic),
             _ => BodyInput {
                 center: poses
                     .get(e)
@@ -199,7 +220,7 @@ fn solve_soft_step(
     report_impulses(&s.solver, &s.sources, &mut contacts);
     for (slot, &e) in s.entities.iter().enumerate() {
         if let Ok(m) = movers.get_mut(e)
-            && !SleepState::is_asleep(m.10.as_deref())
+            && !held(m.10, e, &s.waking)
         {
             scatter(m, &s.bodies, slot);
         }
@@ -219,13 +240,13 @@ fn wake_touched_sleepers(
     contacts: &Contacts,
     wake_speed: f32,
     waking: &mut Vec<Entity>,
+    waker: &mut Waker,
 ) {
-    waking.clear();
     let state = |e: Entity| {
         movers.get(e).ok().map(|m| ContactSide {
             velocity: m.3.0,
             dynamic: m.5.inverse() > 0.0,
-            asleep: SleepState::is_asleep(m.10),
+            asleep: m.10,
         })
     };
     for c in &contacts.pairs {
@@ -240,11 +261,11 @@ fn wake_touched_sleepers(
             waking.push(c.b);
         }
     }
+    waking.sort_unstable();
+    waking.dedup();
     for &e in waking.iter() {
-        if let Ok(mut m) = movers.get_mut(e)
-            && let Some(sleep) = m.10.as_mut()
-        {
-            sleep.wake();
+        if let Ok(mut m) = movers.get_mut(e) {
+            waker.wake(e, m.11.as_deref_mut());
         }
     }
 }
@@ -252,17 +273,12 @@ fn wake_touched_sleepers(
 /// Every awake moving body and every body a contact names, sorted by entity (creation order),
 /// each once; returns how many are awake moving bodies.
 fn collect_entities(
-    movers: &Query<Mover, MoverFilter>,
+    awake: &Query<Entity, AwakeMover>,
     contacts: &Contacts,
     out: &mut Vec<Entity>,
 ) -> usize {
     out.clear();
-    out.extend(
-        movers
-            .iter()
-            .filter(|m| !SleepState::is_asleep(m.10))
-            .map(|m| m.0),
-    );
+    out.extend(awake.iter());
     let awake = out.len();
     for pair in &contacts.pairs {
         out.push(pair.a);
@@ -279,7 +295,7 @@ fn body_input(
     gathered: &GatheredForces,
     gyroscopic: bool,
 ) -> BodyInput {
-    let (_, p, r, v, w, mass, inertia, locked, angular_drag, drag, _) = m;
+    let (_, p, r, v, w, mass, inertia, locked, angular_drag, drag, ..) = m;
     let inverse_mass = mass.inverse();
     let dynamic = inverse_mass > 0.0;
     BodyInput {

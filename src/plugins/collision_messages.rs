@@ -1,0 +1,167 @@
+//! Collision started / ended messages: each substep's touching pairs compared with the last
+//! substep's.
+//!
+//! Pairs of sleeping or static bodies are not tested (nothing moved), so they are not in the
+//! substep's contacts; they are kept aside, sorted, as the *dormant* pairs, and looked at again
+//! only in a substep after a body woke, lost its [`Static`] marker or was despawned. A sleeping
+//! pile therefore costs this stage nothing per step (Box2D v3 likewise keeps a sleeping
+//! island's contacts in the island's solver set, out of the awake contact array), and falling
+//! asleep ends no collision.
+
+use crate::components::*;
+use crate::plugins::narrow_phase::Contacts;
+use crate::plugins::sleep::{Waker, dormant};
+use bevy_app::prelude::*;
+use bevy_ecs::message::Messages;
+use bevy_ecs::prelude::*;
+
+/// Two bodies started touching this step (`a < b`).
+#[derive(Message, Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CollisionStarted {
+    /// One body.
+    pub a: Entity,
+    /// The other.
+    pub b: Entity,
+}
+
+/// Two bodies stopped touching this step (`a < b`).
+#[derive(Message, Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CollisionEnded {
+    /// One body.
+    pub a: Entity,
+    /// The other.
+    pub b: Entity,
+}
+
+/// The comparison of touching pairs that writes the collision messages, as a label: whatever
+/// adds contacts after the solve (continuous collision) runs before it.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ReportCollisions;
+
+/// A speculative contact (see [`crate::plugins::soft_step`]) counts as touching once a point is
+/// this close (m), or once the solver pushed along it (a fast body stopped at the surface within
+/// the step): Box2D's linear slop, so that a body resting a hair above its support under the
+/// soft contact does not flicker between touching and not.
+pub const TOUCHING_TOLERANCE: f32 = 0.005;
+
+/// Registers the messages and the pairs they are computed from.
+pub(crate) fn add_collision_messages(app: &mut App) {
+    app.init_resource::<TouchingPairs>()
+        .add_message::<CollisionStarted>()
+        .add_message::<CollisionEnded>();
+}
+
+type Pair = (Entity, Entity);
+
+/// The touching pairs at the end of the previous substep, each list sorted.
+#[derive(Resource, Default)]
+pub(crate) struct TouchingPairs {
+    /// Pairs with an awake body: tested every substep.
+    active: Vec<Pair>,
+    /// Pairs of sleeping or static bodies: untested, touching until one of them wakes or goes.
+    dormant: Vec<Pair>,
+}
+
+/// Whether the bodies of a pair are both static or asleep.
+use crate::plugins::narrow_phase::Dormancy;
+
+/// Compares this substep's touching pairs with the last one's; when a pair ends, a sleeping
+/// body in it wakes (what it rested on moved away or vanished).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn report_collisions(
+    contacts: Res<Contacts>,
+    mut touching: ResMut<TouchingPairs>,
+    mut bodies: Query<(Dormancy, Option<&mut SleepState>)>,
+    mut woke: RemovedComponents<Sleeping>,
+    mut unfixed: RemovedComponents<Static>,
+    mut despawned: RemovedComponents<BoundingVolume>,
+    mut fresh: Local<Vec<Pair>>,
+    mut previous: Local<Vec<Pair>>,
+    mut started: MessageWriter<CollisionStarted>,
+    mut ended: MessageWriter<CollisionEnded>,
+    mut waker: Waker,
+) {
+    fresh.clear();
+    fresh.extend(
+        contacts
+            .pairs
+            .iter()
+            .filter(|c| c.normal_impulse > 0.0 || c.manifold.touching(TOUCHING_TOLERANCE))
+            .map(|c| (c.a.min(c.b), c.a.max(c.b))),
+    );
+    fresh.sort_unstable();
+    fresh.dedup();
+    let touching = &mut *touching;
+    let is_dormant = |e: Entity, bodies: &Query<(Dormancy, Option<&mut SleepState>)>| {
+        dormant(bodies.get(e).ok().map(|(d, _)| d))
+    };
+    // Dormant pairs come back into play only after something woke or went.
+    let stirred = woke.read().count() + unfixed.read().count() + despawned.read().count() > 0;
+    previous.clear();
+    previous.extend_from_slice(&touching.active);
+    if stirred {
+        let before = previous.len();
+        touching.dormant.retain(|&(a, b)| {
+            let still = is_dormant(a, &bodies) && is_dormant(b, &bodies);
+            if !still {
+                previous.push((a, b));
+            }
+            still
+        });
+        if previous.len() > before {
+            previous.sort_unstable();
+        }
+    }
+    // Each pair touching before is touching still, newly dormant (not tested now), or ended.
+    let mut newly_dormant = false;
+    for &(a, b) in previous.iter() {
+        if fresh.binary_search(&(a, b)).is_ok() {
+            continue;
+        }
+        if is_dormant(a, &bodies) && is_dormant(b, &bodies) {
+            touching.dormant.push((a, b));
+            newly_dormant = true;
+            continue;
+        }
+        ended.write(CollisionEnded { a, b });
+        for e in [a, b] {
+            if let Ok(((_, true), state)) = bodies.get_mut(e) {
+                waker.wake(e, state.map(Mut::into_inner));
+            }
+        }
+    }
+    if newly_dormant {
+        touching.dormant.sort_unstable();
+    }
+    let mut resumed = false;
+    for &pair in fresh.iter() {
+        if previous.binary_search(&pair).is_ok() {
+            continue;
+        }
+        if let Ok(at) = touching.dormant.binary_search(&pair) {
+            // Tested again (a body of it woke): active from now on, not a new collision.
+            touching.dormant[at].0 = Entity::PLACEHOLDER;
+            resumed = true;
+            continue;
+        }
+        started.write(CollisionStarted {
+            a: pair.0,
+            b: pair.1,
+        });
+    }
+    if resumed {
+        touching.dormant.retain(|p| p.0 != Entity::PLACEHOLDER);
+    }
+    touching.active.clone_from(&fresh);
+}
+
+/// Advances the collision message buffers once per standalone step (an `App` does this itself
+/// every frame), so unread messages live two steps, as Bevy's messages live two frames.
+pub(crate) fn update_collision_messages(world: &mut World) {
+    if let Some(mut m) = world.get_resource_mut::<Messages<CollisionStarted>>() {
+        m.update();
+    }
+    if let Some(mut m) = world.get_resource_mut::<Messages<CollisionEnded>>() {
+        m.update();
+    }
+}
