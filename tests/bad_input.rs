@@ -230,3 +230,64 @@ fn a_childof_loop_is_quarantined_whole_and_the_step_ends() {
         "ball at {z}, expected {expected}"
     );
 }
+
+/// Removes resource `R` after the scene settled, steps on, and returns the ball's height.
+fn height_after_removing<R: bevy_ecs::resource::Resource>() -> f32 {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    app.world_mut()
+        .spawn((Collider::half_space(Vec3::Z), Static));
+    app.world_mut().spawn((
+        Collider::cuboid(5.0, 5.0, 0.5),
+        Position::new(20.0, 0.0, 0.0),
+        Static,
+    ));
+    let ball = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(0.0, 0.0, 2.0),
+            Velocity::default(),
+        ))
+        .id();
+    let on_slab = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(20.0, 0.0, 2.0),
+            Velocity::default(),
+        ))
+        .id();
+    urto::step(app.world_mut(), 10).unwrap();
+    assert!(app.world_mut().remove_resource::<R>().is_some());
+    urto::step(app.world_mut(), 110).unwrap();
+    assert!(app.world().contains_resource::<R>(), "made again");
+    let z = |e| app.world().get::<Position>(e).unwrap().0.z;
+    z(ball).min(z(on_slab) - 0.5)
+}
+
+/// Removing any resource a stage runs on is input, not a crash: the resource is made again
+/// (with a warning), and both balls end resting, on the ground and on a slab in the static
+/// grid, within 2 cm (the broad-phase index, made again empty, re-indexes the scenery).
+#[test]
+fn removing_a_required_resource_between_steps_keeps_balls_resting_within_2cm() {
+    let heights = [
+        height_after_removing::<ContactSettings>(),
+        height_after_removing::<SleepSettings>(),
+        height_after_removing::<PhysicsTimestep>(),
+        height_after_removing::<urto::settings::Integration>(),
+        height_after_removing::<RotationSettings>(),
+        height_after_removing::<urto::plugins::CcdSettings>(),
+        height_after_removing::<urto::plugins::Contacts>(),
+        height_after_removing::<urto::plugins::BroadPhasePairs>(),
+        height_after_removing::<urto::plugins::BroadPhaseIndex>(),
+        height_after_removing::<urto::plugins::GatheredForces>(),
+        height_after_removing::<urto::plugins::SoftStepSolver>(),
+        height_after_removing::<urto::plugins::SpeculativeMargin>(),
+        height_after_removing::<PhysicsStats>(),
+        height_after_removing::<SleepingIslands>(),
+    ];
+    for (i, z) in heights.into_iter().enumerate() {
+        assert!((z - 0.5).abs() < 0.02, "resource {i}: height {z}");
+    }
+}

@@ -24,6 +24,7 @@ use crate::broad_phase::{
 use crate::components::*;
 use crate::plugins::core::PrepareIndex;
 use crate::plugins::proxy_table::{Proxy, ProxyTable};
+use crate::plugins::required_resources::RequireResource;
 use crate::plugins::soft_step::{Lookahead, LookaheadParams};
 use crate::plugins::validation::quarantine;
 use crate::schedule::{BroadPhaseSystems, PhysicsSchedule, SubstepSchedule};
@@ -76,6 +77,9 @@ pub struct BroadPhaseIndex {
     static_batch: Vec<(ProxyId, Aabb)>,
     moving_batch: Vec<(ProxyId, Aabb, BodyKind)>,
     hits: Vec<u32>,
+    /// Made since the last sync (first step, or made again after game code removed it): every
+    /// root is indexed, not only the changed ones.
+    fresh: bool,
 }
 
 impl BroadPhaseIndex {
@@ -92,6 +96,7 @@ impl BroadPhaseIndex {
             static_batch: Vec::new(),
             moving_batch: Vec::new(),
             hits: Vec::new(),
+            fresh: true,
         }
     }
 
@@ -117,9 +122,12 @@ impl BroadPhaseIndex {
 
 impl Plugin for BroadPhasePlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<BroadPhasePairs>()
-            .init_resource::<SleepTransitions>()
-            .insert_resource(BroadPhaseIndex::new(self))
+        app.init_required::<BroadPhasePairs>()
+            .init_required::<SleepTransitions>()
+            .insert_required({
+                let plugin = self.clone();
+                move || BroadPhaseIndex::new(&plugin)
+            })
             .add_systems(
                 SubstepSchedule,
                 (
@@ -194,6 +202,11 @@ fn sync_broad_phase(
         index.forget(e);
     }
     let back: Vec<Entity> = released.read().chain(orphaned.read()).collect();
+    if std::mem::take(&mut index.fresh) {
+        for row in roots.iter() {
+            index.upsert(row, &lookahead);
+        }
+    }
     for row in back
         .iter()
         .filter_map(|e| roots.get(*e).ok())

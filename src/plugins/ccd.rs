@@ -22,6 +22,7 @@ use crate::geometry::ContactManifold;
 use crate::plugins::broad_phase::BroadPhaseIndex;
 use crate::plugins::integration::IntegrateBodies;
 use crate::plugins::narrow_phase::{ComputeContacts, ContactPair, Contacts};
+use crate::plugins::required_resources::RequireResource;
 use crate::plugins::response::ReportCollisions;
 use crate::plugins::soft_step::{SolveBodies, legacy_solver};
 use crate::schedule::{SubstepSchedule, SubstepSet};
@@ -65,9 +66,9 @@ pub struct CcdImpacts {
 
 impl Plugin for CcdPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<CcdSettings>()
-            .init_resource::<CcdImpacts>()
-            .init_resource::<CcdScratch>()
+        app.init_required::<CcdSettings>()
+            .init_required::<CcdImpacts>()
+            .init_required::<CcdScratch>()
             .add_systems(
                 SubstepSchedule,
                 (

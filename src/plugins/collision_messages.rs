@@ -10,6 +10,7 @@
 
 use crate::components::*;
 use crate::plugins::narrow_phase::Contacts;
+use crate::plugins::required_resources::RequireResource;
 use crate::plugins::sleep::{Waker, dormant};
 use bevy_app::prelude::*;
 use bevy_ecs::message::Messages;
@@ -46,7 +47,7 @@ pub const TOUCHING_TOLERANCE: f32 = 0.005;
 
 /// Registers the messages and the pairs they are computed from.
 pub(crate) fn add_collision_messages(app: &mut App) {
-    app.init_resource::<TouchingPairs>()
+    app.init_required::<TouchingPairs>()
         .add_message::<CollisionStarted>()
         .add_message::<CollisionEnded>();
 }

@@ -1,6 +1,7 @@
 //! The core plugin: schedules, settings, statistics, and the two ways a step is driven —
 //! Bevy's fixed-timestep loop in an `App`, or [`step`] on a standalone world.
 
+use crate::plugins::required_resources::{RequireResource, restore_required_resources};
 use crate::schedule::{
     BroadPhaseSystems, PhysicsSchedule, PhysicsSet, SubstepSchedule, SubstepSet,
 };
@@ -22,17 +23,17 @@ pub struct PhysicsCorePlugin {
 
 impl Plugin for PhysicsCorePlugin {
     fn build(&self, app: &mut App) {
-        match self.timestep {
-            Some(ts) => {
-                app.insert_resource(ts);
-            }
-            None => {
-                app.init_resource::<PhysicsTimestep>();
-            }
-        }
-        app.init_resource::<Integration>()
-            .init_resource::<ContactSettings>()
-            .init_resource::<PhysicsStats>();
+        // Removed by game code, the timestep comes back as the plugin was built with it.
+        let ts = self.timestep.unwrap_or_else(|| {
+            app.world()
+                .get_resource::<PhysicsTimestep>()
+                .copied()
+                .unwrap_or_default()
+        });
+        app.insert_required(move || ts)
+            .init_required::<Integration>()
+            .init_required::<ContactSettings>()
+            .init_required::<PhysicsStats>();
 
         // Single-threaded executors: the step is a strict chain, and one thread keeps runs
         // bit-for-bit reproducible whatever the machine's thread count.
@@ -49,7 +50,10 @@ impl Plugin for PhysicsCorePlugin {
                 .chain(),
         );
         physics.add_systems((
-            begin_step.in_set(PhysicsSet::Prepare).before(PrepareWake),
+            (restore_required_resources, begin_step)
+                .chain()
+                .in_set(PhysicsSet::Prepare)
+                .before(PrepareWake),
             run_substeps.in_set(PhysicsSet::Substeps),
         ));
         physics.configure_sets(
@@ -129,6 +133,7 @@ fn run_substeps(world: &mut World) {
 
 /// In an `App`: one physics step per fixed tick, with dt taken from Bevy's fixed clock.
 fn run_physics_in_fixed_update(world: &mut World) {
+    restore_required_resources(world);
     let fixed_dt = world.resource::<Time>().delta_secs();
     let mut ts = world.resource_mut::<PhysicsTimestep>();
     if (ts.dt() - fixed_dt).abs() > f32::EPSILON * ts.dt()

@@ -4,6 +4,7 @@
 //! intermediate state it needs.
 
 use crate::components::*;
+use crate::plugins::required_resources::RequireResource;
 use crate::schedule::{PhysicsSchedule, PhysicsSet};
 use crate::settings::Gravity;
 use crate::stats::{PhysicsStats, Stage};
@@ -40,7 +41,7 @@ impl GatheredForces {
 
 impl Plugin for ForcesPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<GatheredForces>().add_systems(
+        app.init_required::<GatheredForces>().add_systems(
             PhysicsSchedule,
             (
                 clear_gathered_forces,

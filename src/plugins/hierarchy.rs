@@ -18,6 +18,7 @@ use crate::geometry::Isometry;
 use crate::hierarchy::refit_order;
 use crate::plugins::broad_phase::IndexBodies;
 use crate::plugins::core::PrepareIndex;
+use crate::plugins::required_resources::RequireResource;
 use crate::plugins::validation::MAX_HIERARCHY_DEPTH;
 use crate::plugins::validation::quarantine;
 use crate::schedule::{BroadPhaseSystems, PhysicsSchedule, PhysicsSet, SubstepSchedule};
@@ -33,7 +34,7 @@ pub struct HierarchyPlugin;
 
 impl Plugin for HierarchyPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<HierarchyScratch>()
+        app.init_required::<HierarchyScratch>()
             .add_systems(
                 SubstepSchedule,
                 (

@@ -8,6 +8,7 @@ use crate::components::*;
 use crate::dynamics::forces::Spring as CoreSpring;
 use crate::dynamics::{ForceModel, IntegratorScratch, SpringEnd, integrate};
 use crate::plugins::forces::GatheredForces;
+use crate::plugins::required_resources::RequireResource;
 use crate::plugins::soft_step::legacy_solver;
 use crate::schedule::{SubstepSchedule, SubstepSet};
 use crate::settings::{Integration, PhysicsTimestep};
@@ -24,7 +25,7 @@ pub struct IntegrationPlugin;
 
 impl Plugin for IntegrationPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<IntegrationBuffers>().add_systems(
+        app.init_required::<IntegrationBuffers>().add_systems(
             SubstepSchedule,
             integrate_bodies
                 .run_if(any_with_component::<Velocity>)

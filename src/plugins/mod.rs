@@ -21,6 +21,7 @@ pub mod hierarchy;
 pub mod integration;
 pub mod narrow_phase;
 mod proxy_table;
+mod required_resources;
 pub mod response;
 pub mod rotation;
 pub mod sleep;

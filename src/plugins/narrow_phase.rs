@@ -34,6 +34,7 @@ use crate::geometry::contacts::{
 use crate::geometry::{ContactManifold, Shape};
 use crate::hierarchy::{BvTree, HierarchyStats, PairScratch, descend_pairs};
 use crate::plugins::broad_phase::BroadPhasePairs;
+use crate::plugins::required_resources::RequireResource;
 use crate::plugins::sleep::dormant;
 use crate::plugins::soft_step::LookaheadParams;
 use crate::schedule::{SubstepSchedule, SubstepSet};
@@ -130,10 +131,10 @@ struct NarrowPhaseScratch {
 
 impl Plugin for NarrowPhasePlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<Contacts>()
-            .init_resource::<NarrowPhaseScratch>()
-            .init_resource::<OverlappingLeaves>()
-            .init_resource::<HierarchyVisits>()
+        app.init_required::<Contacts>()
+            .init_required::<NarrowPhaseScratch>()
+            .init_required::<OverlappingLeaves>()
+            .init_required::<HierarchyVisits>()
             .add_systems(
                 SubstepSchedule,
                 compute_contacts

@@ -11,6 +11,7 @@ use crate::dynamics::response::{
 };
 use crate::geometry::ContactManifold;
 use crate::plugins::narrow_phase::{ContactPair, Contacts};
+use crate::plugins::required_resources::RequireResource;
 use crate::plugins::sleep::{ContactSide, Waker, wakes};
 use crate::plugins::soft_step::legacy_solver;
 use crate::schedule::{SubstepSchedule, SubstepSet};
@@ -30,7 +31,7 @@ pub struct ResponsePlugin;
 impl Plugin for ResponsePlugin {
     fn build(&self, app: &mut App) {
         add_collision_messages(app);
-        app.init_resource::<ResponseBuffers>().add_systems(
+        app.init_required::<ResponseBuffers>().add_systems(
             SubstepSchedule,
             (
                 resolve_contacts.run_if(legacy_solver),

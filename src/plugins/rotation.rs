@@ -20,6 +20,7 @@ use crate::geometry::{Isometry, MassProperties};
 use crate::plugins::core::PrepareIndex;
 use crate::plugins::forces::GatheredForces;
 use crate::plugins::integration::IntegrateBodies;
+use crate::plugins::required_resources::RequireResource;
 use crate::plugins::soft_step::legacy_solver;
 use crate::schedule::{PhysicsSchedule, SubstepSchedule, SubstepSet};
 use crate::settings::{Integration, PhysicsTimestep, RotationSettings};
@@ -36,8 +37,8 @@ pub struct RotationPlugin;
 
 impl Plugin for RotationPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<RotationSettings>()
-            .init_resource::<RotationBuffers>()
+        app.init_required::<RotationSettings>()
+            .init_required::<RotationBuffers>()
             .add_systems(
                 PhysicsSchedule,
                 compute_inertia

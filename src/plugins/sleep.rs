@@ -25,6 +25,7 @@ use crate::components::*;
 use crate::dynamics::islands::{IslandBuilder, Stillness, islands_to_sleep};
 use crate::plugins::core::PrepareWake;
 use crate::plugins::narrow_phase::Contacts;
+use crate::plugins::required_resources::RequireResource;
 use crate::schedule::{PhysicsSchedule, PhysicsSet};
 use crate::settings::{Gravity, PhysicsTimestep, SleepSettings};
 use crate::stats::PhysicsStats;
@@ -41,8 +42,8 @@ pub struct SleepPlugin;
 
 impl Plugin for SleepPlugin {
     fn build(&self, app: &mut App) {
-        app.init_resource::<SleepSettings>()
-            .init_resource::<SleepingIslands>()
+        app.init_required::<SleepSettings>()
+            .init_required::<SleepingIslands>()
             .add_systems(
                 PhysicsSchedule,
                 (wake_on_game_changes, wake_islands)

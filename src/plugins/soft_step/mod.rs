@@ -43,6 +43,7 @@ use crate::dynamics::solver::Solver;
 use crate::dynamics::solver::{BodyInput, ContactInput, SoftStepSettings, SolverBodies};
 use crate::plugins::forces::GatheredForces;
 use crate::plugins::narrow_phase::Contacts;
+use crate::plugins::required_resources::RequireResource;
 use crate::plugins::sleep::{ContactSide, Waker, wakes};
 use crate::schedule::{SubstepSchedule, SubstepSet};
 use crate::settings::{ContactSettings, PhysicsTimestep, RotationSettings, SleepSettings};
@@ -68,18 +69,17 @@ impl Plugin for SoftStepPlugin {
             log::warn!("urto: SoftStepPlugin settings refused ({e}); using the defaults");
             SoftStepSettings::default()
         });
-        app.insert_resource(SoftStepSolver {
-            solver: Solver::new(settings),
-            ..Default::default()
-        })
-        .init_resource::<SpeculativeMargin>()
-        .add_systems(
-            SubstepSchedule,
-            solve_soft_step
-                .run_if(any_with_component::<Velocity>)
-                .in_set(SolveBodies)
-                .in_set(SubstepSet::Response),
-        );
+        // Its presence is the switch: removed by game code, it comes back (a warning says so)
+        // rather than the legacy stages taking over silently.
+        app.insert_required(move || SoftStepSolver::new(settings))
+            .init_required::<SpeculativeMargin>()
+            .add_systems(
+                SubstepSchedule,
+                solve_soft_step
+                    .run_if(any_with_component::<Velocity>)
+                    .in_set(SolveBodies)
+                    .in_set(SubstepSet::Response),
+            );
     }
 }
 
