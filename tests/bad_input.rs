@@ -3,6 +3,7 @@
 mod common;
 
 use glam::Vec3;
+use urto::geometry::Shape;
 use urto::prelude::*;
 
 fn quarantined(app: &bevy_app::App, e: bevy_ecs::entity::Entity) -> bool {
@@ -290,4 +291,102 @@ fn removing_a_required_resource_between_steps_keeps_balls_resting_within_2cm() {
     for (i, z) in heights.into_iter().enumerate() {
         assert!((z - 0.5).abs() < 0.02, "resource {i}: height {z}");
     }
+}
+
+/// A ball, a neighbour touching it and a ground; returns `(app, ball, neighbour)`.
+fn pair_on_ground() -> (
+    bevy_app::App,
+    bevy_ecs::entity::Entity,
+    bevy_ecs::entity::Entity,
+) {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    app.world_mut()
+        .spawn((Collider::half_space(Vec3::Z), Static));
+    let mut ball = |x: f32| {
+        app.world_mut()
+            .spawn((
+                Collider::sphere(0.5),
+                Position::new(x, 0.0, 0.5),
+                Velocity::default(),
+            ))
+            .id()
+    };
+    let (a, b) = (ball(0.0), ball(0.9));
+    (app, a, b)
+}
+
+/// Sizes are kept in a band: a sphere of radius `f32::MAX` (which turned its neighbour NaN) is
+/// refused with a reason naming the bound, and the neighbour stays finite and on the ground.
+#[test]
+fn a_sphere_above_1000_km_is_quarantined_and_its_neighbour_stays_within_1cm_of_rest() {
+    for radius in [f32::MAX, 2.0e6] {
+        let (mut app, a, b) = pair_on_ground();
+        app.world_mut()
+            .entity_mut(a)
+            .insert(Collider::sphere(radius));
+        urto::step(app.world_mut(), 60).unwrap();
+        let why = &app.world().get::<Quarantined>(a).expect("refused").reason;
+        assert!(why.contains("largest supported"), "{why}");
+        let p = app.world().get::<Position>(b).unwrap().0;
+        assert!(p.is_finite() && (p.z - 0.5).abs() < 0.01, "{p}");
+    }
+    assert!(Shape::sphere(1.0e6).validate().is_ok());
+}
+
+/// A finite normal too long to square (1e20) still normalises, and the ground holds.
+#[test]
+fn a_half_space_normal_of_length_1e20_normalises_and_holds_a_ball_within_1cm() {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    app.world_mut()
+        .spawn((Collider::half_space(Vec3::new(0.0, 0.0, 1.0e20)), Static));
+    let ball = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(0.0, 0.0, 1.0),
+            Velocity::default(),
+        ))
+        .id();
+    urto::step(app.world_mut(), 120).unwrap();
+    let z = app.world().get::<Position>(ball).unwrap().0.z;
+    assert!((z - 0.5).abs() < 0.01, "z = {z}");
+    assert!(
+        Shape::half_space(Vec3::new(1e-30, 0.0, 0.0))
+            .validate()
+            .is_ok()
+    );
+    assert!(Shape::half_space(Vec3::ZERO).validate().is_err());
+}
+
+/// A spring of 1e12 N/m on a 1 kg ball (`k·w·h²` ≈ 2e7 at the solver's 1/240 s substep, where
+/// an explicit step diverges above 4) flung the ball it touched to 1e21 m/s. The solver lowers
+/// it to `k·w·h² = 1/4` (14,400 N/m) and its damping to `c·w·h = 1/2`: the ball then moves as
+/// that spring allows (at most `ω·|x₀|` = 120 rad/s × 2.5 m = 300 m/s), ends within 25 cm of the
+/// anchor, and the neighbour stays finite; a counter says one spring was lowered.
+#[test]
+fn a_1e12_spring_is_lowered_to_the_stable_bound_keeps_below_its_300_m_per_s_energy_bound() {
+    let (mut app, a, b) = pair_on_ground();
+    let anchor = Vec3::new(0.0, 0.0, 3.0);
+    app.world_mut().entity_mut(a).insert(Spring {
+        target: SpringTarget::Point(anchor),
+        rest_length: 0.0,
+        stiffness: 1.0e12,
+        damping: 1.0e12,
+    });
+    let mut fastest = 0.0f32;
+    for _ in 0..120 {
+        urto::step(app.world_mut(), 1).unwrap();
+        fastest = fastest.max(app.world().get::<Velocity>(a).unwrap().0.length());
+    }
+    assert!(fastest < 300.0, "fastest {fastest} m/s");
+    let p = app.world().get::<Position>(a).unwrap().0;
+    assert!(p.distance(anchor) < 0.25, "{p}");
+    assert!(app.world().get::<Position>(b).unwrap().0.is_finite());
+    let clamped = app
+        .world()
+        .resource::<PhysicsStats>()
+        .counter("soft_step/springs_clamped");
+    assert_eq!(clamped, Some(1.0));
 }

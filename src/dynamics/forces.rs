@@ -33,6 +33,37 @@ pub struct Spring {
     pub damping: f32,
 }
 
+/// Largest `k·w·h²` (stiffness × the ends' summed inverse masses × step²) a spring may have:
+/// an explicit spring step is stable while `ω·h < 2`, i.e. `k·w·h² < 4`; a sixteenth of that
+/// keeps `ω·h = 1/2`, where the step still follows the oscillation (at `ω·h = 1` with the
+/// damping bound below, a ball on such a spring next to contacts locked into a cycle).
+pub const MAX_SPRING_STIFFNESS_RATIO: f32 = 0.25;
+
+/// Largest `c·w·h` (damping × summed inverse masses × step) a spring may have: an explicit
+/// dashpot overshoots and then diverges once `c·w·h > 2`; a quarter of that damps without
+/// reversing the relative velocity.
+pub const MAX_SPRING_DAMPING_RATIO: f32 = 0.5;
+
+impl Spring {
+    /// This spring with its stiffness and damping lowered into the range an explicit step `h`
+    /// can follow, given the summed inverse masses `w` of its ends (see
+    /// [`MAX_SPRING_STIFFNESS_RATIO`], [`MAX_SPRING_DAMPING_RATIO`]); `None` if it already was
+    /// in range. Stiffer is not more rigid past that bound: it only diverges (a spring of
+    /// 1e12 N/m at 60 Hz flings what it holds to 1e20 m/s).
+    pub fn clamped_to_stability(&self, w: f32, h: f32) -> Option<Spring> {
+        if !(w > 0.0 && h > 0.0) {
+            return None;
+        }
+        let k_max = MAX_SPRING_STIFFNESS_RATIO / (w * h * h);
+        let c_max = MAX_SPRING_DAMPING_RATIO / (w * h);
+        (self.stiffness > k_max || self.damping > c_max).then(|| Spring {
+            stiffness: self.stiffness.min(k_max),
+            damping: self.damping.min(c_max),
+            ..*self
+        })
+    }
+}
+
 /// All forces acting during one step, over bodies indexed `0..n`.
 #[derive(Clone, Debug, Default)]
 pub struct ForceModel {

@@ -46,9 +46,16 @@ pub enum Shape {
     TriMesh(MeshCollider),
 }
 
+/// Largest radius or half extent of a shape (m): 1,000 km. Sizes are kept in a band around 1 so
+/// that squared distances, volumes and inertias stay finite in f32 (a sphere of radius
+/// `f32::MAX` turned the body it touched NaN); a larger ground is a half-space.
+pub const MAX_SHAPE_EXTENT: f32 = 1.0e6;
+
 /// Why a shape cannot be simulated.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ShapeError {
+    /// A radius or half extent above [`MAX_SHAPE_EXTENT`].
+    TooLarge(f32),
     /// A radius that is negative, NaN or infinite.
     BadRadius(f32),
     /// Half extents with a negative, NaN or infinite component.
@@ -65,6 +72,11 @@ impl fmt::Display for ShapeError {
                 write!(f, "box half extents must be finite and >= 0, got {h}")
             }
             Self::BadNormal(n) => write!(f, "plane normal must be finite and non-zero, got {n}"),
+            Self::TooLarge(x) => write!(
+                f,
+                "shape size {x} m is above the largest supported, {MAX_SHAPE_EXTENT} m (use a \
+                 half-space for a ground)"
+            ),
         }
     }
 }
@@ -82,11 +94,16 @@ impl Shape {
         Self::Cuboid(Cuboid { half_extents })
     }
 
-    /// The half-space below the plane of outward `normal` (normalised here; a zero normal is
-    /// kept as is and refused by [`Shape::validate`]).
+    /// The half-space below the plane of outward `normal` (normalised here, after scaling by
+    /// its largest component so that huge or tiny finite normals normalise too; a zero or
+    /// non-finite normal is kept as is and refused by [`Shape::validate`]).
     pub fn half_space(normal: Vec3) -> Self {
+        let scale = normal.abs().max_element();
+        let unit = (scale > 0.0 && scale.is_finite())
+            .then(|| (normal / scale).try_normalize())
+            .flatten();
         Self::HalfSpace(HalfSpace {
-            normal: normal.try_normalize().unwrap_or(normal),
+            normal: unit.unwrap_or(normal),
         })
     }
 
@@ -102,8 +119,14 @@ impl Shape {
             {
                 Err(ShapeError::BadHalfExtents(c.half_extents))
             }
-            Self::HalfSpace(h) if !(h.normal.is_finite() && h.normal.length_squared() > 0.5) => {
+            Self::HalfSpace(h)
+                if !(h.normal.is_finite() && (h.normal.length_squared() - 1.0).abs() < 1e-3) =>
+            {
                 Err(ShapeError::BadNormal(h.normal))
+            }
+            Self::Sphere(s) if s.radius > MAX_SHAPE_EXTENT => Err(ShapeError::TooLarge(s.radius)),
+            Self::Cuboid(c) if c.half_extents.max_element() > MAX_SHAPE_EXTENT => {
+                Err(ShapeError::TooLarge(c.half_extents.max_element()))
             }
             _ => Ok(()),
         }

@@ -146,6 +146,10 @@ pub struct Solver {
     cache: WarmStartCache,
     /// Centres and velocities of the substep, for the springs.
     spring_state: (Vec<Vec3>, Vec<Vec3>),
+    /// The step's springs, each within the stable range of the substep.
+    stable_springs: Vec<Spring>,
+    /// How many springs of the last step were lowered to that range.
+    clamped_springs: usize,
 }
 
 impl Solver {
@@ -183,10 +187,12 @@ impl Solver {
         }
         let inv_h = 1.0 / h;
         self.prepare(bodies, contacts, h);
+        self.stabilise_springs(bodies, springs, h);
+        let springs = std::mem::take(&mut self.stable_springs);
         for _ in 0..substeps {
             integrate_velocities(bodies, h);
             if !springs.is_empty() {
-                self.apply_springs(bodies, springs, h);
+                self.apply_springs(bodies, &springs, h);
             }
             for c in &mut self.constraints {
                 c.flip = !c.flip;
@@ -206,6 +212,40 @@ impl Solver {
         let orientations = &bodies.orientations;
         self.cache
             .store(&self.constraints, |a| orientations[a as usize], h);
+        self.stable_springs = springs;
+    }
+
+    /// How many springs of the last step were too stiff or too damped for the substep and were
+    /// lowered to the stable bound ([`Spring::clamped_to_stability`]).
+    pub fn clamped_springs(&self) -> usize {
+        self.clamped_springs
+    }
+
+    /// Copies `springs` into the step's list, each lowered into the range a substep `h` can
+    /// follow given its ends' inverse masses: past it a spring does not get stiffer, it
+    /// diverges, and flings what it holds into its neighbours.
+    fn stabilise_springs(&mut self, bodies: &SolverBodies, springs: &[Spring], h: f32) {
+        self.stable_springs.clear();
+        self.clamped_springs = 0;
+        let n = bodies.params.len();
+        let inverse_mass = |i: usize| (i < n).then(|| bodies.params[i].inverse_mass);
+        for spring in springs {
+            let other = match spring.other {
+                SpringEnd::Body(j) => inverse_mass(j),
+                SpringEnd::Anchor(_) => Some(0.0),
+            };
+            let w = inverse_mass(spring.body)
+                .zip(other)
+                .map_or(0.0, |(a, b)| a + b);
+            self.stable_springs
+                .push(match spring.clamped_to_stability(w, h) {
+                    Some(stable) => {
+                        self.clamped_springs += 1;
+                        stable
+                    }
+                    None => *spring,
+                });
+        }
     }
 
     /// Each spring's impulse for one substep, from the bodies' state now; an end past the

@@ -38,7 +38,9 @@ use contact_inputs::{Material, add_part_motion, gather_contacts, report_impulses
 pub(crate) use lookahead::{Lookahead, LookaheadParams};
 
 use crate::components::*;
-use crate::dynamics::forces::{Spring as CoreSpring, SpringEnd};
+use crate::dynamics::forces::{
+    MAX_SPRING_DAMPING_RATIO, MAX_SPRING_STIFFNESS_RATIO, Spring as CoreSpring, SpringEnd,
+};
 use crate::dynamics::solver::Solver;
 use crate::dynamics::solver::{BodyInput, ContactInput, SoftStepSettings, SolverBodies};
 use crate::plugins::forces::GatheredForces;
@@ -101,6 +103,7 @@ pub struct SoftStepSolver {
     waking: Vec<Entity>,
     keyed: Vec<(ContactInput, u32)>,
     sources: Vec<u32>,
+    warned_stiff_springs: bool,
 }
 
 impl SoftStepSolver {
@@ -193,6 +196,7 @@ fn solve_soft_step(
     }
     add_user_forces(&gathered, &s.entities, &mut s.bodies);
     gather_springs(&gathered, &s.entities, &s.bodies, &poses, &mut s.springs);
+
     gather_contacts(
         &contacts,
         &s.entities,
@@ -218,6 +222,17 @@ fn solve_soft_step(
         timestep.substep_dt(),
     );
     report_impulses(&s.solver, &s.sources, &mut contacts);
+    let clamped = s.solver.clamped_springs();
+    if clamped > 0 && !s.warned_stiff_springs {
+        s.warned_stiff_springs = true;
+        log::warn!(
+            "urto: {clamped} spring(s) too stiff or too damped for the solver's substep are \
+             lowered to k·w·h² = {MAX_SPRING_STIFFNESS_RATIO}, c·w·h = {MAX_SPRING_DAMPING_RATIO} \
+             (w: the ends' summed inverse masses, h: the substep); more substeps allow \
+             stiffer springs"
+        );
+    }
+    stats.set_counter("soft_step/springs_clamped", clamped as f64);
     for (slot, &e) in s.entities.iter().enumerate() {
         if let Ok(m) = movers.get_mut(e)
             && !held(m.10, e, &s.waking)
@@ -341,7 +356,8 @@ fn add_user_forces(gathered: &GatheredForces, entities: &[Entity], bodies: &mut 
 
 /// The step's springs between solver slots. An end that is no solver body is an anchor at its
 /// world position; an end with no finite position (quarantined, gone) drops the spring, so a
-/// bad body never reaches a good one through it.
+/// bad body never reaches a good one through it (the solver lowers springs too stiff for its
+/// substep: [`CoreSpring::clamped_to_stability`]).
 fn gather_springs(
     gathered: &GatheredForces,
     entities: &[Entity],
@@ -367,13 +383,14 @@ fn gather_springs(
         if matches!(other, SpringEnd::Anchor(p) if !p.is_finite()) {
             continue;
         }
-        out.push(CoreSpring {
+        let spring = CoreSpring {
             body,
             other,
             rest_length: s.rest_length,
             stiffness: s.stiffness,
             damping: s.damping,
-        });
+        };
+        out.push(spring);
     }
 }
 
