@@ -390,3 +390,66 @@ fn a_1e12_spring_is_lowered_to_the_stable_bound_keeps_below_its_300_m_per_s_ener
         .counter("soft_step/springs_clamped");
     assert_eq!(clamped, Some(1.0));
 }
+
+/// A compound whose root lost its `Position` was never collided and nothing said so: the root
+/// is quarantined within one step, with the reason.
+#[test]
+fn a_compound_root_without_a_position_is_quarantined_within_one_step() {
+    let mut app = common::app();
+    let root = app.world_mut().spawn(Velocity::default()).id();
+    app.world_mut().entity_mut(root).remove::<Position>();
+    app.world_mut().spawn((
+        Collider::sphere(0.5),
+        Position::default(),
+        bevy_ecs::prelude::ChildOf(root),
+    ));
+    urto::step(app.world_mut(), 1).unwrap();
+    let why = &app
+        .world()
+        .get::<Quarantined>(root)
+        .expect("refused")
+        .reason;
+    assert!(why.contains("no Position"), "{why}");
+}
+
+/// Every walk over a `ChildOf` chain is linear in its length: a 10,000-deep chain steps
+/// (validation, poses, volumes, inertia) with each node met a bounded number of times. On the
+/// first step every node is new, and each used to recompose its whole subtree (n²/2 = 5e7
+/// poses); the hierarchy counters say how many nodes were recomposed and refit: at most twice
+/// the chain, on the first step and after.
+#[test]
+fn a_10000_deep_chain_recomposes_and_refits_at_most_twice_its_nodes_per_step() {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    let mut parent = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(0.0, 0.0, 5.0),
+            Velocity::default(),
+        ))
+        .id();
+    let n = 10_000;
+    for _ in 0..n {
+        parent = app
+            .world_mut()
+            .spawn((
+                Collider::sphere(0.1),
+                Position::new(0.0, 0.0, 0.01),
+                bevy_ecs::prelude::ChildOf(parent),
+            ))
+            .id();
+    }
+    for step in 0..3 {
+        urto::step(app.world_mut(), 1).unwrap();
+        let stats = app.world().resource::<PhysicsStats>();
+        for name in ["hierarchy/poses", "hierarchy/refits"] {
+            let c = stats.counter(name).unwrap_or(0.0);
+            assert!(
+                c > 0.0 && c <= 2.0 * (n + 1) as f64,
+                "step {step}, {name}: {c}"
+            );
+        }
+    }
+    assert!(app.world().get::<Quarantined>(parent).is_none());
+}

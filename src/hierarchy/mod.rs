@@ -15,4 +15,4 @@ mod pairs;
 mod refit;
 
 pub use pairs::{BvTree, HierarchyStats, PairScratch, descend_pairs};
-pub use refit::refit_order;
+pub use refit::{refit_order, topmost_marked};

@@ -15,17 +15,17 @@
 use crate::bounding::Aabb;
 use crate::components::*;
 use crate::geometry::Isometry;
-use crate::hierarchy::refit_order;
+use crate::hierarchy::{refit_order, topmost_marked};
 use crate::plugins::broad_phase::IndexBodies;
 use crate::plugins::core::PrepareIndex;
 use crate::plugins::required_resources::RequireResource;
-use crate::plugins::validation::MAX_HIERARCHY_DEPTH;
 use crate::plugins::validation::quarantine;
 use crate::schedule::{BroadPhaseSystems, PhysicsSchedule, PhysicsSet, SubstepSchedule};
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
 use bevy_ecs::query::QueryFilter;
+use std::collections::HashMap;
 use std::time::Instant;
 
 /// Propagates world poses down hierarchies and refits bounding volumes up them.
@@ -70,7 +70,10 @@ impl Plugin for HierarchyPlugin {
 
 #[derive(Resource, Default)]
 struct HierarchyScratch {
-    dirty: Vec<(u32, Entity)>,
+    dirty: Vec<Entity>,
+    tops: Vec<Entity>,
+    covered: HashMap<Entity, bool>,
+    depths: HashMap<Entity, u32>,
     stack: Vec<(Entity, Isometry)>,
     order: Vec<(u32, Entity)>,
 }
@@ -117,12 +120,15 @@ fn propagate_poses<F: QueryFilter + 'static>(
     }
     let s = &mut *scratch;
     s.dirty.clear();
-    s.dirty
-        .extend(changed.iter().map(|e| (depth(e, &parents), e)));
+    s.dirty.extend(changed.iter());
     s.dirty.sort_unstable();
+    // Only the changed nodes without a changed ancestor: their subtrees hold all the others,
+    // each recomposed once (linear in the hierarchy, however deep).
+    let parent = |e: Entity| parents.get(e).ok().map(|p| p.parent());
+    topmost_marked(&s.dirty, parent, &mut s.covered, &mut s.tops);
     let mut nodes = queries.p1();
-    for i in 0..s.dirty.len() {
-        let (_, root) = s.dirty[i];
+    for i in 0..s.tops.len() {
+        let root = s.tops[i];
         let parent_pose = match parents.get(root) {
             Ok(p) => nodes.get(p.parent()).map_or(Isometry::IDENTITY, |n| n.3.0),
             Err(_) => Isometry::IDENTITY,
@@ -165,21 +171,6 @@ fn remember_part_poses(
 
 type PartMoved = (InHierarchy, Changed<GlobalPose>);
 
-/// Number of ancestors of `e`, at most [`MAX_HIERARCHY_DEPTH`] (a loop of parents, which
-/// validation quarantines, must not hang the step before it does).
-fn depth(e: Entity, parents: &Query<&ChildOf>) -> u32 {
-    let mut d = 0;
-    let mut up = e;
-    while let Ok(p) = parents.get(up) {
-        d += 1;
-        up = p.parent();
-        if d >= MAX_HIERARCHY_DEPTH {
-            break;
-        }
-    }
-    d
-}
-
 type RefitNode<'a> = (
     Option<&'a Collider>,
     &'a GlobalPose,
@@ -221,6 +212,7 @@ fn refit_bounding_volumes<F: QueryFilter + 'static>(
     refit_order(
         dirty,
         |e| parents.get(e).ok().map(|p| p.parent()),
+        &mut s.depths,
         &mut s.order,
     );
     let mut nodes = queries.p1();

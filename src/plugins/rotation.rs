@@ -66,6 +66,9 @@ struct RotationBuffers {
     centers: Vec<Vec3>,
     torques: EntityHashMap<Vec3>,
     dirty: Vec<Entity>,
+    /// The root of each part met this look (memo of [`root_of`]).
+    roots: EntityHashMap<Entity>,
+    path: Vec<Entity>,
     visited: EntityHashSet,
     stack: Vec<(Entity, Isometry)>,
     parts: Vec<(Isometry, MassProperties)>,
@@ -118,8 +121,10 @@ fn compute_inertia(
         // A chain of ChildOf is at most as long as there are parts (a cycle, which validation
         // reports, stops there).
         let longest_chain = parents.iter().len() + 1;
+        b.roots.clear();
         for part in &changed_parts {
-            b.dirty.push(root_of(part, &parents, longest_chain));
+            let root = root_of(part, &parents, longest_chain, &mut b.roots, &mut b.path);
+            b.dirty.push(root);
         }
     }
     if b.dirty.is_empty() {
@@ -144,14 +149,32 @@ fn compute_inertia(
 }
 
 /// The topmost ancestor of `e`, at most `longest_chain` steps up.
-fn root_of(mut e: Entity, parents: &Query<&ChildOf>, longest_chain: usize) -> Entity {
-    for _ in 0..longest_chain {
-        match parents.get(e) {
-            Ok(parent) => e = parent.parent(),
-            Err(_) => break,
+/// The topmost ancestor of `e`, at most `longest_chain` steps up. `roots` remembers the root of
+/// every node climbed through, and a climb stops at the first remembered node, so the parts of
+/// one deep chain cost linear time together, not quadratic.
+fn root_of(
+    e: Entity,
+    parents: &Query<&ChildOf>,
+    longest_chain: usize,
+    roots: &mut EntityHashMap<Entity>,
+    path: &mut Vec<Entity>,
+) -> Entity {
+    path.clear();
+    let mut up = e;
+    let root = loop {
+        if let Some(&r) = roots.get(&up) {
+            break r;
         }
+        path.push(up);
+        match parents.get(up) {
+            Ok(parent) if path.len() <= longest_chain => up = parent.parent(),
+            _ => break up,
+        }
+    };
+    for &node in path.iter() {
+        roots.insert(node, root);
     }
-    e
+    root
 }
 
 /// Every collider at or below `root`, placed in `root`'s frame, at unit density.

@@ -13,6 +13,7 @@ use crate::plugins::core::PrepareStart;
 use crate::schedule::PhysicsSchedule;
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
+use bevy_ecs::entity::EntityHashSet;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 
@@ -28,6 +29,7 @@ impl Plugin for ValidationPlugin {
                 quarantine_invalid_bodies,
                 quarantine_invalid_rotation,
                 quarantine_parent_cycles,
+                quarantine_unplaced_bodies,
             )
                 .in_set(PrepareStart),
         );
@@ -155,35 +157,73 @@ pub(crate) const MAX_HIERARCHY_DEPTH: u32 = 1 << 16;
 /// Quarantines every entity of a `ChildOf` loop (each is its own ancestor), checked for the
 /// entities whose parent changed: a loop has no root, so no pose or volume reaches it, and the
 /// walks up its chain would never end.
+///
+/// Every node met is settled once (it reaches a root, or a loop was found above it), and the
+/// climbs stop at settled nodes, so a step costs time linear in the nodes met however deep the
+/// chains (a 10,000-deep chain took seconds when each node climbed to its root).
 fn quarantine_parent_cycles(
     changed: Query<Entity, (Changed<ChildOf>, Without<Quarantined>)>,
     parents: Query<&ChildOf>,
+    mut settled: Local<EntityHashSet>,
+    mut path: Local<EntityHashSet>,
     mut commands: Commands,
 ) {
+    settled.clear();
     for e in &changed {
+        path.clear();
         let mut up = e;
-        for _ in 0..MAX_HIERARCHY_DEPTH {
-            let Ok(p) = parents.get(up) else {
+        loop {
+            if settled.contains(&up) || path.len() as u32 >= MAX_HIERARCHY_DEPTH {
                 break;
-            };
-            up = p.parent();
-            if up == e {
+            }
+            if path.contains(&up) {
                 // Quarantine the whole loop, not only the link that closed it.
-                let mut member = e;
+                let mut member = up;
                 loop {
                     quarantine(
                         &mut commands,
                         member,
                         "its ChildOf chain loops back to it".into(),
                     );
-                    member = parents.get(member).map_or(e, |p| p.parent());
-                    if member == e {
+                    member = parents.get(member).map_or(up, |p| p.parent());
+                    if member == up {
                         break;
                     }
                 }
                 break;
             }
+            path.insert(up);
+            match parents.get(up) {
+                Ok(p) => up = p.parent(),
+                Err(_) => break,
+            }
         }
+        settled.extend(path.iter().copied());
+    }
+}
+
+/// Bodies nothing can place: a moving body or a compound's root without a [`Position`] (game
+/// code removed it; `Velocity` and `Static` bring one) is skipped by every stage, so it is
+/// quarantined and the log says why, instead of silently never colliding. The filters are
+/// archetype-level: a world without such bodies pays nothing per body.
+#[allow(clippy::type_complexity)]
+fn quarantine_unplaced_bodies(
+    unplaced: Query<
+        Entity,
+        (
+            Or<(With<Velocity>, With<Children>, With<Collider>)>,
+            Without<Position>,
+            Without<Quarantined>,
+        ),
+    >,
+    mut commands: Commands,
+) {
+    for e in &unplaced {
+        quarantine(
+            &mut commands,
+            e,
+            "it has no Position (a body, a collider or a compound's root needs one)".into(),
+        );
     }
 }
 
