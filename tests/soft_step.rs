@@ -307,6 +307,39 @@ fn with_the_soft_step_a_ball_falling_at_40_m_s_penetrates_the_ground_less_than_1
     assert!(lowest > -0.01, "sank {} m into the ground", -lowest);
 }
 
+/// A ball hanging from a spring rests `m·g/k` below its anchor, within 1 %, however strong
+/// its dashpot: with the damping at the solver's bound (`c·w·h = 1/2`), evaluating the spring
+/// after gravity's kick made the dashpot carry half the weight and the sag came out halved.
+#[test]
+fn with_the_soft_step_a_hanging_ball_sags_m_g_over_k_within_1_percent_whatever_its_damping() {
+    for damping in [20.0, 1.0e6] {
+        let mut app = App::new();
+        app.add_plugins(UrtoPlugins::default());
+        app.insert_resource(Gravity::EARTH_Z_UP);
+        let (k, anchor) = (5000.0f32, Vec3::new(0.0, 0.0, 3.0));
+        let ball = app
+            .world_mut()
+            .spawn((
+                Position(anchor),
+                Velocity::default(),
+                Spring {
+                    target: SpringTarget::Point(anchor),
+                    rest_length: 0.0,
+                    stiffness: k,
+                    damping,
+                },
+            ))
+            .id();
+        urto::step(app.world_mut(), 600).unwrap();
+        let sag = anchor.z - get::<Position>(&app, ball).0.z;
+        let expected = 9.81 / k;
+        assert!(
+            (sag / expected - 1.0).abs() < 0.01,
+            "damping {damping}: sag {sag} m, expected {expected} m"
+        );
+    }
+}
+
 #[test]
 fn with_the_soft_step_a_spring_oscillates_with_the_analytic_period_within_1_percent() {
     let mut app = App::new();

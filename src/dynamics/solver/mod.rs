@@ -8,8 +8,9 @@
 //! 1. **prepare** — contact rows with lever arms ([`ContactConstraint::prepare`]), seeded with
 //!    last step's impulses ([`WarmStartCache`]);
 //! 2. `substeps` times:
-//!    1. **integrate velocities** — gravity, forces, torques, springs (evaluated at the
-//!       substep's state, so a stiff spring is as stable as the substep is short) and damping;
+//!    1. **integrate velocities** — springs, then gravity, forces, torques and damping, all
+//!       evaluated at the substep's starting state (so a stiff spring is as stable as the
+//!       substep is short, and a dashpot never resists gravity's kick);
 //!    2. **warm start** — apply the accumulated impulses (each contact's points are swept in
 //!       the opposite order from the last substep, so Gauss–Seidel favours none of them);
 //!    3. **solve** — one biased pass: penetration pushed out softly, speculative points closed;
@@ -190,10 +191,13 @@ impl Solver {
         self.stabilise_springs(bodies, springs, h);
         let springs = std::mem::take(&mut self.stable_springs);
         for _ in 0..substeps {
-            integrate_velocities(bodies, h);
+            // Springs read the substep's starting state, as gravity and the forces do: read
+            // after gravity's kick, a dashpot resisted it and a hanging body sagged (1 − c·h)
+            // times its g/k (half of it at the damping bound).
             if !springs.is_empty() {
                 self.apply_springs(bodies, &springs, h);
             }
+            integrate_velocities(bodies, h);
             for c in &mut self.constraints {
                 c.flip = !c.flip;
             }
