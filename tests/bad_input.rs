@@ -453,3 +453,43 @@ fn a_10000_deep_chain_recomposes_and_refits_at_most_twice_its_nodes_per_step() {
     }
     assert!(app.world().get::<Quarantined>(parent).is_none());
 }
+
+/// Settings are public fields, so each is checked when it changes: a NaN sleep speed (every
+/// comparison false: every body "still", asleep in mid-air), a negative default friction and a
+/// NaN CCD ratio are refused with the defaults back, and a dropped ball falls 2 m within 1 s.
+#[test]
+fn unusable_settings_are_refused_with_the_defaults_and_a_dropped_ball_falls_2m_within_1s() {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    let ball = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(0.0, 0.0, 10.0),
+            Velocity::default(),
+        ))
+        .id();
+    urto::step(app.world_mut(), 1).unwrap();
+    app.world_mut().resource_mut::<SleepSettings>().speed = f32::NAN;
+    app.world_mut()
+        .resource_mut::<ContactSettings>()
+        .default_friction = -1.0;
+    app.world_mut()
+        .resource_mut::<urto::plugins::CcdSettings>()
+        .auto_speed_ratio = Some(f32::NAN);
+    urto::step(app.world_mut(), 60).unwrap();
+    assert_eq!(
+        *app.world().resource::<SleepSettings>(),
+        SleepSettings::default()
+    );
+    assert_eq!(
+        *app.world().resource::<ContactSettings>(),
+        ContactSettings::default()
+    );
+    assert_eq!(
+        *app.world().resource::<urto::plugins::CcdSettings>(),
+        urto::plugins::CcdSettings::default()
+    );
+    let z = app.world().get::<Position>(ball).unwrap().0.z;
+    assert!(z < 8.0, "z = {z}");
+}

@@ -1,10 +1,13 @@
 //! The core plugin: schedules, settings, statistics, and the two ways a step is driven —
 //! Bevy's fixed-timestep loop in an `App`, or [`step`] on a standalone world.
 
+use crate::plugins::ccd::CcdSettings;
 use crate::plugins::required_resources::{RequireResource, restore_required_resources};
+use crate::plugins::settings_check::check_settings;
 use crate::schedule::{
     BroadPhaseSystems, PhysicsSchedule, PhysicsSet, SubstepSchedule, SubstepSet,
 };
+use crate::settings::SleepSettings;
 use crate::settings::{ContactSettings, Integration, PhysicsTimestep};
 use crate::stats::PhysicsStats;
 use bevy_app::prelude::*;
@@ -50,7 +53,13 @@ impl Plugin for PhysicsCorePlugin {
                 .chain(),
         );
         physics.add_systems((
-            (restore_required_resources, begin_step)
+            (
+                restore_required_resources,
+                begin_step,
+                check_settings::<ContactSettings>,
+                check_settings::<SleepSettings>,
+                check_settings::<CcdSettings>,
+            )
                 .chain()
                 .in_set(PhysicsSet::Prepare)
                 .before(PrepareWake),

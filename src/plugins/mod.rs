@@ -24,6 +24,7 @@ mod proxy_table;
 mod required_resources;
 pub mod response;
 pub mod rotation;
+mod settings_check;
 pub mod sleep;
 pub mod soft_step;
 pub mod transform_sync;
