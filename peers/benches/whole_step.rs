@@ -334,7 +334,12 @@ fn urto_state(app: &App, balls: &[bevy_ecs::entity::Entity]) -> (Vec<Ball>, usiz
         .iter()
         .filter(|&&e| world.get::<Sleeping>(e).is_some())
         .count();
-    (state, world.resource::<Contacts>().pairs.len(), sleeping)
+    // Pairs touching, asleep ones included (sleeping pairs are not in `Contacts`: untested).
+    let touching = world
+        .resource::<PhysicsStats>()
+        .counter("collisions/touching_pairs")
+        .map_or(world.resource::<Contacts>().pairs.len(), |n| n as usize);
+    (state, touching, sleeping)
 }
 
 /// Steps `n` times and returns urto's own per-stage times averaged over those steps (µs), for

@@ -12,6 +12,7 @@ use crate::components::*;
 use crate::plugins::narrow_phase::Contacts;
 use crate::plugins::required_resources::RequireResource;
 use crate::plugins::sleep::{Waker, dormant};
+use crate::stats::PhysicsStats;
 use bevy_app::prelude::*;
 use bevy_ecs::message::Messages;
 use bevy_ecs::prelude::*;
@@ -81,6 +82,7 @@ pub(crate) fn report_collisions(
     mut started: MessageWriter<CollisionStarted>,
     mut ended: MessageWriter<CollisionEnded>,
     mut waker: Waker,
+    mut stats: ResMut<PhysicsStats>,
 ) {
     fresh.clear();
     fresh.extend(
@@ -154,6 +156,9 @@ pub(crate) fn report_collisions(
         touching.dormant.retain(|p| p.0 != Entity::PLACEHOLDER);
     }
     touching.active.clone_from(&fresh);
+    // Every pair touching now, tested this substep or at rest asleep.
+    let all = touching.active.len() + touching.dormant.len();
+    stats.set_counter("collisions/touching_pairs", all as f64);
 }
 
 /// Advances the collision message buffers once per standalone step (an `App` does this itself
