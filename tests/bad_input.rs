@@ -16,22 +16,9 @@ fn nan_and_infinite_state_is_quarantined_and_neighbours_stay_finite() {
     app.insert_resource(Gravity::EARTH_Z_UP);
     app.world_mut()
         .spawn((Collider::half_space(Vec3::Z), Static));
-    let good = app
-        .world_mut()
-        .spawn((
-            Collider::sphere(0.5),
-            Position::new(0.0, 0.0, 0.6),
-            Velocity::default(),
-        ))
-        .id();
+    let good = common::ball(&mut app, Vec3::new(0.0, 0.0, 0.6));
     let bad = [
-        app.world_mut()
-            .spawn((
-                Collider::sphere(0.5),
-                Position::new(f32::NAN, 0.0, 0.6),
-                Velocity::default(),
-            ))
-            .id(),
+        common::ball(&mut app, Vec3::new(f32::NAN, 0.0, 0.6)),
         app.world_mut()
             .spawn((
                 Collider::sphere(0.5),
@@ -179,14 +166,7 @@ fn u32_max_solver_iterations_end_after_at_most_256_sweeps() {
     });
     app.world_mut()
         .spawn((Collider::half_space(Vec3::Z), Static));
-    let ball = app
-        .world_mut()
-        .spawn((
-            Collider::sphere(0.5),
-            Position::new(0.0, 0.0, 0.5),
-            Velocity::default(),
-        ))
-        .id();
+    let ball = common::ball(&mut app, Vec3::new(0.0, 0.0, 0.5));
     urto::step(app.world_mut(), 10).unwrap();
     let z = app.world().get::<Position>(ball).unwrap().0.z;
     assert!((z - 0.5).abs() < 0.01, "ball at {z}");
@@ -213,14 +193,7 @@ fn a_childof_loop_is_quarantined_whole_and_the_step_ends() {
         .spawn((Collider::sphere(0.5), Position::default(), ChildOf(a)))
         .id();
     app.world_mut().entity_mut(a).insert(ChildOf(b));
-    let ball = app
-        .world_mut()
-        .spawn((
-            Collider::sphere(0.5),
-            Position::new(5.0, 0.0, 10.0),
-            Velocity::default(),
-        ))
-        .id();
+    let ball = common::ball(&mut app, Vec3::new(5.0, 0.0, 10.0));
     urto::step(app.world_mut(), 60).unwrap();
     assert!(quarantined(&app, a) && quarantined(&app, b));
     let z = app.world().get::<Position>(ball).unwrap().0.z;
@@ -243,22 +216,8 @@ fn height_after_removing<R: bevy_ecs::resource::Resource>() -> f32 {
         Position::new(20.0, 0.0, 0.0),
         Static,
     ));
-    let ball = app
-        .world_mut()
-        .spawn((
-            Collider::sphere(0.5),
-            Position::new(0.0, 0.0, 2.0),
-            Velocity::default(),
-        ))
-        .id();
-    let on_slab = app
-        .world_mut()
-        .spawn((
-            Collider::sphere(0.5),
-            Position::new(20.0, 0.0, 2.0),
-            Velocity::default(),
-        ))
-        .id();
+    let ball = common::ball(&mut app, Vec3::new(0.0, 0.0, 2.0));
+    let on_slab = common::ball(&mut app, Vec3::new(20.0, 0.0, 2.0));
     urto::step(app.world_mut(), 10).unwrap();
     assert!(app.world_mut().remove_resource::<R>().is_some());
     urto::step(app.world_mut(), 110).unwrap();
@@ -303,15 +262,7 @@ fn pair_on_ground() -> (
     app.insert_resource(Gravity::EARTH_Z_UP);
     app.world_mut()
         .spawn((Collider::half_space(Vec3::Z), Static));
-    let mut ball = |x: f32| {
-        app.world_mut()
-            .spawn((
-                Collider::sphere(0.5),
-                Position::new(x, 0.0, 0.5),
-                Velocity::default(),
-            ))
-            .id()
-    };
+    let mut ball = |x: f32| common::ball(&mut app, Vec3::new(x, 0.0, 0.5));
     let (a, b) = (ball(0.0), ball(0.9));
     (app, a, b)
 }
@@ -341,14 +292,7 @@ fn a_half_space_normal_of_length_1e20_normalises_and_holds_a_ball_within_1cm() {
     app.insert_resource(Gravity::EARTH_Z_UP);
     app.world_mut()
         .spawn((Collider::half_space(Vec3::new(0.0, 0.0, 1.0e20)), Static));
-    let ball = app
-        .world_mut()
-        .spawn((
-            Collider::sphere(0.5),
-            Position::new(0.0, 0.0, 1.0),
-            Velocity::default(),
-        ))
-        .id();
+    let ball = common::ball(&mut app, Vec3::new(0.0, 0.0, 1.0));
     urto::step(app.world_mut(), 120).unwrap();
     let z = app.world().get::<Position>(ball).unwrap().0.z;
     assert!((z - 0.5).abs() < 0.01, "z = {z}");
@@ -421,14 +365,7 @@ fn a_compound_root_without_a_position_is_quarantined_within_one_step() {
 fn a_10000_deep_chain_recomposes_and_refits_at_most_twice_its_nodes_per_step() {
     let mut app = common::app();
     app.insert_resource(Gravity::EARTH_Z_UP);
-    let mut parent = app
-        .world_mut()
-        .spawn((
-            Collider::sphere(0.5),
-            Position::new(0.0, 0.0, 5.0),
-            Velocity::default(),
-        ))
-        .id();
+    let mut parent = common::ball(&mut app, Vec3::new(0.0, 0.0, 5.0));
     let n = 10_000;
     for _ in 0..n {
         parent = app
@@ -461,14 +398,7 @@ fn a_10000_deep_chain_recomposes_and_refits_at_most_twice_its_nodes_per_step() {
 fn unusable_settings_are_refused_with_the_defaults_and_a_dropped_ball_falls_2m_within_1s() {
     let mut app = common::app();
     app.insert_resource(Gravity::EARTH_Z_UP);
-    let ball = app
-        .world_mut()
-        .spawn((
-            Collider::sphere(0.5),
-            Position::new(0.0, 0.0, 10.0),
-            Velocity::default(),
-        ))
-        .id();
+    let ball = common::ball(&mut app, Vec3::new(0.0, 0.0, 10.0));
     urto::step(app.world_mut(), 1).unwrap();
     app.world_mut().resource_mut::<SleepSettings>().speed = f32::NAN;
     app.world_mut()

@@ -21,12 +21,6 @@ fn sleepy_app() -> App {
     app
 }
 
-fn ball(app: &mut App, at: Vec3) -> Entity {
-    app.world_mut()
-        .spawn((Collider::sphere(0.5), Position(at), Velocity::default()))
-        .id()
-}
-
 fn asleep(app: &App, e: Entity) -> bool {
     app.world().get::<Sleeping>(e).is_some()
 }
@@ -48,7 +42,7 @@ fn counter(app: &App, name: &str) -> f64 {
 fn resting_balls_fall_asleep_and_cost_nothing() {
     let mut app = sleepy_app();
     let balls: Vec<Entity> = (0..10)
-        .map(|i| ball(&mut app, Vec3::new(i as f32 * 2.0, 0.0, 0.6)))
+        .map(|i| common::ball(&mut app, Vec3::new(i as f32 * 2.0, 0.0, 0.6)))
         .collect();
     urto::step(app.world_mut(), 120).unwrap();
     assert!(balls.iter().all(|b| asleep(&app, *b)));
@@ -81,7 +75,7 @@ fn sleeping_is_on_by_default_and_off_when_disabled() {
         });
     app.world_mut()
         .spawn((Collider::half_space(Vec3::Z), Static));
-    let b = ball(&mut app, Vec3::new(0.0, 0.0, 0.6));
+    let b = common::ball(&mut app, Vec3::new(0.0, 0.0, 0.6));
     urto::step(app.world_mut(), 120).unwrap();
     assert!(!asleep(&app, b));
     assert_eq!(counter(&app, "integrate/bodies"), 1.0);
@@ -157,11 +151,11 @@ fn despawning_the_bottom_of_a_sleeping_stack_wakes_the_whole_island() {
 #[test]
 fn a_falling_ball_wakes_the_one_it_hits() {
     let mut app = sleepy_app();
-    let lower = ball(&mut app, Vec3::new(0.0, 0.0, 0.5));
+    let lower = common::ball(&mut app, Vec3::new(0.0, 0.0, 0.5));
     urto::step(app.world_mut(), 60).unwrap();
     assert!(asleep(&app, lower));
     // Slightly off-centre, so the lower ball is pushed sideways.
-    ball(&mut app, Vec3::new(0.3, 0.0, 3.0));
+    common::ball(&mut app, Vec3::new(0.3, 0.0, 3.0));
     let mut woke = false;
     for _ in 0..60 {
         urto::step(app.world_mut(), 1).unwrap();
@@ -177,7 +171,7 @@ fn a_falling_ball_wakes_the_one_it_hits() {
 fn game_code_wakes_a_sleeping_body() {
     for poke in 0..3 {
         let mut app = sleepy_app();
-        let b = ball(&mut app, Vec3::new(0.0, 0.0, 0.5));
+        let b = common::ball(&mut app, Vec3::new(0.0, 0.0, 0.5));
         urto::step(app.world_mut(), 60).unwrap();
         assert!(asleep(&app, b));
         let mut e = app.world_mut().entity_mut(b);
@@ -237,7 +231,7 @@ fn a_sleeping_pile_gets_zero_pairs_zero_solver_bodies_and_zero_sleep_candidates(
     let mut app = sleepy_app();
     let mut bodies: Vec<Entity> = (0..12)
         .map(|i| {
-            ball(
+            common::ball(
                 &mut app,
                 Vec3::new((i % 4) as f32 * 1.001, (i / 4) as f32 * 1.001, 0.5),
             )
@@ -268,6 +262,17 @@ fn a_sleeping_pile_gets_zero_pairs_zero_solver_bodies_and_zero_sleep_candidates(
     assert_eq!(before, after);
 }
 
+/// Three boxes stacked on the ground, stepped until they sleep (checked).
+fn sleeping_stack() -> (App, Vec<Entity>) {
+    let mut app = sleepy_app();
+    let stack: Vec<Entity> = (0..3)
+        .map(|i| crate_box(&mut app, 0.5 + i as f32))
+        .collect();
+    urto::step(app.world_mut(), 240).unwrap();
+    assert!(stack.iter().all(|&b| asleep(&app, b)));
+    (app, stack)
+}
+
 fn position(app: &App, e: Entity) -> Vec3 {
     app.world().get::<Position>(e).unwrap().0
 }
@@ -276,12 +281,7 @@ fn position(app: &App, e: Entity) -> Vec3 {
 /// NaN mass is quarantined within one step, and its sleeping neighbours stay finite.
 #[test]
 fn a_nan_mass_written_to_a_sleeping_body_is_quarantined_within_one_step() {
-    let mut app = sleepy_app();
-    let stack: Vec<Entity> = (0..3)
-        .map(|i| crate_box(&mut app, 0.5 + i as f32))
-        .collect();
-    urto::step(app.world_mut(), 240).unwrap();
-    assert!(stack.iter().all(|&b| asleep(&app, b)));
+    let (mut app, stack) = sleeping_stack();
     app.world_mut().get_mut::<Mass>(stack[1]).unwrap().0 = f32::NAN;
     urto::step(app.world_mut(), 1).unwrap();
     assert!(app.world().get::<Quarantined>(stack[1]).is_some());
@@ -295,12 +295,7 @@ fn a_nan_mass_written_to_a_sleeping_body_is_quarantined_within_one_step() {
 /// step simulates anything.
 #[test]
 fn removing_the_sleeping_marker_wakes_the_whole_island_within_one_step() {
-    let mut app = sleepy_app();
-    let stack: Vec<Entity> = (0..3)
-        .map(|i| crate_box(&mut app, 0.5 + i as f32))
-        .collect();
-    urto::step(app.world_mut(), 240).unwrap();
-    assert!(stack.iter().all(|&b| asleep(&app, b)));
+    let (mut app, stack) = sleeping_stack();
     app.world_mut().entity_mut(stack[2]).remove::<Sleeping>();
     urto::step(app.world_mut(), 1).unwrap();
     assert!(stack.iter().all(|&b| !asleep(&app, b)));
@@ -318,7 +313,7 @@ fn despawning_the_ground_wakes_the_balls_asleep_on_it_and_they_fall_1m_within_1s
         .spawn((Collider::half_space(Vec3::Z), Static))
         .id();
     let balls: Vec<Entity> = (0..4)
-        .map(|i| ball(&mut app, Vec3::new(i as f32 * 2.0, 0.0, 0.5)))
+        .map(|i| common::ball(&mut app, Vec3::new(i as f32 * 2.0, 0.0, 0.5)))
         .collect();
     urto::step(app.world_mut(), 120).unwrap();
     assert!(balls.iter().all(|&b| asleep(&app, b)));

@@ -20,4 +20,4 @@ mod pairs;
 mod refit;
 
 pub use pairs::{BvTree, HierarchyStats, PairScratch, descend_pairs};
-pub use refit::{refit_order, topmost_marked};
+pub use refit::{climb, refit_order, topmost_marked};

@@ -22,41 +22,52 @@ pub fn refit_order<N: Copy + Ord + Hash>(
     depths.clear();
     let mut path = Vec::new();
     for n in changed {
-        depth_of(n, &parent, depths, &mut path);
+        record_depths(n, &parent, depths, &mut path);
     }
     out.extend(depths.iter().map(|(&n, &d)| (d, n)));
     out.sort_unstable_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
 }
 
-/// The depth of `n` (its root: 0), recording it and every ancestor met on the way up in
-/// `depths`; the climb stops at the first node already there. A loop of parents stops after
-/// [`MAX_PATH`] nodes (validation quarantines it).
-fn depth_of<N: Copy + Eq + Hash>(
+/// Climbs from `start` towards its root, pushing onto `path` each node that `known` does not
+/// answer for, and returns the answer for the first node it does (`None`: the climb ended at a
+/// root, the last node of `path`, or after [`MAX_PATH`] nodes, on a loop of parents, which
+/// validation quarantines). The memoised walk shared by the hierarchy's climbs: with `known`
+/// filled from each climb's `path`, many climbs up one chain cost linear time together.
+pub fn climb<N: Copy, V>(
+    start: Option<N>,
+    parent: impl Fn(N) -> Option<N>,
+    known: impl Fn(N) -> Option<V>,
+    path: &mut Vec<N>,
+) -> Option<V> {
+    path.clear();
+    let mut up = start;
+    while let Some(node) = up {
+        if let Some(v) = known(node) {
+            return Some(v);
+        }
+        path.push(node);
+        if path.len() as u32 >= MAX_PATH {
+            return None;
+        }
+        up = parent(node);
+    }
+    None
+}
+
+/// Records in `depths` the depth of `n` (its root: 0) and of every ancestor met on the way up;
+/// the climb stops at the first node already there.
+fn record_depths<N: Copy + Eq + Hash>(
     n: N,
     parent: &impl Fn(N) -> Option<N>,
     depths: &mut HashMap<N, u32>,
     path: &mut Vec<N>,
-) -> u32 {
-    path.clear();
-    let mut up = Some(n);
-    let mut base = None;
-    while let Some(node) = up {
-        if let Some(&d) = depths.get(&node) {
-            base = Some(d);
-            break;
-        }
-        path.push(node);
-        if path.len() as u32 >= MAX_PATH {
-            break;
-        }
-        up = parent(node);
-    }
+) {
+    let base = climb(Some(n), parent, |x| depths.get(&x).copied(), path);
     // The last node of the path is a root (depth 0) or the child of a known node.
     let first = base.map_or(0, |d| d + 1);
     for (k, node) in path.iter().rev().enumerate() {
         depths.insert(*node, first + k as u32);
     }
-    depths[&n]
 }
 
 /// The nodes of `marked` that have no marked ancestor, in `marked`'s order: updating each of
@@ -74,20 +85,8 @@ pub fn topmost_marked<N: Copy + Eq + Hash>(
     covered.extend(marked.iter().map(|&n| (n, true)));
     let mut path = Vec::new();
     for &n in marked {
-        let mut up = parent(n);
-        path.clear();
-        let mut verdict = false;
-        while let Some(node) = up {
-            if let Some(&v) = covered.get(&node) {
-                verdict = v;
-                break;
-            }
-            path.push(node);
-            if path.len() as u32 >= MAX_PATH {
-                break;
-            }
-            up = parent(node);
-        }
+        let above = climb(parent(n), &parent, |x| covered.get(&x).copied(), &mut path);
+        let verdict = above.unwrap_or(false);
         for node in path.drain(..) {
             covered.insert(node, verdict);
         }

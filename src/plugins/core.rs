@@ -142,9 +142,12 @@ fn run_substeps(world: &mut World) {
 
 /// In an `App`: one physics step per fixed tick, with dt taken from Bevy's fixed clock.
 fn run_physics_in_fixed_update(world: &mut World) {
-    restore_required_resources(world);
     let fixed_dt = world.resource::<Time>().delta_secs();
-    let mut ts = world.resource_mut::<PhysicsTimestep>();
+    // Removed by game code, the timestep is made again by the schedule's first system.
+    let Some(mut ts) = world.get_resource_mut::<PhysicsTimestep>() else {
+        world.run_schedule(PhysicsSchedule);
+        return;
+    };
     if (ts.dt() - fixed_dt).abs() > f32::EPSILON * ts.dt()
         && let Err(e) = ts.set_dt(fixed_dt)
     {

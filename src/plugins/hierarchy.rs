@@ -121,7 +121,6 @@ fn propagate_poses<F: QueryFilter + 'static>(
     let s = &mut *scratch;
     s.dirty.clear();
     s.dirty.extend(changed.iter());
-    s.dirty.sort_unstable();
     // Only the changed nodes without a changed ancestor: their subtrees hold all the others,
     // each recomposed once (linear in the hierarchy, however deep).
     let parent = |e: Entity| parents.get(e).ok().map(|p| p.parent());

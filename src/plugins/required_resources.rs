@@ -63,8 +63,15 @@ fn register<R: Resource>(app: &mut App, make: impl Fn() -> R + Send + Sync + 'st
     });
 }
 
-/// Puts back every required resource that game code removed, warning once for each.
+/// Puts back every required resource that game code removed, warning once for each. Every
+/// step pays only the presence checks; the list leaves the world only when one is missing.
 pub(crate) fn restore_required_resources(world: &mut World) {
+    let missing = world
+        .get_resource::<RequiredResources>()
+        .is_some_and(|list| list.0.iter().any(|r| !(r.present)(world)));
+    if !missing {
+        return;
+    }
     let Some(list) = world.remove_resource::<RequiredResources>() else {
         return;
     };

@@ -17,6 +17,7 @@
 use crate::components::*;
 use crate::dynamics::{AngularBody, integrate_rotations};
 use crate::geometry::{Isometry, MassProperties};
+use crate::hierarchy::climb;
 use crate::plugins::core::PrepareIndex;
 use crate::plugins::forces::GatheredForces;
 use crate::plugins::integration::IntegrateBodies;
@@ -118,12 +119,9 @@ fn compute_inertia(
     b.dirty.clear();
     b.dirty.extend(&root_queries.p0());
     if !changed_parts.is_empty() {
-        // A chain of ChildOf is at most as long as there are parts (a cycle, which validation
-        // reports, stops there).
-        let longest_chain = parents.iter().len() + 1;
         b.roots.clear();
         for part in &changed_parts {
-            let root = root_of(part, &parents, longest_chain, &mut b.roots, &mut b.path);
+            let root = root_of(part, &parents, &mut b.roots, &mut b.path);
             b.dirty.push(root);
         }
     }
@@ -149,28 +147,18 @@ fn compute_inertia(
 }
 
 /// The topmost ancestor of `e`, at most `longest_chain` steps up.
-/// The topmost ancestor of `e`, at most `longest_chain` steps up. `roots` remembers the root of
-/// every node climbed through, and a climb stops at the first remembered node, so the parts of
-/// one deep chain cost linear time together, not quadratic.
+/// The topmost ancestor of `e`. `roots` remembers the root of every node climbed through, and
+/// a climb stops at the first remembered node ([`climb`]), so the parts of one deep chain cost
+/// linear time together, not quadratic.
 fn root_of(
     e: Entity,
     parents: &Query<&ChildOf>,
-    longest_chain: usize,
     roots: &mut EntityHashMap<Entity>,
     path: &mut Vec<Entity>,
 ) -> Entity {
-    path.clear();
-    let mut up = e;
-    let root = loop {
-        if let Some(&r) = roots.get(&up) {
-            break r;
-        }
-        path.push(up);
-        match parents.get(up) {
-            Ok(parent) if path.len() <= longest_chain => up = parent.parent(),
-            _ => break up,
-        }
-    };
+    let parent = |x: Entity| parents.get(x).ok().map(|p| p.parent());
+    let found = climb(Some(e), parent, |x| roots.get(&x).copied(), path);
+    let root = found.or(path.last().copied()).unwrap_or(e);
     for &node in path.iter() {
         roots.insert(node, root);
     }

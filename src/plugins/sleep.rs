@@ -110,9 +110,7 @@ pub(crate) struct Waker<'w, 's> {
 impl Waker<'_, '_> {
     /// Wakes `e`, whose sleep state is `state`.
     pub fn wake(&mut self, e: Entity, state: Option<&mut SleepState>) {
-        if let Ok(mut entity) = self.commands.get_entity(e) {
-            entity.queue_silenced(entity_command::remove::<Sleeping>());
-        }
+        unmark(&mut self.commands, e);
         if let Some(state) = state {
             if state.island != 0
                 && let Some(islands) = self.islands.as_mut()
@@ -194,17 +192,29 @@ fn wake_on_game_changes(
         let spun = w.is_some_and(|w| w.0 != Vec3::ZERO);
         let moved = p.0 != sleep.at || r.0 != sleep.orientation || v.0 != Vec3::ZERO;
         let (mass, collider, inertia, drag, angular_drag, parent, children) = settings;
-        let changed = |c: Option<bool>| c.unwrap_or(false);
         let rebuilt = mass.is_changed()
-            || changed(collider.map(|c| c.is_changed()))
-            || changed(inertia.map(|c| c.is_changed()))
-            || changed(drag.map(|c| c.is_changed()))
-            || changed(angular_drag.map(|c| c.is_changed()))
-            || changed(parent.map(|c| c.is_changed()))
-            || changed(children.map(|c| c.is_changed()));
+            || written(collider)
+            || written(inertia)
+            || written(drag)
+            || written(angular_drag)
+            || written(parent)
+            || written(children);
         if pushed || spun || moved || rebuilt {
             waker.wake(e, Some(&mut sleep));
         }
+    }
+}
+
+/// Whether an optional component was written since the system last ran.
+fn written<T: Component>(c: Option<Ref<T>>) -> bool {
+    c.is_some_and(|c| c.is_changed())
+}
+
+/// Takes the [`Sleeping`] marker off `e` when the commands apply (nothing if `e` is gone by
+/// then).
+fn unmark(commands: &mut Commands, e: Entity) {
+    if let Ok(mut entity) = commands.get_entity(e) {
+        entity.queue_silenced(entity_command::remove::<Sleeping>());
     }
 }
 
@@ -223,9 +233,7 @@ fn wake_islands(
             if let Ok(mut state) = states.get_mut(e) {
                 state.restart();
             }
-            if let Ok(mut entity) = commands.get_entity(e) {
-                entity.queue_silenced(entity_command::remove::<Sleeping>());
-            }
+            unmark(&mut commands, e);
         }
     }
 }
@@ -238,7 +246,7 @@ fn wake_everything(
 ) {
     for (e, mut state) in &mut sleepers {
         state.restart();
-        commands.entity(e).remove::<Sleeping>();
+        unmark(&mut commands, e);
     }
     if let Some(mut islands) = islands {
         islands.members.clear();

@@ -122,6 +122,13 @@ pub fn app_with(dt: f32, substeps: u32) -> App {
     app
 }
 
+/// A dynamic ball of radius 0.5 m (1 kg) at `at`, at rest.
+pub fn ball(app: &mut App, at: Vec3) -> bevy_ecs::entity::Entity {
+    app.world_mut()
+        .spawn((Collider::sphere(0.5), Position(at), Velocity::default()))
+        .id()
+}
+
 /// An app at 60 Hz, one substep.
 pub fn app() -> App {
     app_with(1.0 / 60.0, 1)
