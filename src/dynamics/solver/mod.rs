@@ -6,7 +6,8 @@
 //! with `h = dt / substeps`:
 //!
 //! 1. **prepare** — contact rows with lever arms ([`ContactConstraint::prepare`]), seeded with
-//!    last step's impulses ([`WarmStartCache`]);
+//!    last step's impulses ([`WarmStartCache`]), then coloured ([`colouring`]: no two contacts
+//!    of a colour move the same body) and packed four at a time into [`ContactBatch`]es;
 //! 2. `substeps` times:
 //!    1. **integrate velocities** — springs, then gravity, forces, torques and damping, all
 //!       evaluated at the substep's starting state (so a stiff spring is as stable as the
@@ -26,11 +27,25 @@
 //! (4 substeps, damping ratio 10, twice as stiff against immovable bodies,
 //! push-out at most 3 m/s, bounces above 1 m/s); see [`SoftStepSettings`].
 //!
-//! Bodies are in the caller's slot order and contacts in the caller's key order, so the result
-//! depends on nothing else (no hashing, no archetype or thread order).
+//! # Four contacts at once
+//! The passes run colour by colour, each colour's contacts side by side in the lanes of
+//! `wide::f32x4` ([`batch`], Box2D v3's wide contact solver): a batch gathers its bodies'
+//! velocities, runs the scalar rows' arithmetic in every lane and scatters them back, which
+//! gives what solving its contacts one after the other would, since they share no moving body.
+//! Contacts no colour takes (a body in more than [`colouring::COLOURS`] contacts) and those with
+//! rolling resistance are solved one at a time after the colours. Gauss–Seidel order still
+//! matters between colours: the colours are visited forwards and backwards in alternate
+//! substeps (forwards only, a 20-box stack swayed 1.4 cm in 10 s; alternating, 0.6 cm).
+//!
+//! Bodies are in the caller's slot order and contacts in the caller's key order, and the
+//! colouring follows the key order, so the result depends on nothing else (no hashing, no
+//! archetype or thread order).
 
+pub mod batch;
 pub mod body;
+pub mod colouring;
 pub mod contact;
+pub mod lanes;
 pub mod rolling;
 pub mod softness;
 pub mod warm_start;
@@ -38,6 +53,7 @@ pub mod warm_start;
 #[cfg(test)]
 mod scenarios;
 
+pub use batch::ContactBatch;
 pub use body::{BodyInput, BodyParams, BodyState, SolverBodies};
 pub use contact::{ConstraintPoint, ContactConstraint, ContactInput, ContactPointInput};
 pub use rolling::RollingRows;
@@ -47,6 +63,7 @@ pub use warm_start::WarmStartCache;
 use crate::dynamics::forces::{ForceModel, Spring, SpringEnd};
 use crate::dynamics::free_rotation::FreeBody;
 use crate::settings::{MAX_SUBSTEPS, SettingsError};
+use colouring::Colouring;
 use glam::{Quat, Vec3};
 
 /// Most relax passes per substep a setting may ask for (more is a hang, not accuracy).
@@ -144,6 +161,10 @@ pub struct Solver {
     /// The tunables.
     pub settings: SoftStepSettings,
     constraints: Vec<ContactConstraint>,
+    /// The constraints by colour, for the batches.
+    colouring: Colouring,
+    /// The coloured constraints, [`lanes::LANES`] at a time.
+    batches: Vec<ContactBatch>,
     cache: WarmStartCache,
     /// Centres and velocities of the substep, for the springs.
     spring_state: (Vec<Vec3>, Vec<Vec3>),
@@ -190,6 +211,7 @@ impl Solver {
         self.prepare(bodies, contacts, h);
         self.stabilise_springs(bodies, springs, h);
         let springs = std::mem::take(&mut self.stable_springs);
+        let mut flip = false;
         for _ in 0..substeps {
             // Springs read the substep's starting state, as gravity and the forces do: read
             // after gravity's kick, a dashpot resisted it and a hanging body sagged (1 − c·h)
@@ -198,17 +220,16 @@ impl Solver {
                 self.apply_springs(bodies, &springs, h);
             }
             integrate_velocities(bodies, h);
-            for c in &mut self.constraints {
-                c.flip = !c.flip;
-            }
-            for c in &self.constraints {
-                c.warm_start(&mut bodies.states);
-            }
-            self.solve_contacts(bodies, inv_h, true);
+            flip = !flip;
+            self.warm_start(bodies, flip);
+            self.solve_contacts(bodies, inv_h, true, flip);
             integrate_positions(bodies, h, s.max_rotation_per_substep);
             for _ in 0..s.relax_iterations {
-                self.solve_contacts(bodies, inv_h, false);
+                self.solve_contacts(bodies, inv_h, false, flip);
             }
+        }
+        for batch in &self.batches {
+            batch.unpack(&mut self.constraints);
         }
         for c in &mut self.constraints {
             c.restitute(&mut bodies.states, s.restitution_threshold);
@@ -279,11 +300,38 @@ impl Solver {
         }
     }
 
-    /// One pass over every contact: biased (push-out) or relaxing (no bias, friction).
-    fn solve_contacts(&mut self, bodies: &mut SolverBodies, inv_h: f32, use_bias: bool) {
+    /// Applies every contact's accumulated impulses: the batches, then the rest.
+    fn warm_start(&mut self, bodies: &mut SolverBodies, flip: bool) {
+        for batch in &self.batches {
+            batch.warm_start(&mut bodies.states);
+        }
+        for &i in self.colouring.one_by_one() {
+            let c = &mut self.constraints[i as usize];
+            c.flip = flip;
+            c.warm_start(&mut bodies.states);
+        }
+    }
+
+    /// One pass over every contact, colour by colour and then the rest one at a time: biased
+    /// (push-out) or relaxing (no bias, friction); `flip` visits each contact's points
+    /// backwards.
+    fn solve_contacts(
+        &mut self,
+        bodies: &mut SolverBodies,
+        inv_h: f32,
+        use_bias: bool,
+        flip: bool,
+    ) {
         let push = self.settings.max_push_out;
-        for c in &mut self.constraints {
-            c.solve(&mut bodies.states, inv_h, push, use_bias);
+        let solve =
+            |batch: &mut ContactBatch| batch.solve(&mut bodies.states, inv_h, push, use_bias, flip);
+        if flip {
+            self.batches.iter_mut().rev().for_each(solve);
+        } else {
+            self.batches.iter_mut().for_each(solve);
+        }
+        for &i in self.colouring.one_by_one() {
+            self.constraints[i as usize].solve(&mut bodies.states, inv_h, push, use_bias);
         }
     }
 
@@ -308,6 +356,14 @@ impl Solver {
             |a| orientations[a as usize],
             h,
             s.warm_start_distance,
+        );
+        self.colouring.colour(&self.constraints, bodies.len());
+        let constraints = &self.constraints;
+        self.batches.clear();
+        self.batches.extend(
+            self.colouring
+                .batches()
+                .map(|indices| ContactBatch::pack(indices, constraints)),
         );
     }
 }

@@ -317,9 +317,11 @@ fn a_tall_box_pushed_at_its_top_tips_over_and_pushed_at_its_base_slides() {
     }
 }
 
-#[test]
-fn a_20_row_pyramid_of_210_boxes_stands_3_s_with_drift_under_1_cm() {
+/// The largest distance a box of a 20-row pyramid (210 boxes) moved in `seconds`, with
+/// `relax` passes per substep.
+fn pyramid_drift(relax: u32, seconds: f32) -> f32 {
     let mut scene = Scene::default();
+    scene.solver.settings.relax_iterations = relax;
     scene.ground(Vec3::Z);
     let half = 0.25;
     let mut boxes = Vec::new();
@@ -331,14 +333,30 @@ fn a_20_row_pyramid_of_210_boxes_stands_3_s_with_drift_under_1_cm() {
         }
     }
     let start: Vec<Vec3> = boxes.iter().map(|&b| scene.bodies[b].center).collect();
-    scene.run(3.0);
-    let drift = boxes
+    scene.run(seconds);
+    boxes
         .iter()
         .zip(&start)
         .map(|(&b, s)| scene.bodies[b].center.distance(*s))
-        .fold(0.0f32, f32::max);
+        .fold(0.0f32, f32::max)
+}
+
+#[test]
+fn a_20_row_pyramid_of_210_boxes_stands_3_s_with_drift_under_1_cm() {
+    let drift = pyramid_drift(2, 3.0);
     eprintln!("pyramid: drift {drift} m");
     assert!(drift < 0.01, "drift {drift} m");
+}
+
+/// With Box2D's single relax pass the pyramid stands but creeps: 6.8 cm in 5 s with the
+/// coloured batches, 2.0 cm with the contacts solved one by one in key order (the order of the
+/// sweep matters at this edge; sorting the batches by key, closer to that order, made it
+/// 95 cm). Hence the default of two passes.
+#[test]
+fn a_20_row_pyramid_stands_5_s_with_box2ds_single_relax_pass_drifting_under_10_cm() {
+    let drift = pyramid_drift(1, 5.0);
+    eprintln!("pyramid, relax 1: drift {drift} m");
+    assert!(drift < 0.1, "drift {drift} m");
 }
 
 #[test]

@@ -1,0 +1,451 @@
+//! Four contacts solved at once: the rows of [`ContactConstraint`] laid out one contact per
+//! SIMD lane (Box2D v3's `contact_solver.c` wide path, rapier's `ContactWithTwistFriction<SimdReal>`).
+//!
+//! The contacts of a batch come from one colour ([`Colouring`](super::colouring::Colouring)),
+//! so no two lanes move the same body: the batch gathers its bodies' velocities, runs exactly the
+//! scalar solver's arithmetic ([`ContactConstraint::solve`], whose module derives the rows) in
+//! every lane, and scatters the velocities back. A lane whose contact has fewer points than the
+//! batch's largest, and the padding lanes of a short batch, hold zero rows: their impulses come
+//! out zero and change nothing, so no lane needs a mask.
+//!
+//! The batch is packed from the prepared constraints once per step and its impulses unpacked
+//! into them after the substeps, so restitution, warm-start storage and contact reports read
+//! the constraints as before.
+
+use super::body::BodyState;
+use super::contact::{ConstraintPoint, ContactConstraint, RowPart};
+use super::lanes::{LANES, Lanes, Quatx4, Vec3x4};
+use crate::geometry::MAX_MANIFOLD_POINTS;
+use glam::Vec3;
+
+/// One row of four contacts' points ([`RowPart`] per lane).
+#[derive(Clone, Copy, Debug, Default)]
+struct RowX4 {
+    arm: [Vec3x4; 2],
+    turn: [Vec3x4; 2],
+    mass: Lanes,
+}
+
+impl RowX4 {
+    fn gather(rows: [&RowPart; LANES]) -> Self {
+        Self {
+            arm: [0, 1].map(|k| Vec3x4::gather(rows.map(|r| r.arm[k]))),
+            turn: [0, 1].map(|k| Vec3x4::gather(rows.map(|r| r.turn[k]))),
+            mass: Lanes::new(rows.map(|r| r.mass)),
+        }
+    }
+}
+
+/// The `k`-th point of four contacts ([`ConstraintPoint`] per lane).
+#[derive(Clone, Copy, Debug, Default)]
+struct PointX4 {
+    anchor_a: Vec3x4,
+    anchor_b: Vec3x4,
+    base_separation: Lanes,
+    normal_row: RowX4,
+    tangent_rows: [RowX4; 2],
+    normal_impulse: Lanes,
+    tangent_impulse: [Lanes; 2],
+    max_normal_impulse: Lanes,
+    relative_velocity: Lanes,
+}
+
+impl PointX4 {
+    fn gather(points: [&ConstraintPoint; LANES]) -> Self {
+        let each = |f: fn(&ConstraintPoint) -> f32| Lanes::new(points.map(f));
+        Self {
+            anchor_a: Vec3x4::gather(points.map(|p| p.anchor_a)),
+            anchor_b: Vec3x4::gather(points.map(|p| p.anchor_b)),
+            base_separation: each(|p| p.base_separation),
+            normal_row: RowX4::gather(points.map(|p| &p.normal_row)),
+            tangent_rows: [0, 1].map(|k| RowX4::gather(points.map(|p| &p.tangent_rows[k]))),
+            normal_impulse: each(|p| p.normal_impulse),
+            tangent_impulse: [
+                each(|p| p.tangent_impulse[0]),
+                each(|p| p.tangent_impulse[1]),
+            ],
+            max_normal_impulse: each(|p| p.max_normal_impulse),
+            relative_velocity: each(|p| p.relative_velocity),
+        }
+    }
+
+    /// Writes lane `lane`'s impulses and approach speed into `point`.
+    fn scatter(&self, lane: usize, point: &mut ConstraintPoint) {
+        let at = |v: &Lanes| v.as_array()[lane];
+        point.normal_impulse = at(&self.normal_impulse);
+        point.tangent_impulse = self.tangent_impulse.each_ref().map(at);
+        point.max_normal_impulse = at(&self.max_normal_impulse);
+        point.relative_velocity = at(&self.relative_velocity);
+    }
+}
+
+/// Four contacts of one colour, solved side by side.
+#[derive(Clone, Debug)]
+pub struct ContactBatch {
+    /// Which constraint each lane holds (`None`: padding).
+    constraints: [Option<u32>; LANES],
+    /// Body slots of A and B per lane (padding lanes repeat lane 0's).
+    bodies: [[usize; LANES]; 2],
+    /// Whether the lane writes A's and B's velocities back (dynamic bodies of real lanes).
+    writes: [[bool; LANES]; 2],
+    normal: Vec3x4,
+    tangents: [Vec3x4; 2],
+    friction: Lanes,
+    inverse_mass: [Lanes; 2],
+    /// `mass_scale · bias_rate`, `mass_scale`, `impulse_scale` of each lane's softness.
+    softness: [Lanes; 3],
+    closing_acceleration: Lanes,
+    points: [PointX4; MAX_MANIFOLD_POINTS],
+    /// The most points any lane has.
+    count: usize,
+    /// Whether any lane has friction.
+    rubs: bool,
+}
+
+impl ContactBatch {
+    /// Packs `indices` (1 to [`LANES`] constraints of one colour) of `constraints`.
+    pub fn pack(indices: &[u32], constraints: &[ContactConstraint]) -> Self {
+        let lanes: [Option<&ContactConstraint>; LANES] =
+            std::array::from_fn(|l| indices.get(l).map(|&i| &constraints[i as usize]));
+        let first = lanes[0].expect("a batch holds at least one constraint");
+        let real = |l: usize| lanes[l].unwrap_or(first);
+        let each = |f: fn(&ContactConstraint) -> f32| {
+            Lanes::new(std::array::from_fn(|l| lanes[l].map_or(0.0, f)))
+        };
+        let vectors = |f: fn(&ContactConstraint) -> Vec3| {
+            Vec3x4::gather(std::array::from_fn(|l| lanes[l].map_or(Vec3::ZERO, f)))
+        };
+        let zero = ConstraintPoint::default();
+        let points = std::array::from_fn(|k| {
+            PointX4::gather(std::array::from_fn(|l| match lanes[l] {
+                Some(c) if k < c.count as usize => &c.points[k],
+                _ => &zero,
+            }))
+        });
+        Self {
+            constraints: std::array::from_fn(|l| indices.get(l).copied()),
+            bodies: [
+                std::array::from_fn(|l| real(l).a as usize),
+                std::array::from_fn(|l| real(l).b as usize),
+            ],
+            writes: [0, 1].map(|k| std::array::from_fn(|l| lanes[l].is_some_and(|c| c.dynamic[k]))),
+            normal: vectors(|c| c.normal),
+            tangents: [vectors(|c| c.tangents[0]), vectors(|c| c.tangents[1])],
+            friction: each(|c| c.friction),
+            inverse_mass: [each(|c| c.inverse_mass[0]), each(|c| c.inverse_mass[1])],
+            softness: [
+                each(|c| c.softness.mass_scale * c.softness.bias_rate),
+                each(|c| c.softness.mass_scale),
+                each(|c| c.softness.impulse_scale),
+            ],
+            closing_acceleration: each(|c| c.closing_acceleration),
+            points,
+            count: lanes
+                .iter()
+                .flatten()
+                .map(|c| c.count as usize)
+                .max()
+                .unwrap_or(0),
+            rubs: lanes.iter().flatten().any(|c| c.friction > 0.0),
+        }
+    }
+
+    /// Writes the impulses and approach speeds back into the constraints the lanes came from.
+    pub fn unpack(&self, constraints: &mut [ContactConstraint]) {
+        for (lane, index) in self.constraints.iter().enumerate() {
+            let Some(index) = index else { continue };
+            let c = &mut constraints[*index as usize];
+            for (point, wide) in c.points[..c.count as usize].iter_mut().zip(&self.points) {
+                wide.scatter(lane, point);
+            }
+        }
+    }
+
+    /// Applies the accumulated impulses ([`ContactConstraint::warm_start`] per lane).
+    pub fn warm_start(&self, states: &mut [BodyState]) {
+        let mut pair = PairX4::load(self, states);
+        for p in &self.points[..self.count] {
+            pair.push(
+                self.inverse_mass,
+                self.normal,
+                &p.normal_row,
+                p.normal_impulse,
+            );
+            for k in 0..2 {
+                let (t, row) = (self.tangents[k], &p.tangent_rows[k]);
+                pair.push(self.inverse_mass, t, row, p.tangent_impulse[k]);
+            }
+        }
+        pair.store(self, states);
+    }
+
+    /// One pass over the rows ([`ContactConstraint::solve`] per lane; `flip` visits the points
+    /// backwards).
+    pub fn solve(
+        &mut self,
+        states: &mut [BodyState],
+        inv_h: f32,
+        max_push_out: f32,
+        use_bias: bool,
+        flip: bool,
+    ) {
+        let mut pair = PairX4::load(self, states);
+        self.solve_normals(&mut pair, states, inv_h, max_push_out, use_bias, flip);
+        if !use_bias && self.rubs {
+            self.solve_friction(&mut pair);
+        }
+        pair.store(self, states);
+    }
+
+    /// The normal rows: speculative points close their gap, penetrating ones are pushed out
+    /// softly when `use_bias`.
+    fn solve_normals(
+        &mut self,
+        pair: &mut PairX4,
+        states: &[BodyState],
+        inv_h: f32,
+        max_push_out: f32,
+        use_bias: bool,
+        flip: bool,
+    ) {
+        let [slots_a, slots_b] = self.bodies;
+        let moved = Vec3x4::gather(slots_b.map(|i| states[i].delta_position))
+            - Vec3x4::gather(slots_a.map(|i| states[i].delta_position));
+        let dqa = Quatx4::gather(slots_a.map(|i| states[i].delta_rotation));
+        let dqb = Quatx4::gather(slots_b.map(|i| states[i].delta_rotation));
+        let (zero, one) = (Lanes::ZERO, Lanes::ONE);
+        let [bias_rate, soft_mass, soft_impulse] = if use_bias {
+            self.softness
+        } else {
+            [zero, one, zero]
+        };
+        let (inv_h, most_push) = (Lanes::splat(inv_h), Lanes::splat(-max_push_out));
+        let n = self.normal;
+        for k in 0..self.count {
+            let i = if flip { self.count - 1 - k } else { k };
+            let p = &mut self.points[i];
+            let s = p.base_separation
+                + (moved + dqb.rotate(p.anchor_b) - dqa.rotate(p.anchor_a)).dot(n);
+            let apart = s.simd_gt(zero);
+            let push_out = if use_bias {
+                (bias_rate * s).max(most_push)
+            } else {
+                zero
+            };
+            let bias = apart.select(s * inv_h, push_out);
+            let mass_scale = apart.select(one, soft_mass);
+            let impulse_scale = apart.select(zero, soft_impulse);
+            let row = &p.normal_row;
+            let vn = pair.along(n, row);
+            let impulse = -row.mass * (mass_scale * vn + bias) - impulse_scale * p.normal_impulse;
+            let total = (p.normal_impulse + impulse).max(zero);
+            pair.push(self.inverse_mass, n, row, total - p.normal_impulse);
+            let first = p.max_normal_impulse.simd_eq(zero) & total.simd_gt(zero);
+            if first.any() {
+                let speed = impact_speed(vn, s, self.closing_acceleration);
+                p.relative_velocity = first.select(speed, p.relative_velocity);
+            }
+            p.normal_impulse = total;
+            p.max_normal_impulse = p.max_normal_impulse.max(total);
+        }
+    }
+
+    /// Coulomb friction: both tangent rows clamped together to the disc `μ λ_n`.
+    fn solve_friction(&mut self, pair: &mut PairX4) {
+        let (zero, one) = (Lanes::ZERO, Lanes::ONE);
+        let [t0, t1] = self.tangents;
+        for p in &mut self.points[..self.count] {
+            let [old0, old1] = p.tangent_impulse;
+            let idle = p.normal_impulse.simd_eq(zero) & old0.simd_eq(zero) & old1.simd_eq(zero);
+            if idle.all() {
+                continue;
+            }
+            let [r0, r1] = &p.tangent_rows;
+            let w0 = old0 - r0.mass * pair.along(t0, r0);
+            let w1 = old1 - r1.mass * pair.along(t1, r1);
+            let limit = self.friction * p.normal_impulse;
+            let length = (w0 * w0 + w1 * w1).sqrt();
+            let clamped = length.simd_gt(limit) & length.simd_gt(zero);
+            let scale = clamped.select(limit / length, one);
+            let (new0, new1) = (w0 * scale, w1 * scale);
+            pair.push(self.inverse_mass, t0, r0, new0 - old0);
+            pair.push(self.inverse_mass, t1, r1, new1 - old1);
+            p.tangent_impulse = [new0, new1];
+        }
+    }
+}
+
+/// [`contact`](super::contact)'s `impact_speed` per lane: a speculative point approaching at
+/// `vn` from `s` away meets the surface at `−√(vn² − 2 a s)`.
+fn impact_speed(vn: Lanes, s: Lanes, closing: Lanes) -> Lanes {
+    let zero = Lanes::ZERO;
+    let squared = vn * vn - Lanes::splat(2.0) * closing * s;
+    let faster =
+        s.simd_gt(zero) & vn.simd_lt(zero) & squared.is_finite() & squared.simd_gt(vn * vn);
+    faster.select(-squared.sqrt(), vn)
+}
+
+/// The velocities of a batch's bodies, one pair per lane.
+struct PairX4 {
+    va: Vec3x4,
+    wa: Vec3x4,
+    vb: Vec3x4,
+    wb: Vec3x4,
+}
+
+impl PairX4 {
+    fn load(batch: &ContactBatch, states: &[BodyState]) -> Self {
+        let [a, b] = batch.bodies;
+        Self {
+            va: Vec3x4::gather(a.map(|i| states[i].linear_velocity)),
+            wa: Vec3x4::gather(a.map(|i| states[i].angular_velocity)),
+            vb: Vec3x4::gather(b.map(|i| states[i].linear_velocity)),
+            wb: Vec3x4::gather(b.map(|i| states[i].angular_velocity)),
+        }
+    }
+
+    /// The rate of a row: `d·(v_b − v_a) + (r_b × d)·ω_b − (r_a × d)·ω_a`.
+    fn along(&self, dir: Vec3x4, row: &RowX4) -> Lanes {
+        dir.dot(self.vb - self.va) + row.arm[1].dot(self.wb) - row.arm[0].dot(self.wa)
+    }
+
+    /// An impulse `λ d` on B at its anchor, `−λ d` on A.
+    fn push(&mut self, inverse_mass: [Lanes; 2], dir: Vec3x4, row: &RowX4, lambda: Lanes) {
+        self.va = self.va - dir * (lambda * inverse_mass[0]);
+        self.wa = self.wa - row.turn[0] * lambda;
+        self.vb = self.vb + dir * (lambda * inverse_mass[1]);
+        self.wb = self.wb + row.turn[1] * lambda;
+    }
+
+    fn store(self, batch: &ContactBatch, states: &mut [BodyState]) {
+        let [va, wa, vb, wb] = [self.va, self.wa, self.vb, self.wb].map(|v| v.to_vecs());
+        for lane in 0..LANES {
+            if batch.writes[0][lane] {
+                let s = &mut states[batch.bodies[0][lane]];
+                s.linear_velocity = va[lane];
+                s.angular_velocity = wa[lane];
+            }
+            if batch.writes[1][lane] {
+                let s = &mut states[batch.bodies[1][lane]];
+                s.linear_velocity = vb[lane];
+                s.angular_velocity = wb[lane];
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dynamics::solver::{
+        BodyInput, ContactInput, ContactPointInput, Softness, SolverBodies,
+    };
+    use glam::Quat;
+
+    /// Six moving, turning bodies and three contacts between disjoint pairs, with 4, 2 and 1
+    /// points, some apart (speculative) and some penetrating, carrying impulses from a warm
+    /// start.
+    fn scene() -> (SolverBodies, Vec<ContactConstraint>) {
+        let mut bodies = SolverBodies::default();
+        for i in 0..6 {
+            let f = i as f32;
+            bodies.push(BodyInput {
+                center: Vec3::new(f, 0.3 * f, 0.0),
+                orientation: Quat::from_rotation_y(0.2 * f),
+                linear_velocity: Vec3::new(0.5 - f * 0.2, 0.1 * f, -1.0 + 0.3 * f),
+                angular_velocity: Vec3::new(0.7, -0.2 * f, 0.4),
+                inverse_mass: 1.0 / (1.0 + f),
+                inverse_principal_inertia: Vec3::new(2.0, 3.0, 1.0 + f),
+                ..Default::default()
+            });
+        }
+        for (i, s) in bodies.states.iter_mut().enumerate() {
+            s.delta_position = Vec3::new(0.01, -0.02, 0.003 * i as f32);
+            s.delta_rotation = Quat::from_rotation_z(0.01 * i as f32);
+        }
+        let softness = Softness::new(60.0, 10.0, 1.0 / 240.0);
+        let constraints = [(0u32, 1u32, 4u8), (2, 3, 2), (4, 5, 1)]
+            .iter()
+            .enumerate()
+            .map(|(k, &(a, b, count))| {
+                let mut input = ContactInput {
+                    a,
+                    b,
+                    normal: Vec3::new(0.1, 0.2 * k as f32, 1.0).normalize(),
+                    friction: 0.6,
+                    restitution: 0.0,
+                    rolling_resistance: 0.0,
+                    points: [ContactPointInput::default(); MAX_MANIFOLD_POINTS],
+                    count,
+                    key: k as u128,
+                };
+                for (j, p) in input.points.iter_mut().enumerate() {
+                    *p = ContactPointInput {
+                        point: Vec3::new(a as f32 + 0.5, 0.2 * j as f32, 0.1 * k as f32),
+                        separation: 0.01 * (j as f32 - 1.5),
+                    };
+                }
+                let mut c = ContactConstraint::prepare(
+                    &input,
+                    &bodies.centers,
+                    &bodies.states,
+                    &bodies.params,
+                    softness,
+                );
+                for (j, p) in c.points.iter_mut().enumerate() {
+                    p.normal_impulse = 0.1 * j as f32;
+                    p.tangent_impulse = [0.02, -0.01 * j as f32];
+                }
+                c
+            })
+            .collect();
+        (bodies, constraints)
+    }
+
+    #[test]
+    fn a_batch_of_disjoint_contacts_solves_as_the_scalar_rows_do_within_1e_5() {
+        let (bodies, constraints) = scene();
+        let (h, push) = (1.0 / 240.0, 3.0);
+        let mut scalar_states = bodies.states.clone();
+        let mut scalar = constraints.clone();
+        for c in &mut scalar {
+            c.flip = true;
+            c.warm_start(&mut scalar_states);
+            c.solve(&mut scalar_states, 1.0 / h, push, true);
+            c.solve(&mut scalar_states, 1.0 / h, push, false);
+        }
+        let mut batch_states = bodies.states.clone();
+        let mut batched = constraints.clone();
+        let mut batch = ContactBatch::pack(&[0, 1, 2], &constraints);
+        batch.warm_start(&mut batch_states);
+        batch.solve(&mut batch_states, 1.0 / h, push, true, true);
+        batch.solve(&mut batch_states, 1.0 / h, push, false, true);
+        batch.unpack(&mut batched);
+        for (s, b) in scalar_states.iter().zip(&batch_states) {
+            assert!(
+                (s.linear_velocity - b.linear_velocity).length() < 1e-5,
+                "{s:?} {b:?}"
+            );
+            assert!((s.angular_velocity - b.angular_velocity).length() < 1e-5);
+        }
+        for (s, b) in scalar.iter().zip(&batched) {
+            for (ps, pb) in s.points().iter().zip(b.points()) {
+                assert!(
+                    (ps.normal_impulse - pb.normal_impulse).abs() < 1e-5,
+                    "{ps:?} {pb:?}"
+                );
+                assert!((ps.tangent_impulse[0] - pb.tangent_impulse[0]).abs() < 1e-5);
+                assert!((ps.tangent_impulse[1] - pb.tangent_impulse[1]).abs() < 1e-5);
+                assert!((ps.relative_velocity - pb.relative_velocity).abs() < 1e-5);
+                assert_eq!(ps.max_normal_impulse > 0.0, pb.max_normal_impulse > 0.0);
+            }
+        }
+        // Something happened: the contacts pushed.
+        assert!(
+            batched
+                .iter()
+                .any(|c| c.points().iter().any(|p| p.normal_impulse > 0.0))
+        );
+        assert_ne!(batch_states, bodies.states);
+    }
+}
