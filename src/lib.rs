@@ -5,7 +5,7 @@
 //! in the narrow phase, reflection/impulse response, and debug recordings for the rerun viewer.
 //!
 //! Two layers, data flowing one way:
-//! - the **algorithm core** — [`geometry`], [`bounding`], [`dynamics`], [`clock`] — plain Rust
+//! - the **algorithm core** — [`geometry`], [`bounding`], [`dynamics`], [`spatial`], [`clock`] — plain Rust
 //!   and glam, no ECS: every algorithm is testable and benchmarkable alone;
 //! - the **ECS layer** — [`components`], [`schedule`], [`plugins`], [`debug`] — thin
 //!   `bevy_ecs` systems that gather components, call the core, and write back.
@@ -39,6 +39,7 @@ pub mod hierarchy;
 pub mod plugins;
 pub mod schedule;
 pub mod settings;
+pub mod spatial;
 pub mod stats;
 
 pub use plugins::{UrtoPlugins, step};
@@ -49,7 +50,10 @@ pub mod prelude {
     pub use crate::components::*;
     pub use crate::dynamics::Integrator;
     pub use crate::dynamics::solver::SoftStepSettings;
-    pub use crate::plugins::{CollisionEnded, CollisionStarted, SoftStepPlugin, UrtoPlugins};
+    pub use crate::plugins::{
+        CollisionEnded, CollisionStarted, RayHit, SoftStepPlugin, SpatialQuery, SpatialQueryFilter,
+        UrtoPlugins,
+    };
     pub use crate::schedule::{PhysicsSchedule, PhysicsSet, SubstepSchedule, SubstepSet};
     pub use crate::settings::*;
     pub use crate::stats::{PhysicsStats, Stage};

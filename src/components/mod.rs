@@ -34,6 +34,7 @@ pub use sleeping::{SleepState, Sleeping, SleepingIslands};
 
 use crate::bounding::Aabb;
 use crate::geometry::{Isometry, MeshCollider, MeshColliderError, Shape, TriMesh};
+pub use crate::spatial::{LayerMask, Layers};
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
 
@@ -244,6 +245,42 @@ pub struct StepStartPose(pub Isometry);
 /// The sweep uses the body's bounding sphere (exact for balls, conservative for other shapes).
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Ccd;
+
+/// Which collision layers a collider is in and which it interacts with (see
+/// [`crate::spatial::layers`]): two colliders touch only when each is a member of a layer the
+/// other filters, and a [`SpatialQuery`](crate::plugins::SpatialQuery) sees colliders whose
+/// memberships meet its mask. Without it a collider is in the first layer and interacts with
+/// every layer (Avian's default).
+///
+/// ```
+/// # use urto::prelude::*;
+/// const PLAYER: LayerMask = LayerMask(1 << 1);
+/// const GHOST: LayerMask = LayerMask(1 << 2);
+/// // A ghost in its own layer that passes through players.
+/// let ghost = CollisionLayers::new(GHOST, !PLAYER);
+/// let player = CollisionLayers::new(PLAYER, LayerMask::ALL);
+/// assert!(!ghost.interacts_with(&player));
+/// assert!(ghost.interacts_with(&CollisionLayers::default()));
+/// ```
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CollisionLayers(pub Layers);
+
+impl CollisionLayers {
+    /// Members of `memberships`, interacting with `filters`.
+    pub const fn new(memberships: LayerMask, filters: LayerMask) -> Self {
+        Self(Layers::new(memberships, filters))
+    }
+
+    /// Whether colliders with these layers and `other`'s may touch.
+    pub const fn interacts_with(&self, other: &Self) -> bool {
+        self.0.interacts_with(&other.0)
+    }
+}
+
+/// The layers of a collider that may have none (the default's).
+pub(crate) fn layers_of(layers: Option<&CollisionLayers>) -> CollisionLayers {
+    layers.copied().unwrap_or_default()
+}
 
 /// Marks scenery that never moves.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -180,6 +180,7 @@ type Obstacle<'a> = (
     &'a BoundingVolume,
     Option<&'a Children>,
     Option<&'a Restitution>,
+    Option<&'a CollisionLayers>,
 );
 
 /// Sweeps each recorded body from its start to where the integrator put it.
@@ -208,6 +209,7 @@ fn sweep_fast_bodies(
             continue;
         };
         let e_body = e_body.map_or(contact_settings.default_restitution, |r| r.0);
+        let layers = layers_of(obstacles.get(body).ok().and_then(|o| o.5));
         if !(p.0 - from).is_finite() {
             // The integrator overflowed: leave the body where it is, for the refit to quarantine.
             continue;
@@ -220,7 +222,7 @@ fn sweep_fast_bodies(
             };
             let sweep = sweep.with_initial_overlap(InitialOverlap::ApproachingOnly);
             let Some((hit, root, leaf, e_obstacle)) =
-                first_impact(&sweep, &obstacles, &mut index, s)
+                first_impact(&sweep, layers, &obstacles, &mut index, s)
             else {
                 at += motion;
                 motion = Vec3::ZERO;
@@ -262,10 +264,12 @@ fn sweep_fast_bodies(
 /// below which it is rounding (a body sliding along its support), not an impact.
 const TOUCHING_TOLERANCE: f32 = 1e-4;
 
-/// The earliest impact of `sweep` with the static scenery its swept volume meets:
-/// the hit, the obstacle's root, the collider hit, and that collider's restitution.
+/// The earliest impact of `sweep` (a body with `layers`) with the static scenery its swept
+/// volume meets and its layers interact with: the hit, the obstacle's root, the collider hit,
+/// and that collider's restitution.
 fn first_impact(
     sweep: &SphereSweep,
+    layers: CollisionLayers,
     obstacles: &Query<Obstacle, Without<Quarantined>>,
     index: &mut BroadPhaseIndex,
     s: &mut CcdScratch,
@@ -278,7 +282,7 @@ fn first_impact(
         s.stack.clear();
         s.stack.push(root);
         while let Some(node) = s.stack.pop() {
-            let Ok((collider, global, bv, children, e)) = obstacles.get(node) else {
+            let Ok((collider, global, bv, children, e, node_layers)) = obstacles.get(node) else {
                 continue;
             };
             if !bv.0.intersects(&swept) {
@@ -288,6 +292,9 @@ fn first_impact(
             let Some(c) = collider else {
                 continue;
             };
+            if !layers.interacts_with(&layers_of(node_layers)) {
+                continue;
+            }
             let Some(hit) = toi_sphere_shape(sweep, &c.shape, &global.0, &mut s.query) else {
                 continue;
             };

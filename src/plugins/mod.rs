@@ -27,6 +27,7 @@ pub mod rotation;
 mod settings_check;
 pub mod sleep;
 pub mod soft_step;
+pub mod spatial_query;
 pub mod transform_sync;
 pub mod validation;
 
@@ -41,6 +42,9 @@ pub use response::{CollisionEnded, CollisionStarted, ReportCollisions, ResponseP
 pub use rotation::RotationPlugin;
 pub use sleep::SleepPlugin;
 pub use soft_step::{SoftStepPlugin, SoftStepSolver, SolveBodies, SpeculativeMargin};
+pub use spatial_query::{
+    RayHit, SpatialQuery, SpatialQueryFilter, SpatialQueryIndex, SpatialQueryPlugin,
+};
 pub use transform_sync::TransformSyncPlugin;
 pub use validation::ValidationPlugin;
 
@@ -89,5 +93,6 @@ impl PluginGroup for UrtoPlugins {
             .add(ResponsePlugin)
             .add(SleepPlugin)
             .add(TransformSyncPlugin)
+            .add(SpatialQueryPlugin)
     }
 }

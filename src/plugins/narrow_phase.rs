@@ -19,6 +19,8 @@
 //! `narrow_phase/bvh_nodes_visited`, `narrow_phase/bv_tests` and `narrow_phase/triangle_tests`
 //! (with `narrow_phase/mesh_pairs`, the mesh queries run) once a mesh pair has been tested.
 //!
+//! Collider pairs whose [`CollisionLayers`] do not interact are skipped before any shape test.
+//!
 //! For debugging, [`OverlappingLeaves`] can list, per mesh pair in contact, the leaves of the
 //! hierarchies whose triangles touched, and [`HierarchyVisits`] the scene-graph nodes the descent
 //! of compound pairs tested, entered and pruned; each is filled only while enabled (the rerun
@@ -206,6 +208,7 @@ fn compute_contacts(
     nodes: Query<Node, Without<Quarantined>>,
     dormancy: Query<Dormancy>,
     motion: Query<Motion>,
+    layers: Query<&CollisionLayers>,
     lookahead: LookaheadParams,
     sleep: Option<Res<SleepSettings>>,
     mut contacts: ResMut<Contacts>,
@@ -235,6 +238,10 @@ fn compute_contacts(
     contacts.pairs.clear();
     let sleeping = sleep.is_some_and(|s| s.enabled);
     let dormant = |e: Entity| dormant(dormancy.get(e).ok());
+    // Layers are per collider: a compound's parts may filter differently.
+    let interacts = |x: Entity, y: Entity| {
+        layers_of(layers.get(x).ok()).interacts_with(&layers_of(layers.get(y).ok()))
+    };
     for &(a, b) in &pairs.pairs {
         if sleeping && dormant(a) && dormant(b) {
             continue; // at rest against each other: nothing to compute until one wakes
@@ -242,7 +249,9 @@ fn compute_contacts(
         let margin = margin(a) + margin(b);
         let compound = |e: Entity| matches!(nodes.get(e), Ok((.., Some(_))));
         if !compound(a) && !compound(b) {
-            scratch.test_leaves(&nodes, (a, b), (a, b), margin, &mut contacts, &mut debug);
+            if interacts(a, b) {
+                scratch.test_leaves(&nodes, (a, b), (a, b), margin, &mut contacts, &mut debug);
+            }
             continue;
         }
         let tree = EcsTree {
@@ -270,6 +279,9 @@ fn compute_contacts(
         }
         for i in 0..scratch.leaf_pairs.len() {
             let leaves = scratch.leaf_pairs[i];
+            if !interacts(leaves.0, leaves.1) {
+                continue;
+            }
             scratch.test_leaves(&nodes, (a, b), leaves, margin, &mut contacts, &mut debug);
         }
     }

@@ -1,0 +1,235 @@
+//! Criterion benchmarks of the spatial queries against parry3d's BVH (the tree under rapier's
+//! query pipeline) on the same scene: 10,000 balls and turned boxes in a 100 m cube.
+//!
+//! - `ray_first_hit`: 1,000 rays, each the nearest hit (urto's box tree and exact casts; parry's
+//!   `Bvh::cast_ray` with each shape's `cast_ray` as the leaf test);
+//! - `sphere_overlap`: 1,000 balls of radius 2 m, each every collider it touches (urto's
+//!   `overlapping`; parry's `intersect_aabb` and `intersection_test`);
+//! - `build` and `refit` of the tree over the 10,000 boxes (parry's refit is its leaf updates
+//!   and `refit`, as rapier does each step).
+//!
+//! Before timing, the answers are compared and printed: the same first hits, the same overlaps.
+//! A quick run: `cargo bench --bench spatial_queries -- --quick`.
+
+#[allow(dead_code)]
+#[path = "../tests/common/rng.rs"]
+mod rng;
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use glam::Vec3;
+use parry3d::bounding_volume::Aabb as ParryAabb;
+use parry3d::partitioning::{Bvh, BvhBuildStrategy, BvhWorkspace};
+use parry3d::shape::{Ball, Cuboid, SharedShape};
+use rng::Rng;
+use std::hint::black_box;
+use urto::geometry::{Isometry, Shape};
+use urto::spatial::{Ray, SpatialIndex};
+
+const COLLIDERS: usize = 10_000;
+const QUERIES: usize = 1_000;
+
+struct Scene {
+    ours: Vec<(Shape, Isometry)>,
+    theirs: Vec<(SharedShape, parry3d::math::Pose)>,
+}
+
+fn scene() -> Scene {
+    let mut rng = Rng::new(7);
+    let mut scene = Scene {
+        ours: Vec::new(),
+        theirs: Vec::new(),
+    };
+    for i in 0..COLLIDERS {
+        let pose = Isometry::new(rng.in_ball(50.0), rng.rotation());
+        let at = parry3d::math::Pose::from_parts(pose.translation, pose.rotation);
+        if i % 2 == 0 {
+            let r = rng.range(0.2, 1.0);
+            scene.ours.push((Shape::sphere(r), pose));
+            scene.theirs.push((SharedShape::new(Ball::new(r)), at));
+        } else {
+            let h = Vec3::new(
+                rng.range(0.1, 1.0),
+                rng.range(0.1, 1.0),
+                rng.range(0.1, 1.0),
+            );
+            scene.ours.push((Shape::cuboid(h), pose));
+            scene.theirs.push((SharedShape::new(Cuboid::new(h)), at));
+        }
+    }
+    scene
+}
+
+fn rays() -> Vec<Ray> {
+    let mut rng = Rng::new(8);
+    (0..QUERIES)
+        .map(|_| {
+            let origin = rng.in_ball(60.0);
+            Ray::new(origin, rng.in_ball(40.0) - origin).unwrap()
+        })
+        .collect()
+}
+
+fn ours_indexed(scene: &Scene) -> SpatialIndex {
+    let mut index = SpatialIndex::default();
+    index.update(
+        scene
+            .ours
+            .iter()
+            .enumerate()
+            .map(|(i, (s, p))| (i as u32, s, *p)),
+    );
+    index
+}
+
+fn parry_aabbs(scene: &Scene) -> Vec<ParryAabb> {
+    scene
+        .theirs
+        .iter()
+        .map(|(s, p)| s.compute_aabb(p))
+        .collect()
+}
+
+fn parry_first_hit(bvh: &Bvh, scene: &Scene, ray: &Ray) -> Option<(u32, f32)> {
+    let r = parry3d::query::Ray::new(ray.origin(), ray.direction());
+    bvh.cast_ray(&r, 1.0e3, |i, best| {
+        let (shape, pose) = &scene.theirs[i as usize];
+        shape.cast_ray(pose, &r, best, true)
+    })
+}
+
+fn parry_overlaps(bvh: &Bvh, scene: &Scene, centre: Vec3, out: &mut Vec<u32>) {
+    out.clear();
+    let ball = Ball::new(2.0);
+    let at = parry3d::math::Pose::from_translation(centre);
+    let aabb = ParryAabb::new(centre - Vec3::splat(2.0), centre + Vec3::splat(2.0));
+    for i in bvh.intersect_aabb(&aabb) {
+        let (shape, pose) = &scene.theirs[i as usize];
+        if parry3d::query::intersection_test(&at, &ball, pose, shape.as_ref())
+            .is_ok_and(|hit| hit.intersecting)
+        {
+            out.push(i);
+        }
+    }
+    out.sort_unstable();
+}
+
+/// Prints how often both engines agree, so the timings compare the same work.
+fn check(scene: &Scene, rays: &[Ray]) {
+    let mut ours = ours_indexed(scene);
+    let bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &parry_aabbs(scene));
+    let (mut same, mut hits) = (0, 0);
+    for ray in rays {
+        let a = ours.cast_ray(&*scene.ours, ray, 1.0e3, |_| true).unwrap();
+        let b = parry_first_hit(&bvh, scene, ray);
+        hits += usize::from(a.is_some());
+        let agree = match (a, b) {
+            (Some(a), Some((id, t))) => a.id == id && (a.hit.distance - t).abs() < 1e-3,
+            (None, None) => true,
+            _ => false,
+        };
+        same += usize::from(agree);
+    }
+    let (mut same_sets, mut found) = (0, 0);
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    for ray in rays {
+        let centre = ray.origin() * 0.5;
+        let ball = Shape::sphere(2.0);
+        ours.overlapping(
+            &*scene.ours,
+            (&ball, &Isometry::from_translation(centre)),
+            |_| true,
+            &mut a,
+        );
+        parry_overlaps(&bvh, scene, centre, &mut b);
+        same_sets += usize::from(a == b);
+        found += a.len();
+    }
+    println!(
+        "spatial_queries check: first hits agree on {same} of {} rays ({hits} hit); overlap \
+         sets agree on {same_sets} of {} balls ({found} colliders found)",
+        rays.len(),
+        rays.len()
+    );
+}
+
+fn bench(c: &mut Criterion) {
+    let scene = scene();
+    let rays = rays();
+    check(&scene, &rays);
+    let mut ours = ours_indexed(&scene);
+    let aabbs = parry_aabbs(&scene);
+    let mut bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &aabbs);
+
+    let mut group = c.benchmark_group("ray_first_hit");
+    group.throughput(Throughput::Elements(QUERIES as u64));
+    group.bench_function("urto", |b| {
+        b.iter(|| {
+            for ray in &rays {
+                black_box(ours.cast_ray(&*scene.ours, ray, 1.0e3, |_| true).unwrap());
+            }
+        })
+    });
+    group.bench_function("parry3d", |b| {
+        b.iter(|| {
+            for ray in &rays {
+                black_box(parry_first_hit(&bvh, &scene, ray));
+            }
+        })
+    });
+    group.finish();
+
+    let mut group = c.benchmark_group("sphere_overlap");
+    group.throughput(Throughput::Elements(QUERIES as u64));
+    let mut out = Vec::new();
+    let ball = Shape::sphere(2.0);
+    group.bench_function("urto", |b| {
+        b.iter(|| {
+            for ray in &rays {
+                let at = Isometry::from_translation(ray.origin() * 0.5);
+                ours.overlapping(&*scene.ours, (&ball, &at), |_| true, &mut out);
+                black_box(&out);
+            }
+        })
+    });
+    group.bench_function("parry3d", |b| {
+        b.iter(|| {
+            for ray in &rays {
+                parry_overlaps(&bvh, &scene, ray.origin() * 0.5, &mut out);
+                black_box(&out);
+            }
+        })
+    });
+    group.finish();
+
+    let mut group = c.benchmark_group("tree_10k");
+    let items = || {
+        scene
+            .ours
+            .iter()
+            .enumerate()
+            .map(|(i, (s, p))| (i as u32, s, *p))
+    };
+    group.bench_function("urto_build", |b| {
+        b.iter(|| {
+            let mut fresh = SpatialIndex::default();
+            black_box(fresh.update(items()));
+        })
+    });
+    group.bench_function("parry3d_build", |b| {
+        b.iter(|| black_box(Bvh::from_leaves(BvhBuildStrategy::Binned, &aabbs)))
+    });
+    group.bench_function("urto_refit", |b| b.iter(|| black_box(ours.update(items()))));
+    let mut workspace = BvhWorkspace::default();
+    group.bench_function("parry3d_refit", |b| {
+        b.iter(|| {
+            for (i, (shape, pose)) in scene.theirs.iter().enumerate() {
+                bvh.insert_or_update_partially(shape.compute_aabb(pose), i as u32, 0.0);
+            }
+            bvh.refit(&mut workspace);
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

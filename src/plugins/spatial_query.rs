@@ -1,0 +1,325 @@
+//! Spatial queries for game code: the [`SpatialQuery`] system parameter casts rays and spheres,
+//! lists overlaps and point containment, with a [`SpatialQueryFilter`] (layers, excluded
+//! entities), answered by the core's [`SpatialIndex`] (a box tree over the colliders, never a
+//! scan of every collider).
+//!
+//! ```
+//! # use bevy_ecs::prelude::*;
+//! # use urto::prelude::*;
+//! fn aim(query: SpatialQuery) {
+//!     let hit = query.cast_ray(glam::Vec3::new(0.0, 0.0, 5.0), -glam::Vec3::Z, 100.0,
+//!         &SpatialQueryFilter::default());
+//!     if let Ok(Some(hit)) = hit {
+//!         println!("{:?} at {} m", hit.entity, hit.distance);
+//!     }
+//! }
+//! ```
+//!
+//! The index is built lazily: the first query after a physics step refreshes it (refit in
+//! `O(n)` while the colliders are the same ones, rebuilt when they change), so a game that
+//! never queries pays nothing and one that queries pays once per step, whatever the number of
+//! queries. It sees the world as the last step left it; bodies a game moves or spawns between
+//! steps are seen after the next step, or at once after [`SpatialQuery::refresh`]. Roots are
+//! read at their [`Position`] and [`Rotation`], parts of compound bodies at their
+//! [`GlobalPose`]. Quarantined colliders are never hit.
+
+use crate::components::*;
+use crate::geometry::{Isometry, Shape};
+use crate::plugins::required_resources::RequireResource;
+use crate::spatial::{ColliderLookup, IndexUpdate, LayerMask, QueryError, Ray, SpatialIndex};
+use crate::stats::PhysicsStats;
+use bevy_app::prelude::*;
+use bevy_ecs::prelude::*;
+use bevy_ecs::system::SystemParam;
+use glam::Vec3;
+use std::sync::{Mutex, MutexGuard};
+
+/// Makes the query index a shared resource (without it each system keeps its own).
+#[derive(Debug, Clone, Default)]
+pub struct SpatialQueryPlugin;
+
+impl Plugin for SpatialQueryPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_required::<SpatialQueryIndex>();
+    }
+}
+
+/// The query index of the colliders and the step it was refreshed at.
+#[derive(Resource, Default)]
+pub struct SpatialQueryIndex {
+    state: Mutex<IndexState>,
+}
+
+#[derive(Default)]
+struct IndexState {
+    index: SpatialIndex,
+    /// Entity of each index id.
+    entities: Vec<Entity>,
+    /// The physics step of the last refresh.
+    step: Option<u64>,
+    rebuilds: u64,
+    refits: u64,
+}
+
+impl SpatialQueryIndex {
+    /// How many times the tree was rebuilt and refitted (for tests and the curious).
+    pub fn refreshes(&self) -> (u64, u64) {
+        let state = self.lock();
+        (state.rebuilds, state.refits)
+    }
+
+    fn lock(&self) -> MutexGuard<'_, IndexState> {
+        // A query that panicked mid-refresh leaves a state that the next refresh overwrites.
+        self.state
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+}
+
+/// Which colliders a query may hit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpatialQueryFilter {
+    /// Hit colliders that are members of one of these layers ([`CollisionLayers`]).
+    pub mask: LayerMask,
+    /// Never hit these entities (the caster itself, say).
+    pub excluded: Vec<Entity>,
+}
+
+impl Default for SpatialQueryFilter {
+    fn default() -> Self {
+        Self {
+            mask: LayerMask::ALL,
+            excluded: Vec::new(),
+        }
+    }
+}
+
+impl SpatialQueryFilter {
+    /// Colliders in the layers of `mask`.
+    pub fn from_mask(mask: LayerMask) -> Self {
+        Self {
+            mask,
+            ..Default::default()
+        }
+    }
+
+    /// The same filter, also excluding `entities`.
+    #[must_use]
+    pub fn with_excluded(mut self, entities: impl IntoIterator<Item = Entity>) -> Self {
+        self.excluded.extend(entities);
+        self
+    }
+}
+
+/// A ray's or a cast's hit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RayHit {
+    /// The collider hit (a part, for a compound body).
+    pub entity: Entity,
+    /// Distance along the unit direction (0: the cast started touching or inside).
+    pub distance: f32,
+    /// Where the surfaces meet.
+    pub point: Vec3,
+    /// Unit surface normal at the hit, pointing back toward the caster.
+    pub normal: Vec3,
+}
+
+type QueryCollider = (
+    Entity,
+    &'static Collider,
+    &'static GlobalPose,
+    Option<&'static Position>,
+    Option<&'static Rotation>,
+    Has<ChildOf>,
+    Option<&'static CollisionLayers>,
+);
+
+/// Ray casts, sphere casts, overlap and point queries against the colliders (see the
+/// [module](self)).
+#[derive(SystemParam)]
+pub struct SpatialQuery<'w, 's> {
+    shared: Option<Res<'w, SpatialQueryIndex>>,
+    own: Local<'s, SpatialQueryIndex>,
+    colliders: Query<'w, 's, QueryCollider, Without<Quarantined>>,
+    stats: Option<Res<'w, PhysicsStats>>,
+}
+
+/// The ECS colliders by index id.
+struct Lookup<'a, 'w, 's> {
+    entities: &'a [Entity],
+    colliders: &'a Query<'w, 's, QueryCollider, Without<Quarantined>>,
+}
+
+impl ColliderLookup for Lookup<'_, '_, '_> {
+    fn collider(&self, id: u32) -> Option<(&Shape, Isometry)> {
+        let e = *self.entities.get(id as usize)?;
+        let row = self.colliders.get(e).ok()?;
+        Some((&row.1.shape, pose_of(&row)))
+    }
+}
+
+/// Where a collider is: a root at its position, a part at its global pose.
+fn pose_of((_, _, global, position, rotation, child, _): &QueryItemOf) -> Isometry {
+    match (child, position, rotation) {
+        (false, Some(p), Some(r)) => Isometry::new(p.0, r.0),
+        _ => global.0,
+    }
+}
+
+type QueryItemOf<'a> = (
+    Entity,
+    &'a Collider,
+    &'a GlobalPose,
+    Option<&'a Position>,
+    Option<&'a Rotation>,
+    bool,
+    Option<&'a CollisionLayers>,
+);
+
+impl SpatialQuery<'_, '_> {
+    fn index(&self) -> &SpatialQueryIndex {
+        self.shared.as_deref().unwrap_or(&self.own)
+    }
+
+    /// The index, refreshed if a step ran since (or `force`).
+    fn fresh(&self, force: bool) -> MutexGuard<'_, IndexState> {
+        let mut state = self.index().lock();
+        let step = self.stats.as_ref().map(|s| s.step);
+        if force || step.is_none() || state.step != step {
+            let state = &mut *state;
+            state.entities.clear();
+            state
+                .entities
+                .extend(self.colliders.iter().map(|row| row.0));
+            let rows = self.colliders.iter().enumerate();
+            let colliders = rows.map(|(id, row)| (id as u32, &row.1.shape, pose_of(&row)));
+            match state.index.update(colliders) {
+                IndexUpdate::Refitted => state.refits += 1,
+                IndexUpdate::Rebuilt => state.rebuilds += 1,
+            }
+            state.step = step;
+        }
+        state
+    }
+
+    /// Re-reads every collider's pose now (after a game moved or spawned bodies between steps).
+    pub fn refresh(&self) {
+        drop(self.fresh(true));
+    }
+
+    /// Whether the collider `id` passes `filter`.
+    fn accepts(&self, entities: &[Entity], id: u32, filter: &SpatialQueryFilter) -> bool {
+        let Some(&e) = entities.get(id as usize) else {
+            return false;
+        };
+        let layers = self.colliders.get(e).ok().map(|row| row.6);
+        let member =
+            |l: Option<&CollisionLayers>| l.map_or(LayerMask::DEFAULT, |l| l.0.memberships);
+        layers.is_some_and(|l| member(l).intersects(filter.mask)) && !filter.excluded.contains(&e)
+    }
+
+    /// The nearest collider the ray from `origin` along `direction` hits within `max_distance`
+    /// (`f32::INFINITY`: no limit). A ray starting inside a solid hits it at distance 0.
+    pub fn cast_ray(
+        &self,
+        origin: Vec3,
+        direction: Vec3,
+        max_distance: f32,
+        filter: &SpatialQueryFilter,
+    ) -> Result<Option<RayHit>, QueryError> {
+        self.cast_sphere(0.0, origin, direction, max_distance, filter)
+    }
+
+    /// The nearest collider a ball of `radius` moving from `origin` along `direction` meets
+    /// within `max_distance`.
+    pub fn cast_sphere(
+        &self,
+        radius: f32,
+        origin: Vec3,
+        direction: Vec3,
+        max_distance: f32,
+        filter: &SpatialQueryFilter,
+    ) -> Result<Option<RayHit>, QueryError> {
+        let ray = Ray::new(origin, direction)?;
+        let mut state = self.fresh(false);
+        let IndexState {
+            index, entities, ..
+        } = &mut *state;
+        let lookup = Lookup {
+            entities,
+            colliders: &self.colliders,
+        };
+        let accept = |id| self.accepts(entities, id, filter);
+        let hit = index.cast_sphere(&lookup, &ray, radius, max_distance, accept)?;
+        Ok(hit.map(|h| to_ray_hit(entities, h)))
+    }
+
+    /// Every collider the ray hits within `max_distance`, nearest first.
+    pub fn cast_ray_all(
+        &self,
+        origin: Vec3,
+        direction: Vec3,
+        max_distance: f32,
+        filter: &SpatialQueryFilter,
+    ) -> Result<Vec<RayHit>, QueryError> {
+        let ray = Ray::new(origin, direction)?;
+        let mut state = self.fresh(false);
+        let IndexState {
+            index, entities, ..
+        } = &mut *state;
+        let lookup = Lookup {
+            entities,
+            colliders: &self.colliders,
+        };
+        let accept = |id| self.accepts(entities, id, filter);
+        let mut hits = Vec::new();
+        index.cast_ray_all(&lookup, &ray, max_distance, accept, &mut hits)?;
+        Ok(hits.into_iter().map(|h| to_ray_hit(entities, h)).collect())
+    }
+
+    /// The colliders that `shape` placed at `pose` touches or overlaps (meshes are surfaces).
+    pub fn overlapping(
+        &self,
+        shape: &Shape,
+        pose: Isometry,
+        filter: &SpatialQueryFilter,
+    ) -> Result<Vec<Entity>, QueryError> {
+        if !pose.is_finite() {
+            return Err(QueryError::NonFiniteOrigin(pose.translation));
+        }
+        let mut state = self.fresh(false);
+        let IndexState {
+            index, entities, ..
+        } = &mut *state;
+        let lookup = Lookup {
+            entities,
+            colliders: &self.colliders,
+        };
+        let accept = |id| self.accepts(entities, id, filter);
+        let mut ids = Vec::new();
+        index.overlapping(&lookup, (shape, &pose), accept, &mut ids);
+        Ok(ids.into_iter().map(|id| entities[id as usize]).collect())
+    }
+
+    /// The colliders holding `point` (inside or on a solid; on a mesh's surface).
+    pub fn containing_point(
+        &self,
+        point: Vec3,
+        filter: &SpatialQueryFilter,
+    ) -> Result<Vec<Entity>, QueryError> {
+        self.overlapping(
+            &Shape::sphere(0.0),
+            Isometry::from_translation(point),
+            filter,
+        )
+    }
+}
+
+fn to_ray_hit(entities: &[Entity], h: crate::spatial::QueryHit) -> RayHit {
+    RayHit {
+        entity: entities[h.id as usize],
+        distance: h.hit.distance,
+        point: h.hit.point,
+        normal: h.hit.normal,
+    }
+}

@@ -1,0 +1,262 @@
+//! The query index: every collider's box in an [`AabbTree`] (half-spaces aside, tested
+//! directly), and the queries a game asks — first hit and all hits of a ray, a sphere cast,
+//! the colliders overlapping a shape, the colliders containing a point — answered by visiting
+//! only the boxes the query meets and testing those shapes exactly (the shape tests of
+//! [`crate::ccd`] and [`crate::geometry::contacts`], meshes through their own hierarchies).
+//!
+//! The index stores boxes and ids, not shapes: each query reads the shapes it tests through a
+//! [`ColliderLookup`] (the ECS's query, or a slice in the core's tests), and a filter closure
+//! (layers, excluded entities) refuses candidates before any exact test. Results are
+//! deterministic: hits at equal distances are ordered by id.
+
+use super::cast::{CastHit, QueryError, Ray, cast_sphere, check_max_distance};
+use super::tree::{AabbTree, RaySegment};
+use crate::bounding::Aabb;
+use crate::bvh::QueryScratch;
+use crate::geometry::contacts::{ContactScratch, contact_with_scratch};
+use crate::geometry::{Isometry, Shape};
+use glam::Vec3;
+
+/// Where the queries read the colliders they test.
+pub trait ColliderLookup {
+    /// Collider `id`'s shape and world pose; `None` if it is gone (it is then skipped).
+    fn collider(&self, id: u32) -> Option<(&Shape, Isometry)>;
+}
+
+impl ColliderLookup for [(Shape, Isometry)] {
+    fn collider(&self, id: u32) -> Option<(&Shape, Isometry)> {
+        self.get(id as usize).map(|(s, p)| (s, *p))
+    }
+}
+
+/// A hit of a ray or a cast: which collider, and where.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct QueryHit {
+    /// The collider's id in the index.
+    pub id: u32,
+    /// Where, how far, and the surface normal.
+    pub hit: CastHit,
+}
+
+/// How the last [`SpatialIndex::update`] kept the tree.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IndexUpdate {
+    /// The same colliders in the same order: boxes refitted, `O(n)`.
+    Refitted,
+    /// Colliders came or went: tree rebuilt, `O(n log n)`.
+    Rebuilt,
+}
+
+/// The colliders' boxes and the buffers of the queries.
+#[derive(Debug, Default)]
+pub struct SpatialIndex {
+    tree: AabbTree,
+    /// Half-spaces (and any shape with a box that is not finite): tested by every query.
+    unbounded: Vec<u32>,
+    items: Vec<(u32, Aabb)>,
+    node_stack: Vec<u32>,
+    ray_stack: Vec<(u32, f32)>,
+    candidates: Vec<u32>,
+    mesh: QueryScratch,
+    contact: ContactScratch,
+}
+
+impl SpatialIndex {
+    /// Indexes `colliders` (`id`, shape, world pose).
+    pub fn update<'a>(
+        &mut self,
+        colliders: impl IntoIterator<Item = (u32, &'a Shape, Isometry)>,
+    ) -> IndexUpdate {
+        self.items.clear();
+        self.unbounded.clear();
+        for (id, shape, pose) in colliders {
+            let aabb = shape.world_aabb(&pose);
+            if aabb.is_valid() && aabb.is_finite() {
+                self.items.push((id, aabb));
+            } else {
+                self.unbounded.push(id);
+            }
+        }
+        if self.tree.refit(&self.items) {
+            IndexUpdate::Refitted
+        } else {
+            self.tree.build(&self.items);
+            IndexUpdate::Rebuilt
+        }
+    }
+
+    /// Colliders indexed (bounded and unbounded).
+    pub fn len(&self) -> usize {
+        self.tree.len() + self.unbounded.len()
+    }
+
+    /// Whether nothing is indexed.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The nearest collider `accept`ed that `ray` hits within `max_distance`.
+    pub fn cast_ray<L: ColliderLookup + ?Sized>(
+        &mut self,
+        colliders: &L,
+        ray: &Ray,
+        max_distance: f32,
+        accept: impl FnMut(u32) -> bool,
+    ) -> Result<Option<QueryHit>, QueryError> {
+        self.cast_sphere(colliders, ray, 0.0, max_distance, accept)
+    }
+
+    /// The nearest collider `accept`ed that a sphere of `radius` moving along `ray` meets
+    /// within `max_distance` (`radius` 0: a ray).
+    pub fn cast_sphere<L: ColliderLookup + ?Sized>(
+        &mut self,
+        colliders: &L,
+        ray: &Ray,
+        radius: f32,
+        max_distance: f32,
+        mut accept: impl FnMut(u32) -> bool,
+    ) -> Result<Option<QueryHit>, QueryError> {
+        let max = check_max_distance(max_distance)?;
+        check_radius(radius)?;
+        let mut best: Option<QueryHit> = None;
+        let mut consider = |id: u32, mesh: &mut QueryScratch| -> Option<f32> {
+            if !accept(id) {
+                return None;
+            }
+            // Cast to the query's own limit, not the nearest hit's, so that a shape's distance
+            // does not depend on the order the tree found it in (the sweep's length scales it).
+            if let Some(hit) = exact_cast(colliders, id, ray, radius, max, mesh) {
+                let nearer = best.is_none_or(|b| {
+                    hit.distance < b.hit.distance || (hit.distance == b.hit.distance && id < b.id)
+                });
+                if nearer {
+                    best = Some(QueryHit { id, hit });
+                }
+            }
+            // Boxes entered beyond the nearest hit so far cannot hold a nearer one.
+            best.map(|b| b.hit.distance)
+        };
+        for i in 0..self.unbounded.len() {
+            consider(self.unbounded[i], &mut self.mesh);
+        }
+        let segment = RaySegment::new(ray.origin(), ray.direction());
+        let mesh = &mut self.mesh;
+        self.tree
+            .along_ray(&segment, radius, max, &mut self.ray_stack, |id, _| {
+                consider(id, mesh)
+            });
+        Ok(best)
+    }
+
+    /// Every collider `accept`ed that `ray` hits within `max_distance`, nearest first (ties by
+    /// id), each once, in `out` (cleared first).
+    pub fn cast_ray_all<L: ColliderLookup + ?Sized>(
+        &mut self,
+        colliders: &L,
+        ray: &Ray,
+        max_distance: f32,
+        mut accept: impl FnMut(u32) -> bool,
+        out: &mut Vec<QueryHit>,
+    ) -> Result<(), QueryError> {
+        let max = check_max_distance(max_distance)?;
+        out.clear();
+        let mut consider = |id: u32, mesh: &mut QueryScratch| {
+            if accept(id)
+                && let Some(hit) = exact_cast(colliders, id, ray, 0.0, max, mesh)
+            {
+                out.push(QueryHit { id, hit });
+            }
+        };
+        for i in 0..self.unbounded.len() {
+            consider(self.unbounded[i], &mut self.mesh);
+        }
+        let segment = RaySegment::new(ray.origin(), ray.direction());
+        let mesh = &mut self.mesh;
+        self.tree
+            .along_ray(&segment, 0.0, max, &mut self.ray_stack, |id, _| {
+                consider(id, mesh);
+                None
+            });
+        out.sort_by(|a, b| {
+            a.hit
+                .distance
+                .total_cmp(&b.hit.distance)
+                .then(a.id.cmp(&b.id))
+        });
+        Ok(())
+    }
+
+    /// The colliders `accept`ed that `shape` at `pose` touches or overlaps, ascending ids, in
+    /// `out` (cleared first). Meshes are surfaces: a shape wholly inside a closed mesh does not
+    /// touch it. Two half-spaces are never reported (no test covers the pair).
+    pub fn overlapping<L: ColliderLookup + ?Sized>(
+        &mut self,
+        colliders: &L,
+        (shape, pose): (&Shape, &Isometry),
+        mut accept: impl FnMut(u32) -> bool,
+        out: &mut Vec<u32>,
+    ) {
+        out.clear();
+        self.candidates.clear();
+        self.candidates.extend_from_slice(&self.unbounded);
+        let query_box = shape.world_aabb(pose);
+        let candidates = &mut self.candidates;
+        self.tree
+            .overlapping(&query_box, &mut self.node_stack, |id| candidates.push(id));
+        for &id in &self.candidates {
+            if !accept(id) {
+                continue;
+            }
+            let Some((other, other_pose)) = colliders.collider(id) else {
+                continue;
+            };
+            let touching =
+                contact_with_scratch(shape, pose, other, &other_pose, &mut self.contact).is_some();
+            if touching {
+                out.push(id);
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+    }
+
+    /// The colliders `accept`ed holding `point` (inside or on a solid; on a mesh's surface),
+    /// ascending ids, in `out` (cleared first).
+    pub fn containing<L: ColliderLookup + ?Sized>(
+        &mut self,
+        colliders: &L,
+        point: Vec3,
+        accept: impl FnMut(u32) -> bool,
+        out: &mut Vec<u32>,
+    ) -> Result<(), QueryError> {
+        if !point.is_finite() {
+            return Err(QueryError::NonFiniteOrigin(point));
+        }
+        let at = Isometry::from_translation(point);
+        self.overlapping(colliders, (&Shape::sphere(0.0), &at), accept, out);
+        Ok(())
+    }
+}
+
+/// Refuses a cast radius that is negative or not finite.
+fn check_radius(radius: f32) -> Result<(), QueryError> {
+    if radius.is_finite() && radius >= 0.0 {
+        Ok(())
+    } else {
+        Err(QueryError::BadRadius(radius))
+    }
+}
+
+/// The cast of collider `id` (looked up) within `max`.
+fn exact_cast<L: ColliderLookup + ?Sized>(
+    colliders: &L,
+    id: u32,
+    ray: &Ray,
+    radius: f32,
+    max: f32,
+    mesh: &mut QueryScratch,
+) -> Option<CastHit> {
+    let (shape, pose) = colliders.collider(id)?;
+    let aabb = shape.world_aabb(&pose);
+    cast_sphere(ray, radius, max, (shape, &pose, &aabb), mesh)
+}

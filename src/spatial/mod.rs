@@ -1,0 +1,26 @@
+//! Spatial queries and collision layers: what a game asks of the physics world besides
+//! stepping it — "what does this ray hit?", "what is inside this volume?", "which colliders
+//! may touch?" (rapier's query pipeline and `InteractionGroups`, Avian's `SpatialQuery` and
+//! `CollisionLayers`).
+//!
+//! - [`layers`]: membership and filter bit masks, checked per collider pair in the narrow phase
+//!   and per candidate in the queries.
+//! - [`tree`]: a bounding-volume tree over the colliders' boxes, refitted while the colliders
+//!   stay the same and rebuilt when they change.
+//! - [`cast`]: a ray or a sphere cast against one shape, through the exact times of impact of
+//!   [`crate::ccd`] (a ray is a sweep of radius 0).
+//! - [`index`]: the queries over the tree — ray casts (first hit, all hits), sphere casts,
+//!   overlaps and point queries — with a filter, never a scan of every collider.
+//!
+//! The ECS face is [`SpatialQuery`](crate::plugins::SpatialQuery), which keeps a
+//! [`SpatialIndex`] of the colliders' world poses after each step.
+
+pub mod cast;
+pub mod index;
+pub mod layers;
+pub mod tree;
+
+pub use cast::{CastHit, QueryError, Ray, cast_sphere};
+pub use index::{ColliderLookup, IndexUpdate, QueryHit, SpatialIndex};
+pub use layers::{LayerMask, Layers};
+pub use tree::{AabbTree, RaySegment};
