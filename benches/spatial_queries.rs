@@ -9,6 +9,9 @@
 //!   and `refit`, as rapier does each step).
 //!
 //! Before timing, the answers are compared and printed: the same first hits, the same overlaps.
+//! (Hits more than 1 mm apart are rays grazing a ball 40–90 m away, where the chord is nearly
+//! zero and the 5e-8 by which an f32 unit direction misses length 1 moves the hit by
+//! millimetres in either engine.)
 //! A quick run: `cargo bench --bench spatial_queries -- --quick`.
 
 #[allow(dead_code)]
@@ -117,17 +120,18 @@ fn parry_overlaps(bvh: &Bvh, scene: &Scene, centre: Vec3, out: &mut Vec<u32>) {
 fn check(scene: &Scene, rays: &[Ray]) {
     let mut ours = ours_indexed(scene);
     let bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, &parry_aabbs(scene));
-    let (mut same, mut hits) = (0, 0);
+    let (mut same, mut same_collider, mut hits) = (0, 0, 0);
     for ray in rays {
         let a = ours.cast_ray(&*scene.ours, ray, 1.0e3, |_| true).unwrap();
         let b = parry_first_hit(&bvh, scene, ray);
         hits += usize::from(a.is_some());
-        let agree = match (a, b) {
-            (Some(a), Some((id, t))) => a.id == id && (a.hit.distance - t).abs() < 1e-3,
-            (None, None) => true,
-            _ => false,
+        let (collider, distance) = match (a, b) {
+            (Some(a), Some((id, t))) => (a.id == id, (a.hit.distance - t).abs() < 1e-3),
+            (None, None) => (true, true),
+            _ => (false, false),
         };
-        same += usize::from(agree);
+        same_collider += usize::from(collider);
+        same += usize::from(collider && distance);
     }
     let (mut same_sets, mut found) = (0, 0);
     let (mut a, mut b) = (Vec::new(), Vec::new());
@@ -145,8 +149,9 @@ fn check(scene: &Scene, rays: &[Ray]) {
         found += a.len();
     }
     println!(
-        "spatial_queries check: first hits agree on {same} of {} rays ({hits} hit); overlap \
-         sets agree on {same_sets} of {} balls ({found} colliders found)",
+        "spatial_queries check: first hits on the same collider for {same_collider} of {} rays \
+         ({hits} hit), within 1 mm for {same}; overlap sets agree on {same_sets} of {} balls \
+         ({found} colliders found)",
         rays.len(),
         rays.len()
     );

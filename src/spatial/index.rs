@@ -13,6 +13,7 @@ use super::cast::{CastHit, QueryError, Ray, cast_sphere, check_max_distance};
 use super::tree::{AabbTree, RaySegment};
 use crate::bounding::Aabb;
 use crate::bvh::QueryScratch;
+use crate::ccd::CONTACT_TOLERANCE_RELATIVE;
 use crate::geometry::contacts::{ContactScratch, contact_with_scratch};
 use crate::geometry::{Isometry, Shape};
 use glam::Vec3;
@@ -85,6 +86,21 @@ impl SpatialIndex {
         }
     }
 
+    /// How much the boxes are grown for a cast: the exact tests accept hits within
+    /// [`SphereSweep::tolerance`](crate::ccd::SphereSweep::tolerance) of a shape, relative to
+    /// the sweep's length, which is at most the distance across the tree's boxes; grown by it,
+    /// no box culls a shape the exact test would hit.
+    fn slack(&self, ray: &Ray, radius: f32, max: f32) -> f32 {
+        let bounds = self.tree.bounds();
+        let across = (ray.origin() - bounds.center()).length() + bounds.half_extents().length();
+        let length = if across.is_finite() {
+            across.min(max)
+        } else {
+            max
+        };
+        2.0 * CONTACT_TOLERANCE_RELATIVE * (radius + length + 1.0)
+    }
+
     /// Colliders indexed (bounded and unbounded).
     pub fn len(&self) -> usize {
         self.tree.len() + self.unbounded.len()
@@ -140,9 +156,10 @@ impl SpatialIndex {
             consider(self.unbounded[i], &mut self.mesh);
         }
         let segment = RaySegment::new(ray.origin(), ray.direction());
+        let grow = radius + self.slack(ray, radius, max);
         let mesh = &mut self.mesh;
         self.tree
-            .along_ray(&segment, radius, max, &mut self.ray_stack, |id, _| {
+            .along_ray(&segment, grow, max, &mut self.ray_stack, |id, _| {
                 consider(id, mesh)
             });
         Ok(best)
@@ -171,9 +188,10 @@ impl SpatialIndex {
             consider(self.unbounded[i], &mut self.mesh);
         }
         let segment = RaySegment::new(ray.origin(), ray.direction());
+        let grow = self.slack(ray, 0.0, max);
         let mesh = &mut self.mesh;
         self.tree
-            .along_ray(&segment, 0.0, max, &mut self.ray_stack, |id, _| {
+            .along_ray(&segment, grow, max, &mut self.ray_stack, |id, _| {
                 consider(id, mesh);
                 None
             });
