@@ -246,6 +246,17 @@ pub struct StepStartPose(pub Isometry);
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Ccd;
 
+/// A collider that detects overlaps without pushing: a trigger volume (a goal, a pickup, a
+/// damage zone). Its overlaps start and end
+/// [`CollisionStarted`](crate::plugins::CollisionStarted) and
+/// [`CollisionEnded`](crate::plugins::CollisionEnded) messages as contacts do, and are listed in
+/// [`SensorOverlaps`](crate::plugins::narrow_phase::SensorOverlaps), but the solver never sees
+/// them: no push, no island (a body resting in a sensor sleeps as it would outside it, and a
+/// sleeping body keeps overlapping), and continuous collision passes through sensors. Works on
+/// static, kinematic and dynamic bodies, and on one part of a compound.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Sensor;
+
 /// Which collision layers a collider is in and which it interacts with (see
 /// [`crate::spatial::layers`]): two colliders touch only when each is a member of a layer the
 /// other filters, and a [`SpatialQuery`](crate::plugins::SpatialQuery) sees colliders whose

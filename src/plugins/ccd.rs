@@ -11,7 +11,8 @@
 //! impact also becomes a contact of the substep, so collision messages report it.
 //!
 //! Only static scenery is swept against; fast bodies meeting each other are left to the
-//! discrete step (and substeps). A body already touching a surface at the start of its motion
+//! discrete step (and substeps). Sensors neither sweep nor stop a sweep, and colliders whose
+//! [`CollisionLayers`] do not interact pass through each other here too. A body already touching a surface at the start of its motion
 //! is the contact solver's business, not an impact.
 
 use crate::bvh::QueryScratch;
@@ -125,6 +126,7 @@ type Mover<'a> = (
 );
 type MovingRoot = (
     Without<Static>,
+    Without<Sensor>,
     Without<Quarantined>,
     Without<ChildOf>,
     Without<Sleeping>,
@@ -181,6 +183,7 @@ type Obstacle<'a> = (
     Option<&'a Children>,
     Option<&'a Restitution>,
     Option<&'a CollisionLayers>,
+    Has<Sensor>,
 );
 
 /// Sweeps each recorded body from its start to where the integrator put it.
@@ -282,7 +285,8 @@ fn first_impact(
         s.stack.clear();
         s.stack.push(root);
         while let Some(node) = s.stack.pop() {
-            let Ok((collider, global, bv, children, e, node_layers)) = obstacles.get(node) else {
+            let Ok((collider, global, bv, children, e, node_layers, sensor)) = obstacles.get(node)
+            else {
                 continue;
             };
             if !bv.0.intersects(&swept) {
@@ -292,7 +296,7 @@ fn first_impact(
             let Some(c) = collider else {
                 continue;
             };
-            if !layers.interacts_with(&layers_of(node_layers)) {
+            if sensor || !layers.interacts_with(&layers_of(node_layers)) {
                 continue;
             }
             let Some(hit) = toi_sphere_shape(sweep, &c.shape, &global.0, &mut s.query) else {

@@ -1,5 +1,5 @@
 //! Collision started / ended messages: each substep's touching pairs compared with the last
-//! substep's.
+//! substep's, and likewise the overlaps of [`Sensor`]s (which the solver never sees).
 //!
 //! Pairs of sleeping or static bodies are not tested (nothing moved), so they are not in the
 //! substep's contacts; they are kept aside, sorted, as the *dormant* pairs, and looked at again
@@ -9,7 +9,7 @@
 //! asleep ends no collision.
 
 use crate::components::*;
-use crate::plugins::narrow_phase::Contacts;
+use crate::plugins::narrow_phase::{Contacts, SensorOverlaps};
 use crate::plugins::required_resources::RequireResource;
 use crate::plugins::sleep::{Waker, dormant};
 use crate::stats::PhysicsStats;
@@ -62,6 +62,8 @@ pub(crate) struct TouchingPairs {
     active: Vec<Pair>,
     /// Pairs of sleeping or static bodies: untested, touching until one of them wakes or goes.
     dormant: Vec<Pair>,
+    /// Pairs overlapping through a [`Sensor`] (the pairs of [`SensorOverlaps`]).
+    sensing: Vec<Pair>,
 }
 
 /// Whether the bodies of a pair are both static or asleep.
@@ -77,6 +79,7 @@ pub(crate) fn report_collisions(
     mut woke: RemovedComponents<Sleeping>,
     mut unfixed: RemovedComponents<Static>,
     mut despawned: RemovedComponents<BoundingVolume>,
+    overlaps: Option<Res<SensorOverlaps>>,
     mut fresh: Local<Vec<Pair>>,
     mut previous: Local<Vec<Pair>>,
     mut started: MessageWriter<CollisionStarted>,
@@ -156,9 +159,56 @@ pub(crate) fn report_collisions(
         touching.dormant.retain(|p| p.0 != Entity::PLACEHOLDER);
     }
     touching.active.clone_from(&fresh);
+    if let Some(overlaps) = overlaps {
+        fresh.clear();
+        fresh.extend(overlaps.pairs.iter().map(|p| (p.a.min(p.b), p.a.max(p.b))));
+        let dormant_pair = |(a, b): Pair| is_dormant(a, &bodies) && is_dormant(b, &bodies);
+        report_sensors(
+            &mut fresh,
+            &mut touching.sensing,
+            dormant_pair,
+            &mut started,
+            &mut ended,
+        );
+    }
     // Every pair touching now, tested this substep or at rest asleep.
     let all = touching.active.len() + touching.dormant.len();
     stats.set_counter("collisions/touching_pairs", all as f64);
+}
+
+/// The sensor overlaps' messages: `fresh` (this substep's pairs) against `sensing` (the last
+/// one's). A pair of two sleeping or static bodies is not tested, so it keeps overlapping (it
+/// neither starts nor ends); a sensor's overlap never wakes anything.
+fn report_sensors(
+    fresh: &mut Vec<Pair>,
+    sensing: &mut Vec<Pair>,
+    dormant: impl Fn(Pair) -> bool,
+    started: &mut MessageWriter<CollisionStarted>,
+    ended: &mut MessageWriter<CollisionEnded>,
+) {
+    fresh.sort_unstable();
+    fresh.dedup();
+    let mut kept = false;
+    for &(a, b) in sensing.iter() {
+        if fresh.binary_search(&(a, b)).is_ok() {
+            continue;
+        }
+        if dormant((a, b)) {
+            fresh.push((a, b));
+            kept = true;
+        } else {
+            ended.write(CollisionEnded { a, b });
+        }
+    }
+    for &(a, b) in fresh.iter() {
+        if sensing.binary_search(&(a, b)).is_err() {
+            started.write(CollisionStarted { a, b });
+        }
+    }
+    if kept {
+        fresh.sort_unstable();
+    }
+    sensing.clone_from(fresh);
 }
 
 /// Advances the collision message buffers once per standalone step (an `App` does this itself

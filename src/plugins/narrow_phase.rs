@@ -19,7 +19,9 @@
 //! `narrow_phase/bvh_nodes_visited`, `narrow_phase/bv_tests` and `narrow_phase/triangle_tests`
 //! (with `narrow_phase/mesh_pairs`, the mesh queries run) once a mesh pair has been tested.
 //!
-//! Collider pairs whose [`CollisionLayers`] do not interact are skipped before any shape test.
+//! Collider pairs whose [`CollisionLayers`] do not interact are skipped before any shape test;
+//! pairs with a [`Sensor`] are tested for overlap only (no lookahead) and listed in
+//! [`SensorOverlaps`], apart from the contacts the solver sees.
 //!
 //! For debugging, [`OverlappingLeaves`] can list, per mesh pair in contact, the leaves of the
 //! hierarchies whose triangles touched, and [`HierarchyVisits`] the scene-graph nodes the descent
@@ -82,6 +84,28 @@ pub struct ContactPair {
     pub normal_impulse: f32,
 }
 
+/// A sensor's overlap: `a` and `b` are the root bodies, `collider_a` and `collider_b` the parts
+/// that overlap (at least one of them a [`Sensor`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SensorPair {
+    /// First body (a moving one).
+    pub a: Entity,
+    /// Second body.
+    pub b: Entity,
+    /// The collider of `a`'s hierarchy that overlaps.
+    pub collider_a: Entity,
+    /// The collider of `b`'s hierarchy that overlaps.
+    pub collider_b: Entity,
+}
+
+/// The overlaps involving a [`Sensor`] in this substep, in the broad phase's pair order: kept
+/// out of [`Contacts`], so nothing responds to them.
+#[derive(Resource, Debug, Default, Clone)]
+pub struct SensorOverlaps {
+    /// The overlapping pairs.
+    pub pairs: Vec<SensorPair>,
+}
+
 /// The contacts of this substep, in the broad phase's pair order.
 #[derive(Resource, Debug, Default, Clone)]
 pub struct Contacts {
@@ -134,6 +158,7 @@ struct NarrowPhaseScratch {
 impl Plugin for NarrowPhasePlugin {
     fn build(&self, app: &mut App) {
         app.init_required::<Contacts>()
+            .init_required::<SensorOverlaps>()
             .init_required::<NarrowPhaseScratch>()
             .init_required::<OverlappingLeaves>()
             .init_required::<HierarchyVisits>()
@@ -209,6 +234,8 @@ fn compute_contacts(
     dormancy: Query<Dormancy>,
     motion: Query<Motion>,
     layers: Query<&CollisionLayers>,
+    sensors: Query<(), With<Sensor>>,
+    mut overlaps: ResMut<SensorOverlaps>,
     lookahead: LookaheadParams,
     sleep: Option<Res<SleepSettings>>,
     mut contacts: ResMut<Contacts>,
@@ -236,11 +263,16 @@ fn compute_contacts(
     };
     let start = Instant::now();
     contacts.pairs.clear();
+    overlaps.pairs.clear();
     let sleeping = sleep.is_some_and(|s| s.enabled);
     let dormant = |e: Entity| dormant(dormancy.get(e).ok());
-    // Layers are per collider: a compound's parts may filter differently.
+    // Layers and sensors are per collider (a compound's parts may differ), and a scene without
+    // any pays no lookup for them.
+    let (any_layers, any_sensors) = (!layers.is_empty(), !sensors.is_empty());
+    let sensing =
+        |x: Entity, y: Entity| any_sensors && (sensors.contains(x) || sensors.contains(y));
     let interacts = |x: Entity, y: Entity| {
-        layers_of(layers.get(x).ok()).interacts_with(&layers_of(layers.get(y).ok()))
+        !any_layers || layers_of(layers.get(x).ok()).interacts_with(&layers_of(layers.get(y).ok()))
     };
     for &(a, b) in &pairs.pairs {
         if sleeping && dormant(a) && dormant(b) {
@@ -249,7 +281,9 @@ fn compute_contacts(
         let margin = margin(a) + margin(b);
         let compound = |e: Entity| matches!(nodes.get(e), Ok((.., Some(_))));
         if !compound(a) && !compound(b) {
-            if interacts(a, b) {
+            if interacts(a, b) && sensing(a, b) {
+                scratch.test_sensor(&nodes, (a, b), (a, b), &mut overlaps);
+            } else if interacts(a, b) {
                 scratch.test_leaves(&nodes, (a, b), (a, b), margin, &mut contacts, &mut debug);
             }
             continue;
@@ -282,6 +316,10 @@ fn compute_contacts(
             if !interacts(leaves.0, leaves.1) {
                 continue;
             }
+            if sensing(leaves.0, leaves.1) {
+                scratch.test_sensor(&nodes, (a, b), leaves, &mut overlaps);
+                continue;
+            }
             scratch.test_leaves(&nodes, (a, b), leaves, margin, &mut contacts, &mut debug);
         }
     }
@@ -309,6 +347,29 @@ fn compute_contacts(
 }
 
 impl NarrowPhaseScratch {
+    /// Tests a pair with a sensor for overlap (no lookahead: a sensor reports what overlaps
+    /// now) and lists it in `overlaps`.
+    fn test_sensor(
+        &mut self,
+        nodes: &Query<Node, Without<Quarantined>>,
+        (a, b): (Entity, Entity),
+        (la, lb): (Entity, Entity),
+        overlaps: &mut SensorOverlaps,
+    ) {
+        let (Ok((Some(ca), ga, ..)), Ok((Some(cb), gb, ..))) = (nodes.get(la), nodes.get(lb))
+        else {
+            return;
+        };
+        if contact_with_scratch(&ca.shape, &ga.0, &cb.shape, &gb.0, &mut self.contact).is_some() {
+            overlaps.pairs.push(SensorPair {
+                a,
+                b,
+                collider_a: la,
+                collider_b: lb,
+            });
+        }
+    }
+
     /// Tests collider `leaves.0` (of body `roots.0`) against collider `leaves.1` (of `roots.1`)
     /// at their world poses, looking `margin` ahead; a mesh goes through its BVH.
     fn test_leaves(

@@ -1,8 +1,9 @@
 //! Four contacts solved at once: the rows of [`ContactConstraint`] laid out one contact per
 //! SIMD lane (Box2D v3's `contact_solver.c` wide path, rapier's `ContactWithTwistFriction<SimdReal>`).
 //!
-//! The contacts of a batch come from one colour ([`Colouring`](super::colouring::Colouring)),
-//! so no two lanes move the same body: the batch gathers its bodies' velocities, runs exactly the
+//! The contacts of a batch move no common body
+//! ([`OrderedBatches`](super::ordered_batches::OrderedBatches)), so no two lanes write the same
+//! velocities: the batch gathers its bodies' velocities, runs exactly the
 //! scalar solver's arithmetic ([`ContactConstraint::solve`], whose module derives the rows) in
 //! every lane, and scatters the velocities back. A lane whose contact has fewer points than the
 //! batch's largest, and the padding lanes of a short batch, hold zero rows: their impulses come
@@ -79,7 +80,7 @@ impl PointX4 {
     }
 }
 
-/// Four contacts of one colour, solved side by side.
+/// Up to four contacts that move no common body, solved side by side.
 #[derive(Clone, Debug)]
 pub struct ContactBatch {
     /// Which constraint each lane holds (`None`: padding).
@@ -103,7 +104,7 @@ pub struct ContactBatch {
 }
 
 impl ContactBatch {
-    /// Packs `indices` (1 to [`LANES`] constraints of one colour) of `constraints`.
+    /// Packs `indices` (1 to [`LANES`] constraints moving no common body) of `constraints`.
     pub fn pack(indices: &[u32], constraints: &[ContactConstraint]) -> Self {
         let lanes: [Option<&ContactConstraint>; LANES] =
             std::array::from_fn(|l| indices.get(l).map(|&i| &constraints[i as usize]));
