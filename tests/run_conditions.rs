@@ -111,3 +111,122 @@ fn springs_pull_towards_their_rest_length() {
         "damped spring should settle at rest length: {x}"
     );
 }
+
+/// A scene using every stage: ground, a resting ball, a falling box, a pushed ball, a compound
+/// with a part, a sensor and a fast CCD ball.
+fn busy_scene(app: &mut bevy_app::App) -> [bevy_ecs::entity::Entity; 2] {
+    use bevy_ecs::hierarchy::ChildOf;
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    let world = app.world_mut();
+    world.spawn((Collider::half_space(Vec3::Z), Static));
+    let resting = world
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(0.0, 0.0, 0.5),
+            Velocity::default(),
+        ))
+        .id();
+    let falling = world
+        .spawn((
+            Collider::cuboid(0.5, 0.5, 0.5),
+            Position::new(3.0, 0.0, 3.0),
+            Velocity::default(),
+        ))
+        .id();
+    world.spawn((
+        Collider::sphere(0.3),
+        Position::new(-3.0, 0.0, 0.3),
+        Velocity::default(),
+        Force(Vec3::new(5.0, 0.0, 0.0)),
+    ));
+    let root = world
+        .spawn((
+            Collider::cuboid(0.2, 0.2, 0.2),
+            Position::new(0.0, 4.0, 2.0),
+            Velocity::default(),
+        ))
+        .id();
+    world.spawn((
+        Collider::sphere(0.2),
+        Position::new(0.5, 0.0, 0.0),
+        ChildOf(root),
+    ));
+    world.spawn((
+        Collider::cuboid(1.0, 1.0, 1.0),
+        Position::new(6.0, 0.0, 1.0),
+        Static,
+        Sensor,
+    ));
+    world.spawn((
+        Collider::sphere(0.1),
+        Position::new(-6.0, 3.0, 1.0),
+        Velocity(Vec3::new(200.0, 0.0, 0.0)),
+        Ccd,
+    ));
+    [resting, falling]
+}
+
+#[test]
+fn every_plugin_of_the_group_can_be_disabled_and_a_busy_scene_steps_without_a_panic_the_ball_resting_within_2_cm()
+ {
+    use bevy_app::{App, PluginGroup};
+    use urto::plugins::*;
+    fn without<P: bevy_app::Plugin>() -> App {
+        let mut app = App::new();
+        app.add_plugins(UrtoPlugins::default().build().disable::<P>());
+        app
+    }
+    type MakeApp = fn() -> App;
+    let apps: [(&str, MakeApp); 14] = [
+        ("core", without::<PhysicsCorePlugin>),
+        ("validation", without::<ValidationPlugin>),
+        ("forces", without::<ForcesPlugin>),
+        ("integration", without::<IntegrationPlugin>),
+        ("rotation", without::<RotationPlugin>),
+        ("hierarchy", without::<HierarchyPlugin>),
+        ("broad phase", without::<BroadPhasePlugin>),
+        ("ccd", without::<CcdPlugin>),
+        ("narrow phase", without::<NarrowPhasePlugin>),
+        ("soft step", without::<SoftStepPlugin>),
+        ("response", without::<ResponsePlugin>),
+        ("sleep", without::<SleepPlugin>),
+        ("transform sync", without::<TransformSyncPlugin>),
+        ("spatial query", without::<SpatialQueryPlugin>),
+    ];
+    let mut panicked = Vec::new();
+    let mut resting = std::collections::BTreeMap::new();
+    for (name, make) in apps {
+        let outcome = std::panic::catch_unwind(move || {
+            let mut app = make();
+            let [ball, _] = busy_scene(&mut app);
+            let stepped = urto::step(app.world_mut(), 60);
+            (
+                stepped.is_ok(),
+                app.world().get::<Position>(ball).map(|p| p.0.z),
+            )
+        });
+        match outcome {
+            Ok(result) => {
+                resting.insert(name, result);
+            }
+            Err(_) => panicked.push(name),
+        }
+    }
+    assert!(panicked.is_empty(), "panicked without: {panicked:?}");
+    // Without the core nothing steps, and `step` says so.
+    assert!(!resting["core"].0);
+    // Without the hierarchy nothing refits the volumes (the broad phase warns), without the
+    // broad or narrow phase nothing finds contacts: the ball falls through the ground. With any
+    // other stage gone it still rests on the ground.
+    let blind = ["hierarchy", "broad phase", "narrow phase"];
+    for name in blind {
+        assert!(resting[name].0 && resting[name].1.unwrap() < 0.0, "{name}");
+    }
+    for (name, (stepped, z)) in &resting {
+        if *name != "core" && !blind.contains(name) {
+            assert!(*stepped, "{name}");
+            let z = z.unwrap();
+            assert!((z - 0.5).abs() < 0.02, "without {name} the ball is at {z}");
+        }
+    }
+}

@@ -23,6 +23,7 @@ use crate::broad_phase::{
 };
 use crate::components::*;
 use crate::plugins::core::PrepareIndex;
+use crate::plugins::hierarchy::HierarchyInstalled;
 use crate::plugins::proxy_table::{Proxy, ProxyTable};
 use crate::plugins::required_resources::RequireResource;
 use crate::plugins::soft_step::{Lookahead, LookaheadParams};
@@ -122,8 +123,7 @@ impl BroadPhaseIndex {
 
 impl Plugin for BroadPhasePlugin {
     fn build(&self, app: &mut App) {
-        app.init_required::<BroadPhasePairs>()
-            .init_required::<SleepTransitions>()
+        app.init_required::<SleepTransitions>()
             .insert_required({
                 let plugin = self.clone();
                 move || BroadPhaseIndex::new(&plugin)
@@ -191,7 +191,16 @@ fn sync_broad_phase(
     lookahead: LookaheadParams,
     mut stats: ResMut<PhysicsStats>,
     mut commands: Commands,
+    (hierarchy, mut warned): (Option<Res<HierarchyInstalled>>, Local<bool>),
 ) {
+    if hierarchy.is_none() && !*warned {
+        *warned = true;
+        log::warn!(
+            "urto: no HierarchyPlugin: poses and bounding volumes are never updated, so the \
+             broad phase sees bodies where they were spawned and nothing collides; replace it \
+             with a stage that writes GlobalPose and BoundingVolume"
+        );
+    }
     let start = Instant::now();
     let lookahead = lookahead.get();
     let index = &mut *index;

@@ -191,7 +191,7 @@ type Obstacle<'a> = (
 fn sweep_fast_bodies(
     mut bodies: Query<(&mut Position, &mut Velocity, Option<&Restitution>), MovingRoot>,
     obstacles: Query<Obstacle, Without<Quarantined>>,
-    mut index: ResMut<BroadPhaseIndex>,
+    index: Option<ResMut<BroadPhaseIndex>>,
     settings: Res<CcdSettings>,
     contact_settings: Res<ContactSettings>,
     timestep: Res<PhysicsTimestep>,
@@ -200,6 +200,10 @@ fn sweep_fast_bodies(
     mut stats: ResMut<PhysicsStats>,
 ) {
     impacts.contacts.clear();
+    // Without a broad phase there is no indexed scenery to sweep against.
+    let Some(mut index) = index else {
+        return;
+    };
     if scratch.starts.is_empty() {
         return;
     }

@@ -1,7 +1,10 @@
 //! The core plugin: schedules, settings, statistics, and the two ways a step is driven —
 //! Bevy's fixed-timestep loop in an `App`, or [`step`] on a standalone world.
 
+use crate::plugins::broad_phase::BroadPhasePairs;
 use crate::plugins::ccd::CcdSettings;
+use crate::plugins::forces::GatheredForces;
+use crate::plugins::narrow_phase::{Contacts, HierarchyVisits, OverlappingLeaves, SensorOverlaps};
 use crate::plugins::required_resources::{RequireResource, restore_required_resources};
 use crate::plugins::settings_check::check_settings;
 use crate::schedule::{
@@ -36,7 +39,16 @@ impl Plugin for PhysicsCorePlugin {
         app.insert_required(move || ts)
             .init_required::<Integration>()
             .init_required::<ContactSettings>()
-            .init_required::<PhysicsStats>();
+            .init_required::<PhysicsStats>()
+            .insert_resource(CoreInstalled);
+        // What one stage writes and another reads belongs to neither: any stage can be
+        // disabled or replaced and the others still find their inputs (empty).
+        app.init_required::<GatheredForces>()
+            .init_required::<BroadPhasePairs>()
+            .init_required::<Contacts>()
+            .init_required::<SensorOverlaps>()
+            .init_required::<OverlappingLeaves>()
+            .init_required::<HierarchyVisits>();
 
         // Single-threaded executors: the step is a strict chain, and one thread keeps runs
         // bit-for-bit reproducible whatever the machine's thread count.
@@ -157,11 +169,16 @@ fn run_physics_in_fixed_update(world: &mut World) {
     world.run_schedule(PhysicsSchedule);
 }
 
+/// Marks a world built with [`PhysicsCorePlugin`]: [`step`] refuses a world without it (the
+/// other stages' systems would find none of the resources they share).
+#[derive(Resource)]
+pub(crate) struct CoreInstalled;
+
 /// Why [`step`] could not run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StepError {
-    /// The world has no physics schedule: add [`UrtoPlugins`](crate::UrtoPlugins) to the app
-    /// whose world is stepped.
+    /// The world has no physics schedule: add [`UrtoPlugins`](crate::UrtoPlugins) (with its
+    /// [`PhysicsCorePlugin`]) to the app whose world is stepped.
     NoPhysicsSchedule,
 }
 
@@ -184,6 +201,9 @@ impl std::error::Error for StepError {}
 /// urto::step(app.world_mut(), 60).unwrap();
 /// ```
 pub fn step(world: &mut World, n: u32) -> Result<(), StepError> {
+    if !world.contains_resource::<CoreInstalled>() {
+        return Err(StepError::NoPhysicsSchedule);
+    }
     for _ in 0..n {
         world
             .try_run_schedule(PhysicsSchedule)

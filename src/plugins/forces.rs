@@ -4,7 +4,6 @@
 //! intermediate state it needs.
 
 use crate::components::*;
-use crate::plugins::required_resources::RequireResource;
 use crate::schedule::{PhysicsSchedule, PhysicsSet};
 use crate::settings::Gravity;
 use crate::stats::{PhysicsStats, Stage};
@@ -41,7 +40,7 @@ impl GatheredForces {
 
 impl Plugin for ForcesPlugin {
     fn build(&self, app: &mut App) {
-        app.init_required::<GatheredForces>().add_systems(
+        app.add_systems(
             PhysicsSchedule,
             (
                 clear_gathered_forces,

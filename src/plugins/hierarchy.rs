@@ -32,9 +32,15 @@ use std::time::Instant;
 #[derive(Debug, Clone, Default)]
 pub struct HierarchyPlugin;
 
+/// Marks a world whose bounding volumes a [`HierarchyPlugin`] keeps fresh (the broad phase
+/// warns without it: nothing would ever collide).
+#[derive(Resource)]
+pub(crate) struct HierarchyInstalled;
+
 impl Plugin for HierarchyPlugin {
     fn build(&self, app: &mut App) {
         app.init_required::<HierarchyScratch>()
+            .insert_resource(HierarchyInstalled)
             .add_systems(
                 SubstepSchedule,
                 (

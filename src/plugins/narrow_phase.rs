@@ -157,18 +157,13 @@ struct NarrowPhaseScratch {
 
 impl Plugin for NarrowPhasePlugin {
     fn build(&self, app: &mut App) {
-        app.init_required::<Contacts>()
-            .init_required::<SensorOverlaps>()
-            .init_required::<NarrowPhaseScratch>()
-            .init_required::<OverlappingLeaves>()
-            .init_required::<HierarchyVisits>()
-            .add_systems(
-                SubstepSchedule,
-                compute_contacts
-                    .run_if(any_with_component::<Collider>)
-                    .in_set(ComputeContacts)
-                    .in_set(SubstepSet::NarrowPhase),
-            );
+        app.init_required::<NarrowPhaseScratch>().add_systems(
+            SubstepSchedule,
+            compute_contacts
+                .run_if(any_with_component::<Collider>)
+                .in_set(ComputeContacts)
+                .in_set(SubstepSet::NarrowPhase),
+        );
     }
 }
 
