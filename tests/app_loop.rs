@@ -56,3 +56,25 @@ fn a_slow_frame_runs_at_most_the_catch_up_cap() {
     app.update();
     assert_eq!(app.world().resource::<PhysicsStats>().step, 3);
 }
+
+#[test]
+fn a_hand_written_update_loop_without_finish_steps_at_exactly_the_configured_60_hz() {
+    // The README's loop: plugins added, then app.update() in a loop, never app.finish().
+    let mut app = App::new();
+    app.add_plugins((TimePlugin, UrtoPlugins::default()))
+        .insert_resource(TimeUpdateStrategy::ManualDuration(
+            Duration::from_secs(1) / 60,
+        ));
+    app.world_mut().spawn(Velocity::default());
+    for _ in 0..121 {
+        app.update();
+    }
+    let fixed = app.world().resource::<bevy_time::Time<bevy_time::Fixed>>();
+    assert_eq!(fixed.timestep(), Duration::from_secs_f32(1.0 / 60.0));
+    // 120 frames of 1/60 s after the first: 120 steps, give or take the rounding of the two
+    // clocks' nanoseconds at the boundary.
+    let steps = app.world().resource::<PhysicsStats>().step;
+    assert!((119..=120).contains(&steps), "{steps} steps");
+    let dt = app.world().resource::<PhysicsTimestep>().dt();
+    assert!((dt - 1.0 / 60.0).abs() < 1e-7, "{dt}");
+}

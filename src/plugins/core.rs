@@ -107,18 +107,48 @@ impl Plugin for PhysicsCorePlugin {
         );
         app.add_schedule(substep);
 
-        app.add_systems(FixedPostUpdate, run_physics_in_fixed_update);
+        app.add_systems(FixedPostUpdate, run_physics_in_fixed_update)
+            .add_systems(PreUpdate, set_fixed_clock);
     }
 
     fn finish(&self, app: &mut App) {
-        // In an App, Bevy's fixed clock is the accumulator: give it our dt and cap the catch-up.
-        let ts = *app.world().resource::<PhysicsTimestep>();
-        if let Some(mut fixed) = app.world_mut().get_resource_mut::<Time<Fixed>>() {
-            fixed.set_timestep(Duration::from_secs_f32(ts.dt()));
+        if let Some(ts) = app.world().get_resource::<PhysicsTimestep>().copied() {
+            set_clocks(app.world_mut(), &ts);
         }
-        if let Some(mut virt) = app.world_mut().get_resource_mut::<Time<Virtual>>() {
-            virt.set_max_delta(Duration::from_secs_f32(ts.dt()) * ts.max_steps_per_frame());
+    }
+}
+
+/// In an App, Bevy's fixed clock is the accumulator: give it our dt and cap the catch-up.
+fn set_clocks(world: &mut World, ts: &PhysicsTimestep) {
+    if let Some(mut fixed) = world.get_resource_mut::<Time<Fixed>>() {
+        fixed.set_timestep(Duration::from_secs_f32(ts.dt()));
+    }
+    if let Some(mut virt) = world.get_resource_mut::<Time<Virtual>>() {
+        virt.set_max_delta(Duration::from_secs_f32(ts.dt()) * ts.max_steps_per_frame());
+    }
+}
+
+/// Before each frame's fixed loop: a [`PhysicsTimestep`] that is new or changed sets Bevy's
+/// fixed clock. `finish()` does this too, but a hand-written `app.update()` loop never calls it,
+/// and Bevy's default 64 Hz then ran the physics instead of the configured rate. Without
+/// `Time<Fixed>` (no `TimePlugin`) the fixed loop never runs: a warning says so, once.
+fn set_fixed_clock(world: &mut World, mut warned: Local<bool>) {
+    if !world.contains_resource::<Time<Fixed>>() {
+        if !*warned {
+            *warned = true;
+            log::warn!(
+                "urto: no Time<Fixed> (add bevy_time's TimePlugin): Bevy's fixed loop never \
+                 runs, so no physics step will; or step the world with urto::step"
+            );
         }
+        return;
+    }
+    let changed = world
+        .get_resource_ref::<PhysicsTimestep>()
+        .filter(|ts| ts.is_changed())
+        .map(|ts| *ts);
+    if let Some(ts) = changed {
+        set_clocks(world, &ts);
     }
 }
 
