@@ -429,3 +429,71 @@ fn a_spinning_ball_stays_awake_and_setting_a_spin_wakes_a_sleeper() {
     );
     assert_ne!(get::<Rotation>(&app, still).0, Quat::IDENTITY);
 }
+
+#[test]
+fn density_gives_a_ball_a_box_and_a_compound_the_mass_of_their_volume_within_1e_5() {
+    use bevy_ecs::hierarchy::ChildOf;
+    use std::f32::consts::PI;
+    let mut app = common::app();
+    let world = app.world_mut();
+    let ball = world
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(0.0, 0.0, 5.0),
+            Velocity::default(),
+            Density(1000.0),
+        ))
+        .id();
+    let crate_box = world
+        .spawn((
+            Collider::cuboid(0.5, 1.0, 1.5),
+            Position::new(5.0, 0.0, 5.0),
+            Velocity::default(),
+            Density(2.0),
+        ))
+        .id();
+    let root = world
+        .spawn((
+            Collider::cuboid(0.5, 0.5, 0.5),
+            Position::new(-5.0, 0.0, 5.0),
+            Velocity::default(),
+            Density(10.0),
+        ))
+        .id();
+    world.spawn((
+        Collider::sphere(0.25),
+        Position::new(1.0, 0.0, 0.0),
+        ChildOf(root),
+    ));
+    let bad = world
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(0.0, 5.0, 5.0),
+            Velocity::default(),
+            Density(f32::NAN),
+        ))
+        .id();
+    let kinematic = world
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(0.0, -5.0, 5.0),
+            Velocity::default(),
+            Mass::INFINITE,
+            Density(1000.0),
+        ))
+        .id();
+    urto::step(app.world_mut(), 2).unwrap();
+    let mass = |e| app.world().get::<Mass>(e).unwrap().0;
+    let close = |a: f32, b: f32| ((a - b) / b).abs() < 1e-5;
+    let ball_mass = 1000.0 * 4.0 / 3.0 * PI * 0.125;
+    assert!(close(mass(ball), ball_mass), "{}", mass(ball));
+    // The inertia follows the new mass: 2/5 m r².
+    let inertia = app.world().get::<Inertia>(ball).unwrap().principal;
+    assert!(close(inertia.x, 0.4 * ball_mass * 0.25), "{inertia}");
+    assert!(close(mass(crate_box), 2.0 * 1.0 * 2.0 * 3.0));
+    let compound = 10.0 * (1.0 + 4.0 / 3.0 * PI * 0.25f32.powi(3));
+    assert!(close(mass(root), compound), "{} vs {compound}", mass(root));
+    assert_eq!(mass(bad), 1.0);
+    assert!(mass(kinematic).is_infinite());
+    assert!(app.world().get::<Quarantined>(bad).is_none());
+}

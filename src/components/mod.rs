@@ -83,6 +83,14 @@ impl Default for Mass {
     }
 }
 
+/// Mass from size (kg/m³): a body with a `Density` gets the [`Mass`] of its colliders' volume
+/// (its parts' included) at this density, recomputed when a collider or part changes, as Avian's
+/// and rapier's colliders give by default (water is 1,000, steel about 7,850). Without it a
+/// body keeps its `Mass` (1 kg by default, whatever its size). A density that is not finite and
+/// positive, or a body without volume (no collider, a half-space), keeps the `Mass` it has.
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+pub struct Density(pub f32);
+
 impl Mass {
     /// A body no force or impulse can move.
     pub const INFINITE: Self = Self(f32::INFINITY);

@@ -82,6 +82,7 @@ type ChangedRoot = (
     Or<(
         Changed<Collider>,
         Changed<Mass>,
+        Changed<Density>,
         Added<Inertia>,
         Changed<Children>,
     )>,
@@ -97,7 +98,16 @@ type ChangedPart = (
     )>,
 );
 type ChangedRoots<'w, 's> = Query<'w, 's, Entity, (ChangedRoot, With<Inertia>)>;
-type Roots<'w, 's> = Query<'w, 's, (&'static mut Inertia, &'static Mass), RootFilter>;
+type Roots<'w, 's> = Query<
+    'w,
+    's,
+    (
+        &'static mut Inertia,
+        &'static mut Mass,
+        Option<&'static Density>,
+    ),
+    RootFilter,
+>;
 type RootFilter = (Without<ChildOf>, Without<Quarantined>);
 type PartData<'a> = (
     Option<&'a Collider>,
@@ -133,15 +143,29 @@ fn compute_inertia(
     let mut roots = root_queries.p1();
     stats.time(Stage::Prepare, "prepare/inertia", || {
         for &root in &b.dirty {
-            let Ok((mut inertia, mass)) = roots.get_mut(root) else {
+            let Ok((mut inertia, mut mass, density)) = roots.get_mut(root) else {
                 continue;
             };
+            gather_compound(root, &parts, &mut b.stack, &mut b.visited, &mut b.parts);
+            let unit = MassProperties::compound(b.parts.drain(..));
+            // A kinematic body (infinite mass) stays kinematic whatever its density.
+            if let Some(&Density(rho)) = density.filter(|_| mass.0.is_finite()) {
+                let from_density = rho * unit.mass;
+                if from_density.is_normal() && from_density > 0.0 {
+                    mass.set_if_neq(Mass(from_density));
+                } else {
+                    log::warn!(
+                        "urto: {root}: density {rho} over a volume of {} m³ gives no usable \
+                         mass; keeping {} kg",
+                        unit.mass,
+                        mass.0
+                    );
+                }
+            }
             if inertia.custom {
                 continue;
             }
-            gather_compound(root, &parts, &mut b.stack, &mut b.visited, &mut b.parts);
-            let computed = inertia_of(MassProperties::compound(b.parts.drain(..)), *mass);
-            inertia.set_if_neq(computed);
+            inertia.set_if_neq(inertia_of(unit, *mass));
         }
     });
 }
