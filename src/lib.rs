@@ -43,6 +43,16 @@ pub mod spatial;
 pub mod stats;
 
 pub use plugins::{UrtoPlugins, step};
+
+/// The crates urto's API is made of, re-exported so a game uses the very versions urto was
+/// built with (a second `glam` in the dependency tree makes `Vec3` two different types).
+pub mod reexports {
+    pub use bevy_app;
+    pub use bevy_ecs;
+    pub use bevy_time;
+    pub use bevy_transform;
+    pub use glam;
+}
 pub use settings::{ContactSettings, Gravity, Integration, PhysicsTimestep, SettingsError};
 
 /// What a game needs in scope.
