@@ -62,7 +62,7 @@ pub mod prelude {
     pub use crate::dynamics::solver::SoftStepSettings;
     pub use crate::plugins::{
         CollisionEnded, CollisionStarted, RayHit, SoftStepPlugin, SpatialQuery, SpatialQueryFilter,
-        UrtoPlugins,
+        TransformInterpolation, UrtoPlugins,
     };
     pub use crate::schedule::{PhysicsSchedule, PhysicsSet, SubstepSchedule, SubstepSet};
     pub use crate::settings::*;

@@ -78,3 +78,53 @@ fn a_hand_written_update_loop_without_finish_steps_at_exactly_the_configured_60_
     let dt = app.world().resource::<PhysicsTimestep>().dt();
     assert!((dt - 1.0 / 60.0).abs() < 1e-7, "{dt}");
 }
+
+#[test]
+fn an_interpolated_body_renders_smoothly_at_twice_the_step_rate_within_10_percent_of_its_speed() {
+    use bevy_transform::components::Transform;
+    let mut app = App::new();
+    app.add_plugins((TimePlugin, UrtoPlugins::default()))
+        .insert_resource(TimeUpdateStrategy::ManualDuration(
+            Duration::from_secs(1) / 120,
+        ));
+    let body = app
+        .world_mut()
+        .spawn((
+            Velocity::new(6.0, 0.0, 0.0),
+            Transform::default(),
+            TransformInterpolation,
+        ))
+        .id();
+    let plain = app
+        .world_mut()
+        .spawn((Velocity::new(6.0, 0.0, 0.0), Transform::default()))
+        .id();
+    let x = |app: &App, e| app.world().get::<Transform>(e).unwrap().translation.x;
+    let (mut drawn, mut jumpy) = (Vec::new(), Vec::new());
+    for _ in 0..40 {
+        app.update();
+        drawn.push(x(&app, body));
+        jumpy.push(x(&app, plain));
+    }
+    // Frames of 1/120 s: 6 m/s moves 5 cm a frame. Uninterpolated, the pose moves 10 cm every
+    // other frame; interpolated, 5 cm every frame.
+    let steps = |xs: &[f32]| {
+        xs.windows(2)
+            .skip(10)
+            .map(|w| w[1] - w[0])
+            .collect::<Vec<_>>()
+    };
+    assert!(
+        steps(&jumpy).iter().any(|d| d.abs() < 1e-6),
+        "the plain body should jump"
+    );
+    for d in steps(&drawn) {
+        assert!(
+            (d - 0.05).abs() < 0.005,
+            "an interpolated frame moved {d} m"
+        );
+    }
+    // The physics itself is not blended: the Position is the stepped one.
+    let p = app.world().get::<Position>(body).unwrap().0.x;
+    assert!((p - x(&app, plain)).abs() < 1e-6);
+}

@@ -19,6 +19,7 @@ pub mod core;
 pub mod forces;
 pub mod hierarchy;
 pub mod integration;
+pub mod interpolation;
 pub mod narrow_phase;
 mod proxy_table;
 mod required_resources;
@@ -37,6 +38,7 @@ pub use core::{PhysicsCorePlugin, StepError, step};
 pub use forces::{ForcesPlugin, GatheredForces};
 pub use hierarchy::HierarchyPlugin;
 pub use integration::IntegrationPlugin;
+pub use interpolation::{InterpolationPlugin, PreviousPose, TransformInterpolation};
 pub use narrow_phase::{ContactPair, Contacts, NarrowPhasePlugin};
 pub use response::{CollisionEnded, CollisionStarted, ReportCollisions, ResponsePlugin};
 pub use rotation::RotationPlugin;
@@ -93,6 +95,7 @@ impl PluginGroup for UrtoPlugins {
             .add(ResponsePlugin)
             .add(SleepPlugin)
             .add(TransformSyncPlugin)
+            .add(InterpolationPlugin)
             .add(SpatialQueryPlugin)
     }
 }
