@@ -276,9 +276,12 @@ fn compute_contacts(
         let margin = margin(a) + margin(b);
         let compound = |e: Entity| matches!(nodes.get(e), Ok((.., Some(_))));
         if !compound(a) && !compound(b) {
-            if interacts(a, b) && sensing(a, b) {
+            if !interacts(a, b) {
+                continue;
+            }
+            if sensing(a, b) {
                 scratch.test_sensor(&nodes, (a, b), (a, b), &mut overlaps);
-            } else if interacts(a, b) {
+            } else {
                 scratch.test_leaves(&nodes, (a, b), (a, b), margin, &mut contacts, &mut debug);
             }
             continue;

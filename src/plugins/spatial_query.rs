@@ -187,12 +187,12 @@ impl SpatialQuery<'_, '_> {
         let step = self.stats.as_ref().map(|s| s.step);
         if force || step.is_none() || state.step != step {
             let state = &mut *state;
-            state.entities.clear();
-            state
-                .entities
-                .extend(self.colliders.iter().map(|row| row.0));
-            let rows = self.colliders.iter().enumerate();
-            let colliders = rows.map(|(id, row)| (id as u32, &row.1.shape, pose_of(&row)));
+            let entities = &mut state.entities;
+            entities.clear();
+            let colliders = self.colliders.iter().enumerate().map(|(id, row)| {
+                entities.push(row.0);
+                (id as u32, &row.1.shape, pose_of(&row))
+            });
             match state.index.update(colliders) {
                 IndexUpdate::Refitted => state.refits += 1,
                 IndexUpdate::Rebuilt => state.rebuilds += 1,
@@ -218,6 +218,23 @@ impl SpatialQuery<'_, '_> {
         layers.is_some_and(|l| member(l).intersects(filter.mask)) && !filter.excluded.contains(&e)
     }
 
+    /// Runs a query on the fresh index with the ECS lookup and `filter` as the acceptance test.
+    fn with_index<R>(
+        &self,
+        filter: &SpatialQueryFilter,
+        query: impl FnOnce(&mut SpatialIndex, &Lookup, &dyn Fn(u32) -> bool) -> R,
+    ) -> R {
+        let mut state = self.fresh(false);
+        let IndexState {
+            index, entities, ..
+        } = &mut *state;
+        let lookup = Lookup {
+            entities,
+            colliders: &self.colliders,
+        };
+        query(index, &lookup, &|id| self.accepts(entities, id, filter))
+    }
+
     /// The nearest collider the ray from `origin` along `direction` hits within `max_distance`
     /// (`f32::INFINITY`: no limit). A ray starting inside a solid hits it at distance 0.
     pub fn cast_ray(
@@ -241,17 +258,10 @@ impl SpatialQuery<'_, '_> {
         filter: &SpatialQueryFilter,
     ) -> Result<Option<RayHit>, QueryError> {
         let ray = Ray::new(origin, direction)?;
-        let mut state = self.fresh(false);
-        let IndexState {
-            index, entities, ..
-        } = &mut *state;
-        let lookup = Lookup {
-            entities,
-            colliders: &self.colliders,
-        };
-        let accept = |id| self.accepts(entities, id, filter);
-        let hit = index.cast_sphere(&lookup, &ray, radius, max_distance, accept)?;
-        Ok(hit.map(|h| to_ray_hit(entities, h)))
+        self.with_index(filter, |index, lookup, accept| {
+            let hit = index.cast_sphere(lookup, &ray, radius, max_distance, accept)?;
+            Ok(hit.map(|h| to_ray_hit(lookup.entities, h)))
+        })
     }
 
     /// Every collider the ray hits within `max_distance`, nearest first.
@@ -263,18 +273,14 @@ impl SpatialQuery<'_, '_> {
         filter: &SpatialQueryFilter,
     ) -> Result<Vec<RayHit>, QueryError> {
         let ray = Ray::new(origin, direction)?;
-        let mut state = self.fresh(false);
-        let IndexState {
-            index, entities, ..
-        } = &mut *state;
-        let lookup = Lookup {
-            entities,
-            colliders: &self.colliders,
-        };
-        let accept = |id| self.accepts(entities, id, filter);
-        let mut hits = Vec::new();
-        index.cast_ray_all(&lookup, &ray, max_distance, accept, &mut hits)?;
-        Ok(hits.into_iter().map(|h| to_ray_hit(entities, h)).collect())
+        self.with_index(filter, |index, lookup, accept| {
+            let mut hits = Vec::new();
+            index.cast_ray_all(lookup, &ray, max_distance, accept, &mut hits)?;
+            Ok(hits
+                .into_iter()
+                .map(|h| to_ray_hit(lookup.entities, h))
+                .collect())
+        })
     }
 
     /// The colliders that `shape` placed at `pose` touches or overlaps (meshes are surfaces).
@@ -287,18 +293,14 @@ impl SpatialQuery<'_, '_> {
         if !pose.is_finite() {
             return Err(QueryError::NonFiniteOrigin(pose.translation));
         }
-        let mut state = self.fresh(false);
-        let IndexState {
-            index, entities, ..
-        } = &mut *state;
-        let lookup = Lookup {
-            entities,
-            colliders: &self.colliders,
-        };
-        let accept = |id| self.accepts(entities, id, filter);
-        let mut ids = Vec::new();
-        index.overlapping(&lookup, (shape, &pose), accept, &mut ids);
-        Ok(ids.into_iter().map(|id| entities[id as usize]).collect())
+        self.with_index(filter, |index, lookup, accept| {
+            let mut ids = Vec::new();
+            index.overlapping(lookup, (shape, &pose), accept, &mut ids);
+            Ok(ids
+                .into_iter()
+                .map(|id| lookup.entities[id as usize])
+                .collect())
+        })
     }
 
     /// The colliders holding `point` (inside or on a solid; on a mesh's surface).

@@ -104,11 +104,17 @@ pub struct ContactBatch {
 }
 
 impl ContactBatch {
-    /// Packs `indices` (1 to [`LANES`] constraints moving no common body) of `constraints`.
-    pub fn pack(indices: &[u32], constraints: &[ContactConstraint]) -> Self {
-        let lanes: [Option<&ContactConstraint>; LANES] =
-            std::array::from_fn(|l| indices.get(l).map(|&i| &constraints[i as usize]));
-        let first = lanes[0].expect("a batch holds at least one constraint");
+    /// Packs `indices` (1 to [`LANES`] constraints moving no common body) of `constraints`;
+    /// `None` for no index, more than [`LANES`] or an index out of range.
+    pub fn pack(indices: &[u32], constraints: &[ContactConstraint]) -> Option<Self> {
+        if indices.is_empty() || indices.len() > LANES {
+            return None;
+        }
+        let mut lanes: [Option<&ContactConstraint>; LANES] = [None; LANES];
+        for (lane, &i) in lanes.iter_mut().zip(indices) {
+            *lane = Some(constraints.get(i as usize)?);
+        }
+        let first = lanes[0]?;
         let real = |l: usize| lanes[l].unwrap_or(first);
         let each = |f: fn(&ContactConstraint) -> f32| {
             Lanes::new(std::array::from_fn(|l| lanes[l].map_or(0.0, f)))
@@ -123,7 +129,7 @@ impl ContactBatch {
                 _ => &zero,
             }))
         });
-        Self {
+        Some(Self {
             constraints: std::array::from_fn(|l| indices.get(l).copied()),
             bodies: [
                 std::array::from_fn(|l| real(l).a as usize),
@@ -148,7 +154,7 @@ impl ContactBatch {
                 .max()
                 .unwrap_or(0),
             rubs: lanes.iter().flatten().any(|c| c.friction > 0.0),
-        }
+        })
     }
 
     /// Writes the impulses and approach speeds back into the constraints the lanes came from.
@@ -417,7 +423,10 @@ mod tests {
         }
         let mut batch_states = bodies.states.clone();
         let mut batched = constraints.clone();
-        let mut batch = ContactBatch::pack(&[0, 1, 2], &constraints);
+        let mut batch = ContactBatch::pack(&[0, 1, 2], &constraints).unwrap();
+        assert!(ContactBatch::pack(&[], &constraints).is_none());
+        assert!(ContactBatch::pack(&[0, 1, 2, 0, 1], &constraints).is_none());
+        assert!(ContactBatch::pack(&[0, 7], &constraints).is_none());
         batch.warm_start(&mut batch_states);
         batch.solve(&mut batch_states, 1.0 / h, push, true, true);
         batch.solve(&mut batch_states, 1.0 / h, push, false, true);

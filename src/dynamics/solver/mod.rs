@@ -366,7 +366,7 @@ impl Solver {
         self.batches.extend(
             self.batching
                 .batches()
-                .map(|indices| ContactBatch::pack(indices, constraints)),
+                .filter_map(|indices| ContactBatch::pack(indices, constraints)),
         );
     }
 }
