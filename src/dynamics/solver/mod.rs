@@ -44,6 +44,8 @@
 pub mod batch;
 pub mod body;
 pub mod contact;
+pub mod joint;
+pub mod joint_rows;
 pub mod lanes;
 pub mod ordered_batches;
 pub mod rolling;
@@ -56,6 +58,9 @@ mod scenarios;
 pub use batch::ContactBatch;
 pub use body::{BodyInput, BodyParams, BodyState, SolverBodies};
 pub use contact::{ConstraintPoint, ContactConstraint, ContactInput, ContactPointInput};
+pub use joint::{
+    JointConstraint, JointFrame, JointImpulses, JointInput, JointKind, JointLimit, JointMotor,
+};
 pub use rolling::RollingRows;
 pub use softness::Softness;
 pub use warm_start::WarmStartCache;
@@ -97,6 +102,11 @@ pub struct SoftStepSettings {
     pub warm_start_distance: f32,
     /// Fastest turn per substep (rad): keeps a wildly spinning body's linearised rotation sane.
     pub max_rotation_per_substep: f32,
+    /// Stiffness with which joints close their position errors in the biased pass (Hz; 0:
+    /// rigid). Box2D v3 takes twice its contact stiffness, 60 Hz.
+    pub joint_hertz: f32,
+    /// Damping ratio of the joints' error correction (Box2D v3: 2).
+    pub joint_damping_ratio: f32,
 }
 
 impl Default for SoftStepSettings {
@@ -111,6 +121,8 @@ impl Default for SoftStepSettings {
             restitution_threshold: 1.0,
             warm_start_distance: 0.05,
             max_rotation_per_substep: 0.25 * std::f32::consts::PI,
+            joint_hertz: 60.0,
+            joint_damping_ratio: 2.0,
         }
     }
 }
@@ -136,6 +148,8 @@ impl SoftStepSettings {
             ("damping_ratio", self.damping_ratio),
             ("restitution_threshold", self.restitution_threshold),
             ("warm_start_distance", self.warm_start_distance),
+            ("joint_hertz", self.joint_hertz),
+            ("joint_damping_ratio", self.joint_damping_ratio),
         ];
         let above_zero = [
             ("max_push_out", self.max_push_out),
@@ -172,6 +186,12 @@ pub struct Solver {
     stable_springs: Vec<Spring>,
     /// How many springs of the last step were lowered to that range.
     clamped_springs: usize,
+    /// The step's joints, with their impulses.
+    joints: Vec<JointConstraint>,
+    /// Last step's joint impulses by key, for the warm start.
+    joint_cache: Vec<(u64, JointImpulses)>,
+    /// The last step's substep (s).
+    substep: f32,
 }
 
 impl Solver {
@@ -189,13 +209,26 @@ impl Solver {
         &self.constraints
     }
 
-    /// Advances `bodies` by `dt` under `contacts` (sorted by key; see the module doc) and
-    /// `springs` (their `body` and `other` are slots; each pulls its bodies' centres of mass).
+    /// The joints of the last step, with their impulses (in the order given; see
+    /// [`JointConstraint::load`] for the force each applied).
+    pub fn joints(&self) -> &[JointConstraint] {
+        &self.joints
+    }
+
+    /// The last step's substep (s).
+    pub fn substep(&self) -> f32 {
+        self.substep
+    }
+
+    /// Advances `bodies` by `dt` under `contacts` (sorted by key; see the module doc),
+    /// `springs` (their `body` and `other` are slots; each pulls its bodies' centres of mass)
+    /// and `joints` (a joint naming a slot past the bodies, or one body twice, is skipped).
     pub fn step(
         &mut self,
         bodies: &mut SolverBodies,
         contacts: &[ContactInput],
         springs: &[Spring],
+        joints: &[JointInput],
         dt: f32,
     ) {
         // The settings are public: unusable ones (a NaN stiffness, u32::MAX substeps) step with
@@ -208,7 +241,10 @@ impl Solver {
             return;
         }
         let inv_h = 1.0 / h;
+        self.substep = h;
         self.prepare(bodies, contacts, h);
+        self.prepare_joints(bodies, joints);
+        let joint_soft = Softness::new(s.joint_hertz, s.joint_damping_ratio, h);
         self.stabilise_springs(bodies, springs, h);
         let springs = std::mem::take(&mut self.stable_springs);
         let mut flip = false;
@@ -221,13 +257,20 @@ impl Solver {
             }
             integrate_velocities(bodies, h);
             flip = !flip;
+            // Joints before contacts, as Box2D: the contacts, solved last, win a conflict.
+            for j in &self.joints {
+                j.warm_start(&mut bodies.states);
+            }
             self.warm_start(bodies, flip);
+            self.solve_joints(bodies, joint_soft, h, true);
             self.solve_contacts(bodies, inv_h, true, flip);
             integrate_positions(bodies, h, s.max_rotation_per_substep);
             for _ in 0..s.relax_iterations {
+                self.solve_joints(bodies, joint_soft, h, false);
                 self.solve_contacts(bodies, inv_h, false, flip);
             }
         }
+        self.store_joint_impulses();
         for batch in &self.batches {
             batch.unpack(&mut self.constraints);
         }
@@ -238,6 +281,37 @@ impl Solver {
         self.cache
             .store(&self.constraints, |a| orientations[a as usize], h);
         self.stable_springs = springs;
+    }
+
+    /// Prepares the step's joints, each seeded with its impulses of the last step.
+    fn prepare_joints(&mut self, bodies: &SolverBodies, joints: &[JointInput]) {
+        let n = bodies.len() as u32;
+        self.joints.clear();
+        for joint in joints {
+            if joint.a >= n || joint.b >= n || joint.a == joint.b {
+                continue;
+            }
+            let mut c = JointConstraint::prepare(joint, bodies);
+            if let Ok(i) = self.joint_cache.binary_search_by_key(&joint.key, |e| e.0) {
+                c.impulses = self.joint_cache[i].1;
+            }
+            self.joints.push(c);
+        }
+    }
+
+    /// One pass over the joints, biased or relaxing.
+    fn solve_joints(&mut self, bodies: &mut SolverBodies, soft: Softness, h: f32, bias: bool) {
+        for j in &mut self.joints {
+            j.solve(&mut bodies.states, soft, h, bias);
+        }
+    }
+
+    /// Keeps the joints' impulses for the next step's warm start, by key.
+    fn store_joint_impulses(&mut self) {
+        self.joint_cache.clear();
+        self.joint_cache
+            .extend(self.joints.iter().map(|j| (j.input.key, j.impulses)));
+        self.joint_cache.sort_unstable_by_key(|e| e.0);
     }
 
     /// How many springs of the last step were too stiff or too damped for the substep and were

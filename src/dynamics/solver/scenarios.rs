@@ -12,6 +12,8 @@ const G: Vec3 = Vec3::new(0.0, 0.0, -9.81);
 const DT: f32 = 1.0 / 60.0;
 const MARGIN: f32 = 0.02;
 
+mod joints;
+
 struct Body {
     shape: Shape,
     center: Vec3,
@@ -31,6 +33,9 @@ struct Scene {
     solver: Solver,
     arrays: SolverBodies,
     contacts: Vec<ContactInput>,
+    joints: Vec<JointInput>,
+    /// Pairs never tested for contact (bodies a joint keeps apart).
+    unpaired: Vec<(usize, usize)>,
 }
 
 impl Scene {
@@ -68,7 +73,8 @@ impl Scene {
         for i in 0..n {
             for j in i + 1..n {
                 let (a, b) = (&self.bodies[i], &self.bodies[j]);
-                if a.inverse_mass == 0.0 && b.inverse_mass == 0.0 {
+                if a.inverse_mass == 0.0 && b.inverse_mass == 0.0 || self.unpaired.contains(&(i, j))
+                {
                     continue;
                 }
                 let (pa, pb) = (
@@ -124,7 +130,8 @@ impl Scene {
                 ..Default::default()
             });
         }
-        self.solver.step(&mut self.arrays, &self.contacts, &[], DT);
+        self.solver
+            .step(&mut self.arrays, &self.contacts, &[], &self.joints, DT);
         for (i, b) in self.bodies.iter_mut().enumerate() {
             b.center = self.arrays.center(i);
             b.orientation = self.arrays.orientation(i);

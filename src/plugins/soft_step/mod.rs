@@ -219,6 +219,7 @@ fn solve_soft_step(
         &mut s.bodies,
         &s.contacts,
         &s.springs,
+        &[],
         timestep.substep_dt(),
     );
     report_impulses(&s.solver, &s.sources, &mut contacts);

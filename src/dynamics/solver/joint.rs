@@ -1,0 +1,480 @@
+//! Joints in the solver: fixed, spherical (ball), revolute (hinge), prismatic (slider) and
+//! distance (rope, rod, spring) joints between two solver bodies, with limits and motors, solved
+//! in the same soft-step substeps as the contacts (Box2D v3's `joint.c` and
+//! `revolute_joint.c`: warm started, soft while biased, rigid while relaxing; Avian's and
+//! rapier's joints offer the same kinds).
+//!
+//! A joint holds each body at a frame (an anchor and a basis in the body's frame, the anchor
+//! measured from the centre of mass). The joint's *axis* is its frames' x axis: the hinge's
+//! axis, the slider's direction. What each kind keeps, from the rows of [`joint_rows`]:
+//!
+//! | kind | point rows | angular rows | axis coordinate (limit, motor) |
+//! | --- | --- | --- | --- |
+//! | fixed | 3 (anchors together) | 3 (frames aligned) | — |
+//! | spherical | 3 | — | — |
+//! | revolute | 3 | 2 (axes aligned) | angle of B's frame about A's axis |
+//! | prismatic | 2 (across the axis) | 3 | travel of B's anchor along A's axis |
+//! | distance | — | — | distance between the anchors |
+//!
+//! Per substep a joint is warm started with its accumulated impulses, then solved in each pass:
+//! motor, limits, then the rows that hold it together (Box2D's order: the hard rows last, so
+//! they win). The position errors are measured from the bodies' motion within the step
+//! (`dp`, `dq`, as the contacts do), so the anchors turn with their bodies. In the biased pass
+//! the errors are closed softly ([`SoftStepSettings::joint_hertz`](super::SoftStepSettings));
+//! the relax passes are rigid and unbiased; a limit not yet reached is speculative, as a
+//! contact is: it lets the coordinate close exactly its gap this substep. A motor is a soft
+//! row of its own: a velocity motor is rigid towards its speed, a position motor is a spring
+//! of the motor's stiffness, and both are bounded by the motor's force per substep.
+//!
+//! [`joint_rows`]: super::joint_rows
+
+use super::body::{BodyState, SolverBodies};
+use super::joint_rows::{AngularRows, AxisRow, PairMasses, hinge_directions, solve_point};
+use super::softness::Softness;
+use glam::{Quat, Vec3};
+
+/// Where a joint holds a body: an anchor from its centre of mass and a basis whose x axis is
+/// the joint's axis, both in the body's frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct JointFrame {
+    /// The anchor, from the centre of mass (body frame).
+    pub anchor: Vec3,
+    /// The joint's axes in the body frame (x: the joint's axis).
+    pub basis: Quat,
+}
+
+impl Default for JointFrame {
+    fn default() -> Self {
+        Self {
+            anchor: Vec3::ZERO,
+            basis: Quat::IDENTITY,
+        }
+    }
+}
+
+/// Bounds on a joint's coordinate (rad for a hinge, m for a slider or a distance).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct JointLimit {
+    /// Lowest value.
+    pub min: f32,
+    /// Highest value (equal to `min`: held there, as a rod holds its length).
+    pub max: f32,
+}
+
+/// Drives a joint's coordinate: towards a speed, or towards a position as a spring, with at most
+/// `max_force` (N, or N·m for a hinge).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct JointMotor {
+    /// Speed the motor drives to (rad/s or m/s); with a target position, the speed at it.
+    pub target_velocity: f32,
+    /// Position the motor pulls to, as a spring of `hertz` and `damping_ratio` (none: a
+    /// velocity motor).
+    pub target_position: Option<f32>,
+    /// The position spring's stiffness (Hz).
+    pub hertz: f32,
+    /// The position spring's damping ratio.
+    pub damping_ratio: f32,
+    /// Largest force (or torque) the motor applies.
+    pub max_force: f32,
+}
+
+impl JointMotor {
+    /// A motor that drives to `speed` with at most `max_force`.
+    pub fn velocity(speed: f32, max_force: f32) -> Self {
+        Self {
+            target_velocity: speed,
+            target_position: None,
+            hertz: 0.0,
+            damping_ratio: 0.0,
+            max_force,
+        }
+    }
+
+    /// A motor that pulls to `target` as a spring of `hertz` and `damping_ratio`, with at most
+    /// `max_force`.
+    pub fn position(target: f32, hertz: f32, damping_ratio: f32, max_force: f32) -> Self {
+        Self {
+            target_velocity: 0.0,
+            target_position: Some(target),
+            hertz,
+            damping_ratio,
+            max_force,
+        }
+    }
+}
+
+/// What a joint keeps (see the module doc's table).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum JointKind {
+    /// Welds the bodies together.
+    Fixed,
+    /// Keeps the anchors together; the bodies turn freely about them.
+    Spherical,
+    /// Keeps the anchors together and the axes aligned; the bodies turn about the axis.
+    Revolute {
+        /// Bounds on the angle (rad, in `(−π, π]`).
+        limit: Option<JointLimit>,
+        /// Drives the angle.
+        motor: Option<JointMotor>,
+    },
+    /// Keeps the frames aligned and B's anchor on A's axis; B slides along it.
+    Prismatic {
+        /// Bounds on the travel (m).
+        limit: Option<JointLimit>,
+        /// Drives the travel.
+        motor: Option<JointMotor>,
+    },
+    /// Bounds the distance between the anchors: a rope (`0..=L`), a rod (`L..=L`), or with a
+    /// position motor a spring.
+    Distance {
+        /// Bounds on the distance (m).
+        limit: JointLimit,
+        /// Drives the distance.
+        motor: Option<JointMotor>,
+    },
+}
+
+/// A joint between two solver slots, as the caller describes it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct JointInput {
+    /// First body's slot.
+    pub a: u32,
+    /// Second body's slot.
+    pub b: u32,
+    /// Where the joint holds A.
+    pub frame_a: JointFrame,
+    /// Where the joint holds B.
+    pub frame_b: JointFrame,
+    /// What it keeps.
+    pub kind: JointKind,
+    /// A key stable from step to step (warm starting follows it).
+    pub key: u64,
+}
+
+/// The impulses a joint accumulated (per substep; carried to the next step's warm start).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct JointImpulses {
+    /// On B at the anchors (world).
+    pub point: Vec3,
+    /// Per angular row (world axes for a lock, the two alignment rows of a hinge in x and y).
+    pub angular: Vec3,
+    /// A slider's two rows across its axis.
+    pub across: [f32; 2],
+    /// The motor's.
+    pub motor: f32,
+    /// The lower limit's (or an equal limit's).
+    pub lower: f32,
+    /// The upper limit's.
+    pub upper: f32,
+}
+
+/// A joint prepared for a step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct JointConstraint {
+    /// The caller's joint.
+    pub input: JointInput,
+    masses: PairMasses,
+    /// Anchors from the centres of mass, world, at the step's start.
+    anchors: [Vec3; 2],
+    /// `c_b − c_a` at the step's start.
+    delta_center: Vec3,
+    /// The joint frames in world at the step's start.
+    frames: [Quat; 2],
+    /// Accumulated impulses.
+    pub impulses: JointImpulses,
+}
+
+/// The joint's rows where the bodies are now.
+struct Rows {
+    anchors: (Vec3, Vec3),
+    /// Anchor to anchor, `c_b + r_b − c_a − r_a`.
+    separation: Vec3,
+    angular: Option<(AngularRows, Vec3)>,
+    across: Option<[(AxisRow, f32); 2]>,
+    axis: Option<(AxisRow, f32)>,
+}
+
+impl JointConstraint {
+    /// Prepares `joint` over `bodies` at the step's start.
+    pub fn prepare(joint: &JointInput, bodies: &SolverBodies) -> Self {
+        let (a, b) = (joint.a as usize, joint.b as usize);
+        let (qa, qb) = (bodies.orientations[a], bodies.orientations[b]);
+        Self {
+            input: *joint,
+            masses: PairMasses::of(&bodies.params, a, b),
+            anchors: [qa * joint.frame_a.anchor, qb * joint.frame_b.anchor],
+            delta_center: bodies.centers[b] - bodies.centers[a],
+            frames: [qa * joint.frame_a.basis, qb * joint.frame_b.basis],
+            impulses: JointImpulses::default(),
+        }
+    }
+
+    fn slots(&self) -> (usize, usize) {
+        (self.input.a as usize, self.input.b as usize)
+    }
+
+    /// The rows, from the bodies' motion since the step's start.
+    fn rows(&self, states: &[BodyState]) -> Rows {
+        let (a, b) = self.slots();
+        let (sa, sb) = (&states[a], &states[b]);
+        let r_a = sa.delta_rotation * self.anchors[0];
+        let r_b = sb.delta_rotation * self.anchors[1];
+        let separation = self.delta_center + sb.delta_position - sa.delta_position + r_b - r_a;
+        let fa = sa.delta_rotation * self.frames[0];
+        let fb = sb.delta_rotation * self.frames[1];
+        let axis = fa * Vec3::X;
+        let mut rows = Rows {
+            anchors: (r_a, r_b),
+            separation,
+            angular: None,
+            across: None,
+            axis: None,
+        };
+        let lock = || (AngularRows::world(), rotation_error(fa, fb));
+        match self.input.kind {
+            JointKind::Fixed => rows.angular = Some(lock()),
+            JointKind::Spherical => {}
+            JointKind::Revolute { .. } => {
+                let (d, c) = hinge_directions(axis, [fb * Vec3::Y, fb * Vec3::Z]);
+                let hinge = AngularRows {
+                    directions: [d[0], d[1], Vec3::ZERO],
+                    count: 2,
+                };
+                rows.angular = Some((hinge, Vec3::new(c[0], c[1], 0.0)));
+                rows.axis = Some((AxisRow::angular(axis), twist_angle(fa, fb)));
+            }
+            JointKind::Prismatic { .. } => {
+                rows.angular = Some(lock());
+                let slide = |dir: Vec3| {
+                    let row = AxisRow {
+                        linear: dir,
+                        angular_a: (r_a + separation).cross(dir),
+                        angular_b: r_b.cross(dir),
+                    };
+                    (row, dir.dot(separation))
+                };
+                rows.across = Some([slide(fa * Vec3::Y), slide(fa * Vec3::Z)]);
+                rows.axis = Some(slide(axis));
+            }
+            JointKind::Distance { .. } => {
+                let length = separation.length();
+                let n = if length > 1e-6 {
+                    separation / length
+                } else {
+                    axis
+                };
+                rows.axis = Some((AxisRow::linear(n, r_a, r_b), length));
+            }
+        }
+        rows
+    }
+
+    /// Applies the accumulated impulses.
+    pub fn warm_start(&self, states: &mut [BodyState]) {
+        let rows = self.rows(states);
+        let ab = self.slots();
+        let m = &self.masses;
+        let j = &self.impulses;
+        if self.holds_point() {
+            let (r_a, r_b) = rows.anchors;
+            m.apply(
+                states,
+                ab,
+                j.point,
+                [r_a.cross(j.point), r_b.cross(j.point)],
+            );
+        }
+        if let Some((angular, _)) = rows.angular {
+            let d = angular.directions;
+            let world = d[0] * j.angular.x + d[1] * j.angular.y + d[2] * j.angular.z;
+            m.apply(states, ab, Vec3::ZERO, [world, world]);
+        }
+        if let Some(across) = rows.across {
+            for ((row, _), impulse) in across.iter().zip(j.across) {
+                row.apply(m, states, ab, impulse);
+            }
+        }
+        if let Some((row, _)) = rows.axis {
+            row.apply(m, states, ab, j.motor + j.lower - j.upper);
+        }
+    }
+
+    /// One pass: biased (`soft` closes the position errors) or relaxing (rigid, no bias).
+    pub fn solve(&mut self, states: &mut [BodyState], soft: Softness, h: f32, use_bias: bool) {
+        let ab = self.slots();
+        let (limit, motor) = match self.input.kind {
+            JointKind::Revolute { limit, motor } | JointKind::Prismatic { limit, motor } => {
+                (limit, motor)
+            }
+            JointKind::Distance { limit, motor } => (Some(limit), motor),
+            _ => (None, None),
+        };
+        let bias_soft = if use_bias { soft } else { Softness::RIGID };
+        let rows = self.rows(states);
+        if let Some((row, coordinate)) = rows.axis {
+            let m = self.masses;
+            let j = &mut self.impulses;
+            if let Some(motor) = motor {
+                solve_motor(&row, coordinate, &motor, &m, states, ab, h, &mut j.motor);
+            }
+            if let Some(limit) = limit {
+                solve_limit(
+                    &row,
+                    coordinate,
+                    limit,
+                    &m,
+                    states,
+                    ab,
+                    (h, use_bias.then_some(soft)),
+                    j,
+                );
+            }
+        }
+        // The hard rows last, each from the state the rows before it left.
+        let rows = if rows.axis.is_some() {
+            self.rows(states)
+        } else {
+            rows
+        };
+        let error = |c: Vec3| use_bias.then_some(c);
+        if let Some((angular, c)) = rows.angular {
+            let acc = &mut self.impulses.angular;
+            angular.solve(&self.masses, states, ab, error(c), bias_soft, acc);
+        }
+        if let Some(across) = rows.across {
+            for ((row, c), acc) in across.iter().zip(&mut self.impulses.across) {
+                let bias = if use_bias { soft.bias_rate * c } else { 0.0 };
+                let free = (f32::NEG_INFINITY, f32::INFINITY);
+                row.solve(&self.masses, states, ab, bias, bias_soft, acc, free);
+            }
+        }
+        if self.holds_point() {
+            let acc = &mut self.impulses.point;
+            let c = error(rows.separation);
+            solve_point(&self.masses, states, ab, rows.anchors, c, bias_soft, acc);
+        }
+    }
+
+    fn holds_point(&self) -> bool {
+        matches!(
+            self.input.kind,
+            JointKind::Fixed | JointKind::Spherical | JointKind::Revolute { .. }
+        )
+    }
+
+    /// The force (N) and torque (N·m) the joint applied over the last substep of the step:
+    /// its accumulated impulses over the substep `h`.
+    pub fn load(&self, h: f32) -> (f32, f32) {
+        let j = &self.impulses;
+        let axial = j.motor + j.lower - j.upper;
+        let mut force = j.point.length() + Vec3::new(j.across[0], j.across[1], 0.0).length();
+        let mut torque = j.angular.length();
+        match self.input.kind {
+            JointKind::Revolute { .. } => torque += axial.abs(),
+            _ => force += axial.abs(),
+        }
+        (force / h, torque / h)
+    }
+}
+
+impl AngularRows {
+    /// The three world axes: a lock of the relative turn.
+    pub fn world() -> Self {
+        Self {
+            directions: [Vec3::X, Vec3::Y, Vec3::Z],
+            count: 3,
+        }
+    }
+}
+
+/// How far frame `fb` is turned from `fa`, as a world rotation vector (`2·vec(fb fa⁻¹)` on the
+/// short way round: its rate is `ω_b − ω_a` for small errors).
+fn rotation_error(fa: Quat, fb: Quat) -> Vec3 {
+    let e = fb * fa.inverse();
+    let e = if e.w < 0.0 { -e } else { e };
+    2.0 * Vec3::new(e.x, e.y, e.z)
+}
+
+/// The angle `fb` is turned from `fa` about `fa`'s x axis, in `(−π, π]` (the twist of the
+/// relative rotation; exact when the alignment rows hold the axes together).
+pub fn twist_angle(fa: Quat, fb: Quat) -> f32 {
+    let r = fa.inverse() * fb;
+    let r = if r.w < 0.0 { -r } else { r };
+    2.0 * r.x.atan2(r.w)
+}
+
+/// The motor's row: towards its speed (rigid), or towards its position as a spring; the
+/// accumulated impulse within `max_force·h`.
+#[allow(clippy::too_many_arguments)]
+fn solve_motor(
+    row: &AxisRow,
+    coordinate: f32,
+    motor: &JointMotor,
+    m: &PairMasses,
+    states: &mut [BodyState],
+    ab: (usize, usize),
+    h: f32,
+    acc: &mut f32,
+) {
+    let (bias, soft) = match motor.target_position {
+        Some(target) => {
+            let soft = Softness::new(motor.hertz, motor.damping_ratio, h);
+            // A spring of 0 Hz holds nothing (Softness would make it rigid).
+            if motor.hertz <= 0.0 {
+                (0.0, Softness::RIGID)
+            } else {
+                (soft.bias_rate * (coordinate - target), soft)
+            }
+        }
+        None => (0.0, Softness::RIGID),
+    };
+    let max = motor.max_force.max(0.0) * h;
+    let bias = bias - motor.target_velocity;
+    row.solve(m, states, ab, bias, soft, acc, (-max, max));
+}
+
+/// A limit's rows: an equal limit holds the coordinate; else each bound pushes only, and is
+/// speculative while not reached (it lets the coordinate close its gap this substep). `soft`
+/// closes a violation in the biased pass; the relax passes (`None`) are rigid.
+#[allow(clippy::too_many_arguments)]
+fn solve_limit(
+    row: &AxisRow,
+    coordinate: f32,
+    limit: JointLimit,
+    m: &PairMasses,
+    states: &mut [BodyState],
+    ab: (usize, usize),
+    (h, soft): (f32, Option<Softness>),
+    j: &mut JointImpulses,
+) {
+    let bias_of = |c: f32| match soft {
+        Some(soft) => (soft.bias_rate * c, soft),
+        None => (0.0, Softness::RIGID),
+    };
+    if limit.min == limit.max {
+        let (bias, soft) = bias_of(coordinate - limit.min);
+        let free = (f32::NEG_INFINITY, f32::INFINITY);
+        row.solve(m, states, ab, bias, soft, &mut j.lower, free);
+        return;
+    }
+    let reversed = AxisRow {
+        linear: -row.linear,
+        angular_a: -row.angular_a,
+        angular_b: -row.angular_b,
+    };
+    let push = (0.0, f32::INFINITY);
+    for (row, c, acc) in [
+        (row, coordinate - limit.min, &mut j.lower),
+        (&reversed, limit.max - coordinate, &mut j.upper),
+    ] {
+        if c == f32::INFINITY {
+            continue;
+        }
+        let (bias, soft) = if c > 0.0 {
+            (c / h, Softness::RIGID)
+        } else {
+            bias_of(c)
+        };
+        row.solve(m, states, ab, bias, soft, acc, push);
+    }
+}

@@ -1,0 +1,378 @@
+//! The pure constraint math of joints: the rows a joint is made of, their Jacobians, effective
+//! masses and impulses, apart from any joint kind (as Avian's `dynamics/solver/joints` keeps
+//! its `PointConstraintPart`s apart, and Jolt its `AxisConstraintPart`,
+//! `PointConstraintPart` and `RotationEulerConstraintPart`).
+//!
+//! Every row works on the velocities `V = (v_a, ω_a, v_b, ω_b)` of two bodies with inverse
+//! masses `m_a⁻¹`, `m_b⁻¹` and world inverse inertias `I_a⁻¹`, `I_b⁻¹`. A row with Jacobian
+//! `J` has the velocity error `Ċ = J V`, the effective mass `K⁻¹` with `K = J M⁻¹ Jᵀ`, and an
+//! impulse `λ` changes the velocities by `M⁻¹ Jᵀ λ`. The soft form of the impulse
+//! (`λ = −mass_scale K⁻¹ (Ċ + bias) − impulse_scale λ_acc`) is [`Softness`]'s.
+//!
+//! * [`AxisRow`]: one scalar row `J = [−lᵀ, −u_aᵀ, lᵀ, u_bᵀ]` (a hinge's angle `l = 0`,
+//!   `u_a = u_b = axis`; a slider's travel and a rope's length, see the joints).
+//! * [`point_mass`]: the three rows keeping two anchors together (a ball joint). With
+//!   `C = c_b + r_b − c_a − r_a`, `Ċ = v_b + ω_b × r_b − v_a − ω_a × r_a`; as
+//!   `ω × r = −[r]× ω`, `J = [−1, [r_a]×, 1, −[r_b]×]` and
+//!   `K = (m_a⁻¹ + m_b⁻¹) 1 − [r_a]× I_a⁻¹ [r_a]× − [r_b]× I_b⁻¹ [r_b]×` (3×3, symmetric).
+//! * [`AngularRows`]: two or three rows on the relative angular velocity alone,
+//!   `Ċ_i = u_i · (ω_b − ω_a)`, `J_i = [0, −u_iᵀ, 0, u_iᵀ]`, `K_ij = u_i · (I_a⁻¹ + I_b⁻¹) u_j`
+//!   (a weld's lock: `u` the world axes; a hinge's alignment: two directions, see
+//!   [`hinge_directions`]).
+
+use super::body::{BodyParams, BodyState};
+use super::softness::Softness;
+use glam::{Mat3, Vec3};
+
+/// The two bodies of a joint as its rows see them: masses and world inverse inertias.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PairMasses {
+    /// `m_a⁻¹`, `m_b⁻¹`.
+    pub inverse_mass: [f32; 2],
+    /// `I_a⁻¹`, `I_b⁻¹` (world, at the step's start).
+    pub inverse_inertia: [Mat3; 2],
+    /// Whether the solver may change each body's velocities.
+    pub dynamic: [bool; 2],
+}
+
+impl PairMasses {
+    /// The masses of bodies `a` and `b`.
+    pub fn of(params: &[BodyParams], a: usize, b: usize) -> Self {
+        let (pa, pb) = (&params[a], &params[b]);
+        Self {
+            inverse_mass: [pa.inverse_mass, pb.inverse_mass],
+            inverse_inertia: [pa.inverse_inertia, pb.inverse_inertia],
+            dynamic: [pa.dynamic, pb.dynamic],
+        }
+    }
+
+    /// Applies the impulse `λ` of a row, linear part `l λ`, angular parts `u_a λ`, `u_b λ`:
+    /// `v_a −= m_a⁻¹ l λ`, `ω_a −= I_a⁻¹ u_a λ`, and the opposite signs for B.
+    pub fn apply(
+        &self,
+        states: &mut [BodyState],
+        (a, b): (usize, usize),
+        linear: Vec3,
+        angular: [Vec3; 2],
+    ) {
+        if self.dynamic[0] {
+            let s = &mut states[a];
+            s.linear_velocity -= linear * self.inverse_mass[0];
+            s.angular_velocity -= self.inverse_inertia[0] * angular[0];
+        }
+        if self.dynamic[1] {
+            let s = &mut states[b];
+            s.linear_velocity += linear * self.inverse_mass[1];
+            s.angular_velocity += self.inverse_inertia[1] * angular[1];
+        }
+    }
+}
+
+/// One scalar row `J = [−lᵀ, −u_aᵀ, lᵀ, u_bᵀ]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AxisRow {
+    /// The linear direction `l`.
+    pub linear: Vec3,
+    /// A's angular direction `u_a`.
+    pub angular_a: Vec3,
+    /// B's angular direction `u_b`.
+    pub angular_b: Vec3,
+}
+
+impl AxisRow {
+    /// A row on the relative turn about `axis` (a hinge's angle).
+    pub fn angular(axis: Vec3) -> Self {
+        Self {
+            linear: Vec3::ZERO,
+            angular_a: axis,
+            angular_b: axis,
+        }
+    }
+
+    /// A row along `direction` between anchors `r_a`, `r_b` (a slider's travel uses its own
+    /// `u_a`, see the prismatic joint).
+    pub fn linear(direction: Vec3, r_a: Vec3, r_b: Vec3) -> Self {
+        Self {
+            linear: direction,
+            angular_a: r_a.cross(direction),
+            angular_b: r_b.cross(direction),
+        }
+    }
+
+    /// `Ċ = J V`.
+    pub fn velocity(&self, sa: &BodyState, sb: &BodyState) -> f32 {
+        self.linear.dot(sb.linear_velocity - sa.linear_velocity)
+            + self.angular_b.dot(sb.angular_velocity)
+            - self.angular_a.dot(sa.angular_velocity)
+    }
+
+    /// `K = J M⁻¹ Jᵀ`.
+    pub fn k(&self, m: &PairMasses) -> f32 {
+        let [ia, ib] = m.inverse_inertia;
+        (m.inverse_mass[0] + m.inverse_mass[1]) * self.linear.length_squared()
+            + self.angular_a.dot(ia * self.angular_a)
+            + self.angular_b.dot(ib * self.angular_b)
+    }
+
+    /// Applies `λ` along the row.
+    pub fn apply(&self, m: &PairMasses, states: &mut [BodyState], ab: (usize, usize), lambda: f32) {
+        m.apply(
+            states,
+            ab,
+            self.linear * lambda,
+            [self.angular_a * lambda, self.angular_b * lambda],
+        );
+    }
+
+    /// Solves the row towards `Ċ = target − bias` (soft when `soft` is given) and clamps the
+    /// accumulated impulse to `range`; returns the impulse applied.
+    #[allow(clippy::too_many_arguments)]
+    pub fn solve(
+        &self,
+        m: &PairMasses,
+        states: &mut [BodyState],
+        (a, b): (usize, usize),
+        bias: f32,
+        soft: Softness,
+        accumulated: &mut f32,
+        range: (f32, f32),
+    ) -> f32 {
+        let k = self.k(m);
+        if k.is_nan() || k <= 0.0 {
+            return 0.0;
+        }
+        let cdot = self.velocity(&states[a], &states[b]);
+        let impulse = -soft.mass_scale * (cdot + bias) / k - soft.impulse_scale * *accumulated;
+        let old = *accumulated;
+        *accumulated = (old + impulse).clamp(range.0, range.1);
+        let applied = *accumulated - old;
+        self.apply(m, states, (a, b), applied);
+        applied
+    }
+}
+
+/// `[v]×`, the matrix of `x ↦ v × x`.
+pub fn skew(v: Vec3) -> Mat3 {
+    Mat3::from_cols(
+        Vec3::new(0.0, v.z, -v.y),
+        Vec3::new(-v.z, 0.0, v.x),
+        Vec3::new(v.y, -v.x, 0.0),
+    )
+}
+
+/// The point rows' `K` for anchors `r_a`, `r_b` (see the module doc).
+pub fn point_mass(m: &PairMasses, r_a: Vec3, r_b: Vec3) -> Mat3 {
+    let (sa, sb) = (skew(r_a), skew(r_b));
+    let [ia, ib] = m.inverse_inertia;
+    Mat3::from_diagonal(Vec3::splat(m.inverse_mass[0] + m.inverse_mass[1]))
+        - sa * ia * sa
+        - sb * ib * sb
+}
+
+/// Solves the point rows: anchors `r_a`, `r_b` (world, now), position error `c` (`None` in a
+/// relax pass); `accumulated` is the world impulse on B. Returns the impulse applied.
+#[allow(clippy::too_many_arguments)]
+pub fn solve_point(
+    m: &PairMasses,
+    states: &mut [BodyState],
+    (a, b): (usize, usize),
+    (r_a, r_b): (Vec3, Vec3),
+    error: Option<Vec3>,
+    soft: Softness,
+    accumulated: &mut Vec3,
+) -> Vec3 {
+    let (sa, sb) = (&states[a], &states[b]);
+    let cdot = sb.linear_velocity + sb.angular_velocity.cross(r_b)
+        - sa.linear_velocity
+        - sa.angular_velocity.cross(r_a);
+    let (bias, soft) = match error {
+        Some(c) => (c * soft.bias_rate, soft),
+        None => (Vec3::ZERO, Softness::RIGID),
+    };
+    let k = point_mass(m, r_a, r_b);
+    let impulse = -soft.mass_scale * solve3(k, cdot + bias) - soft.impulse_scale * *accumulated;
+    *accumulated += impulse;
+    m.apply(
+        states,
+        (a, b),
+        impulse,
+        [r_a.cross(impulse), r_b.cross(impulse)],
+    );
+    impulse
+}
+
+/// `K⁻¹ x` for a symmetric positive semi-definite `K`: the inverse when it is well
+/// conditioned, else row by row (a body turning about some axes only, or two immovable
+/// bodies: those rows take no impulse).
+pub fn solve3(k: Mat3, x: Vec3) -> Vec3 {
+    let det = k.determinant();
+    let scale = k.x_axis.x * k.y_axis.y * k.z_axis.z;
+    if det.is_finite() && det > 1e-6 * scale && scale > 0.0 {
+        return k.inverse() * x;
+    }
+    let inv = |d: f32| if d > 0.0 { 1.0 / d } else { 0.0 };
+    x * Vec3::new(inv(k.x_axis.x), inv(k.y_axis.y), inv(k.z_axis.z))
+}
+
+/// Two or three rows on the relative angular velocity (see the module doc); the directions
+/// are world axes at the step's start.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AngularRows {
+    /// The row directions (two used when `count == 2`).
+    pub directions: [Vec3; 3],
+    /// 2 or 3.
+    pub count: usize,
+}
+
+impl AngularRows {
+    /// `K` restricted to the rows (the unused third row is the identity, so it takes nothing).
+    fn k(&self, m: &PairMasses) -> Mat3 {
+        let i = m.inverse_inertia[0] + m.inverse_inertia[1];
+        let d = self.directions;
+        let mut k = Mat3::IDENTITY;
+        for r in 0..self.count {
+            for c in 0..self.count {
+                k.col_mut(c)[r] = d[r].dot(i * d[c]);
+            }
+        }
+        k
+    }
+
+    /// Solves the rows towards zero relative turn, with per-row position errors `error`
+    /// (`None` in a relax pass); `accumulated` holds one impulse per row. Returns the world
+    /// angular impulse applied to B.
+    pub fn solve(
+        &self,
+        m: &PairMasses,
+        states: &mut [BodyState],
+        (a, b): (usize, usize),
+        error: Option<Vec3>,
+        soft: Softness,
+        accumulated: &mut Vec3,
+    ) -> Vec3 {
+        let relative = states[b].angular_velocity - states[a].angular_velocity;
+        let d = self.directions;
+        let mut cdot = Vec3::ZERO;
+        for (r, dir) in d.iter().enumerate().take(self.count) {
+            cdot[r] = dir.dot(relative);
+        }
+        let (bias, soft) = match error {
+            Some(c) => (c * soft.bias_rate, soft),
+            None => (Vec3::ZERO, Softness::RIGID),
+        };
+        let mut impulse =
+            -soft.mass_scale * solve3(self.k(m), cdot + bias) - soft.impulse_scale * *accumulated;
+        if self.count == 2 {
+            impulse.z = 0.0;
+        }
+        *accumulated += impulse;
+        let world = d[0] * impulse.x + d[1] * impulse.y + d[2] * impulse.z;
+        m.apply(states, (a, b), Vec3::ZERO, [world, world]);
+        world
+    }
+}
+
+/// The two directions of a hinge's alignment rows: with `axis_a` on A and `perp_b`, `perp_b2`
+/// on B perpendicular to B's axis, `C = (axis_a · p_1, axis_a · p_2)` is zero when the axes
+/// agree, and `d/dt (axis_a · p) = (ω_a × axis_a)·p + axis_a·(ω_b × p)
+/// = (ω_b − ω_a) · (p × axis_a)`: the row directions are `p_i × axis_a` (Jolt's
+/// `HingeRotationConstraintPart`).
+pub fn hinge_directions(axis_a: Vec3, perp_b: [Vec3; 2]) -> ([Vec3; 2], [f32; 2]) {
+    (
+        [perp_b[0].cross(axis_a), perp_b[1].cross(axis_a)],
+        [axis_a.dot(perp_b[0]), axis_a.dot(perp_b[1])],
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn masses(ma: f32, mb: f32) -> PairMasses {
+        PairMasses {
+            inverse_mass: [1.0 / ma, 1.0 / mb],
+            inverse_inertia: [
+                Mat3::from_diagonal(Vec3::new(1.0, 2.0, 3.0)),
+                Mat3::from_diagonal(Vec3::new(0.5, 0.25, 4.0)),
+            ],
+            dynamic: [true, true],
+        }
+    }
+
+    #[test]
+    fn the_point_rows_stop_the_anchors_relative_velocity_within_1e_5() {
+        let m = masses(2.0, 3.0);
+        let mut states = [BodyState::default(); 2];
+        states[0].linear_velocity = Vec3::new(1.0, -2.0, 0.5);
+        states[0].angular_velocity = Vec3::new(0.3, 1.0, -2.0);
+        states[1].angular_velocity = Vec3::new(-1.0, 0.2, 0.7);
+        let (ra, rb) = (Vec3::new(0.5, 0.2, -0.1), Vec3::new(-0.3, 0.4, 0.6));
+        let mut acc = Vec3::ZERO;
+        solve_point(
+            &m,
+            &mut states,
+            (0, 1),
+            (ra, rb),
+            None,
+            Softness::RIGID,
+            &mut acc,
+        );
+        let (sa, sb) = (states[0], states[1]);
+        let rel = sb.linear_velocity + sb.angular_velocity.cross(rb)
+            - sa.linear_velocity
+            - sa.angular_velocity.cross(ra);
+        assert!(rel.length() < 1e-5, "{rel}");
+    }
+
+    #[test]
+    fn an_axis_row_conserves_momentum_and_zeroes_its_velocity_within_1e_6() {
+        let m = masses(1.0, 4.0);
+        let mut states = [BodyState::default(); 2];
+        states[0].linear_velocity = Vec3::X;
+        let row = AxisRow::linear(Vec3::X, Vec3::ZERO, Vec3::ZERO);
+        let mut acc = 0.0;
+        row.solve(
+            &m,
+            &mut states,
+            (0, 1),
+            0.0,
+            Softness::RIGID,
+            &mut acc,
+            (f32::NEG_INFINITY, f32::INFINITY),
+        );
+        let p = states[0].linear_velocity + 4.0 * states[1].linear_velocity;
+        assert!((p - Vec3::X).length() < 1e-6);
+        assert!(row.velocity(&states[0], &states[1]).abs() < 1e-6);
+    }
+
+    #[test]
+    fn three_angular_rows_stop_the_relative_turn_and_two_leave_the_hinge_axis_free() {
+        let m = masses(1.0, 1.0);
+        let mut states = [BodyState::default(); 2];
+        states[1].angular_velocity = Vec3::new(1.0, 2.0, 3.0);
+        let lock = AngularRows {
+            directions: [Vec3::X, Vec3::Y, Vec3::Z],
+            count: 3,
+        };
+        let mut acc = Vec3::ZERO;
+        let mut locked = states;
+        lock.solve(&m, &mut locked, (0, 1), None, Softness::RIGID, &mut acc);
+        let rel = locked[1].angular_velocity - locked[0].angular_velocity;
+        assert!(rel.length() < 1e-5, "{rel}");
+        let hinge = AngularRows {
+            directions: [Vec3::X, Vec3::Y, Vec3::ZERO],
+            count: 2,
+        };
+        let mut acc = Vec3::ZERO;
+        hinge.solve(&m, &mut states, (0, 1), None, Softness::RIGID, &mut acc);
+        let rel = states[1].angular_velocity - states[0].angular_velocity;
+        assert!(rel.x.abs() < 1e-5 && rel.y.abs() < 1e-5, "{rel}");
+        assert!((rel.z - 3.0).abs() < 1e-5, "the free axis kept {rel}");
+    }
+
+    #[test]
+    fn a_singular_mass_takes_no_impulse_on_its_empty_rows() {
+        let k = Mat3::from_diagonal(Vec3::new(2.0, 0.0, 0.0));
+        assert_eq!(solve3(k, Vec3::ONE), Vec3::new(0.5, 0.0, 0.0));
+    }
+}
