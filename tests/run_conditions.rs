@@ -163,11 +163,22 @@ fn busy_scene(app: &mut bevy_app::App) -> [bevy_ecs::entity::Entity; 2] {
         Velocity(Vec3::new(200.0, 0.0, 0.0)),
         Ccd,
     ));
+    let lamp = world
+        .spawn((
+            Collider::sphere(0.2),
+            Position::new(0.0, -5.0, 3.0),
+            Velocity::default(),
+        ))
+        .id();
+    world.spawn(
+        Joint::spherical(lamp, JointEnd::World)
+            .with_anchors(Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.0, -5.0, 4.0)),
+    );
     [resting, falling]
 }
 
 #[test]
-fn every_one_of_the_15_plugins_can_be_disabled_and_a_busy_scene_steps_without_a_panic_the_ball_resting_within_2_cm()
+fn every_one_of_the_16_plugins_can_be_disabled_and_a_busy_scene_steps_without_a_panic_the_ball_resting_within_2_cm()
  {
     use bevy_app::{App, PluginGroup};
     use urto::plugins::*;
@@ -177,7 +188,7 @@ fn every_one_of_the_15_plugins_can_be_disabled_and_a_busy_scene_steps_without_a_
         app
     }
     type MakeApp = fn() -> App;
-    let apps: [(&str, MakeApp); 15] = [
+    let apps: [(&str, MakeApp); 16] = [
         ("core", without::<PhysicsCorePlugin>),
         ("validation", without::<ValidationPlugin>),
         ("forces", without::<ForcesPlugin>),
@@ -188,6 +199,7 @@ fn every_one_of_the_15_plugins_can_be_disabled_and_a_busy_scene_steps_without_a_
         ("ccd", without::<CcdPlugin>),
         ("narrow phase", without::<NarrowPhasePlugin>),
         ("soft step", without::<SoftStepPlugin>),
+        ("joints", without::<JointPlugin>),
         ("response", without::<ResponsePlugin>),
         ("sleep", without::<SleepPlugin>),
         ("transform sync", without::<TransformSyncPlugin>),

@@ -26,9 +26,13 @@
 //! spread to their neighbours.
 
 mod angular;
+mod joint;
 mod sleeping;
 
 pub use angular::{AngularDrag, AngularVelocity, ForceAtPoint, Inertia, LockedAxes, Torque};
+pub use joint::{
+    Joint, JointBroken, JointDisabled, JointEnd, JointKind, JointLimit, JointLoad, JointMotor,
+};
 pub(crate) use sleeping::SleepTransitions;
 pub use sleeping::{SleepState, Sleeping, SleepingIslands};
 

@@ -20,6 +20,7 @@ pub mod forces;
 pub mod hierarchy;
 pub mod integration;
 pub mod interpolation;
+pub mod joints;
 pub mod narrow_phase;
 mod proxy_table;
 mod required_resources;
@@ -39,6 +40,7 @@ pub use forces::{ForcesPlugin, GatheredForces};
 pub use hierarchy::HierarchyPlugin;
 pub use integration::IntegrationPlugin;
 pub use interpolation::{InterpolationPlugin, PreviousPose, TransformInterpolation};
+pub use joints::{JointPlugin, JointedPairs};
 pub use narrow_phase::{ContactPair, Contacts, NarrowPhasePlugin};
 pub use response::{CollisionEnded, CollisionStarted, ReportCollisions, ResponsePlugin};
 pub use rotation::RotationPlugin;
@@ -92,6 +94,7 @@ impl PluginGroup for UrtoPlugins {
             .add(CcdPlugin)
             .add(NarrowPhasePlugin)
             .add(SoftStepPlugin::default())
+            .add(JointPlugin)
             .add(ResponsePlugin)
             .add(SleepPlugin)
             .add(TransformSyncPlugin)

@@ -38,6 +38,7 @@ use crate::geometry::contacts::{
 use crate::geometry::{ContactManifold, Shape};
 use crate::hierarchy::{BvTree, HierarchyStats, PairScratch, descend_pairs};
 use crate::plugins::broad_phase::BroadPhasePairs;
+use crate::plugins::joints::JointedPairs;
 use crate::plugins::required_resources::RequireResource;
 use crate::plugins::sleep::dormant;
 use crate::plugins::soft_step::LookaheadParams;
@@ -230,6 +231,7 @@ fn compute_contacts(
     motion: Query<Motion>,
     layers: Query<&CollisionLayers>,
     sensors: Query<(), With<Sensor>>,
+    jointed: Option<Res<JointedPairs>>,
     mut overlaps: ResMut<SensorOverlaps>,
     lookahead: LookaheadParams,
     sleep: Option<Res<SleepSettings>>,
@@ -269,9 +271,13 @@ fn compute_contacts(
     let interacts = |x: Entity, y: Entity| {
         !any_layers || layers_of(layers.get(x).ok()).interacts_with(&layers_of(layers.get(y).ok()))
     };
+    let jointed = jointed.as_deref().filter(|j| !j.is_empty());
     for &(a, b) in &pairs.pairs {
         if sleeping && dormant(a) && dormant(b) {
             continue; // at rest against each other: nothing to compute until one wakes
+        }
+        if jointed.is_some_and(|j| j.contains(a, b)) {
+            continue; // a joint keeps them from colliding
         }
         let margin = margin(a) + margin(b);
         let compound = |e: Entity| matches!(nodes.get(e), Ok((.., Some(_))));

@@ -24,6 +24,7 @@
 use crate::components::*;
 use crate::dynamics::islands::{IslandBuilder, Stillness, islands_to_sleep};
 use crate::plugins::core::PrepareWake;
+use crate::plugins::joints::ActiveJoint;
 use crate::plugins::narrow_phase::Contacts;
 use crate::plugins::required_resources::RequireResource;
 use crate::schedule::{PhysicsSchedule, PhysicsSet};
@@ -303,6 +304,7 @@ fn fall_asleep(
     sleepers: Query<&SleepState, With<Sleeping>>,
     never_sleep: Query<(), (With<Spring>, Without<Static>)>,
     contacts: Option<Res<Contacts>>,
+    joints: Query<&Joint, ActiveJoint>,
     settings: Res<SleepSettings>,
     timestep: Res<PhysicsTimestep>,
     mut islands: ResMut<SleepingIslands>,
@@ -319,6 +321,13 @@ fn fall_asleep(
         for pair in &contacts.pairs {
             link_contact(s, (pair.a, pair.b), &sleepers, &never_sleep);
             link_contact(s, (pair.b, pair.a), &sleepers, &never_sleep);
+        }
+    }
+    // Jointed bodies are one island: they fall asleep and wake together.
+    for joint in &joints {
+        if let Some(b) = joint.body_b_entity() {
+            link_contact(s, (joint.body_a, b), &sleepers, &never_sleep);
+            link_contact(s, (b, joint.body_a), &sleepers, &never_sleep);
         }
     }
     islands_to_sleep(&mut s.islands, &s.stillness, settings.time, &mut s.asleep);

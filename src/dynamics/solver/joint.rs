@@ -43,6 +43,15 @@ pub struct JointFrame {
     pub basis: Quat,
 }
 
+impl JointFrame {
+    /// A finite anchor and a finite unit basis.
+    pub fn is_usable(&self) -> bool {
+        self.anchor.is_finite()
+            && self.basis.is_finite()
+            && (self.basis.length() - 1.0).abs() < 1e-3
+    }
+}
+
 impl Default for JointFrame {
     fn default() -> Self {
         Self {
@@ -132,6 +141,41 @@ pub enum JointKind {
         /// Drives the distance.
         motor: Option<JointMotor>,
     },
+}
+
+impl JointKind {
+    /// The limit and the motor, where the kind has them.
+    pub fn limit_and_motor(&self) -> (Option<JointLimit>, Option<JointMotor>) {
+        match *self {
+            Self::Revolute { limit, motor } | Self::Prismatic { limit, motor } => (limit, motor),
+            Self::Distance { limit, motor } => (Some(limit), motor),
+            Self::Fixed | Self::Spherical => (None, None),
+        }
+    }
+
+    /// Why the limit or motor is unusable, if one is: a limit with `min > max` or NaN (or below
+    /// 0 for a distance), a motor with a negative or NaN force, a non-finite target or an
+    /// unusable stiffness.
+    pub fn problem(&self) -> Option<String> {
+        let (limit, motor) = self.limit_and_motor();
+        if let Some(l) = limit
+            && (l.min.is_nan() || l.max.is_nan() || l.min > l.max)
+        {
+            return Some(format!("limit {}..={} is empty or NaN", l.min, l.max));
+        }
+        if matches!(self, Self::Distance { limit, .. } if limit.min < 0.0) {
+            return Some("a distance limit below 0".into());
+        }
+        if let Some(m) = motor {
+            let target_ok = m.target_position.is_none_or(f32::is_finite);
+            let spring_ok = m.hertz.is_finite() && m.hertz >= 0.0 && m.damping_ratio >= 0.0;
+            let force_ok = m.max_force >= 0.0;
+            if !(force_ok && m.target_velocity.is_finite() && target_ok && spring_ok) {
+                return Some(format!("motor {m:?} has an unusable value"));
+            }
+        }
+        None
+    }
 }
 
 /// A joint between two solver slots, as the caller describes it.
@@ -302,13 +346,7 @@ impl JointConstraint {
     /// One pass: biased (`soft` closes the position errors) or relaxing (rigid, no bias).
     pub fn solve(&mut self, states: &mut [BodyState], soft: Softness, h: f32, use_bias: bool) {
         let ab = self.slots();
-        let (limit, motor) = match self.input.kind {
-            JointKind::Revolute { limit, motor } | JointKind::Prismatic { limit, motor } => {
-                (limit, motor)
-            }
-            JointKind::Distance { limit, motor } => (Some(limit), motor),
-            _ => (None, None),
-        };
+        let (limit, motor) = self.input.kind.limit_and_motor();
         let bias_soft = if use_bias { soft } else { Softness::RIGID };
         let rows = self.rows(states);
         if let Some((row, coordinate)) = rows.axis {

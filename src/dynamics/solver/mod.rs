@@ -222,7 +222,8 @@ impl Solver {
 
     /// Advances `bodies` by `dt` under `contacts` (sorted by key; see the module doc),
     /// `springs` (their `body` and `other` are slots; each pulls its bodies' centres of mass)
-    /// and `joints` (a joint naming a slot past the bodies, or one body twice, is skipped).
+    /// and `joints` (a joint naming a slot past the bodies or one body twice, or with unusable
+    /// frames, limit or motor, is skipped: see [`JointKind::problem`]).
     pub fn step(
         &mut self,
         bodies: &mut SolverBodies,
@@ -288,7 +289,10 @@ impl Solver {
         let n = bodies.len() as u32;
         self.joints.clear();
         for joint in joints {
-            if joint.a >= n || joint.b >= n || joint.a == joint.b {
+            let usable = joint.frame_a.is_usable()
+                && joint.frame_b.is_usable()
+                && joint.kind.problem().is_none();
+            if joint.a >= n || joint.b >= n || joint.a == joint.b || !usable {
                 continue;
             }
             let mut c = JointConstraint::prepare(joint, bodies);

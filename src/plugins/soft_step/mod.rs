@@ -30,11 +30,13 @@
 //! by archetype iteration.
 
 mod contact_inputs;
+mod joint_inputs;
 mod lookahead;
 
 pub use lookahead::SpeculativeMargin;
 
 use contact_inputs::{Material, add_part_motion, gather_contacts, report_impulses};
+use joint_inputs::JointParams;
 pub(crate) use lookahead::{Lookahead, LookaheadParams};
 
 use crate::components::*;
@@ -42,7 +44,9 @@ use crate::dynamics::forces::{
     MAX_SPRING_DAMPING_RATIO, MAX_SPRING_STIFFNESS_RATIO, Spring as CoreSpring, SpringEnd,
 };
 use crate::dynamics::solver::Solver;
-use crate::dynamics::solver::{BodyInput, ContactInput, SoftStepSettings, SolverBodies};
+use crate::dynamics::solver::{
+    BodyInput, ContactInput, JointInput, SoftStepSettings, SolverBodies,
+};
 use crate::plugins::forces::GatheredForces;
 use crate::plugins::narrow_phase::Contacts;
 use crate::plugins::required_resources::RequireResource;
@@ -100,6 +104,9 @@ pub struct SoftStepSolver {
     bodies: SolverBodies,
     contacts: Vec<ContactInput>,
     springs: Vec<CoreSpring>,
+    joints: Vec<JointInput>,
+    /// Each slot's centre of mass in its body frame (joint anchors are given from the origin).
+    local_centers: Vec<Vec3>,
     waking: Vec<Entity>,
     keyed: Vec<(ContactInput, u32)>,
     sources: Vec<u32>,
@@ -107,6 +114,16 @@ pub struct SoftStepSolver {
 }
 
 impl SoftStepSolver {
+    /// Each joint of the last step with the force (N) and torque (N·m) it held over the last
+    /// substep.
+    pub fn joint_loads(&self) -> impl Iterator<Item = (Entity, f32, f32)> + '_ {
+        let h = self.solver.substep();
+        self.solver.joints().iter().map(move |j| {
+            let (force, torque) = j.load(h);
+            (Entity::from_bits(j.input.key), force, torque)
+        })
+    }
+
     /// A solver with these settings (unusable ones step with the defaults; see
     /// [`SoftStepSettings::validated`]); insert it to change the settings of a running app.
     pub fn new(settings: SoftStepSettings) -> Self {
@@ -161,12 +178,17 @@ fn solve_soft_step(
     mut soft: ResMut<SoftStepSolver>,
     mut stats: ResMut<PhysicsStats>,
     mut waker: Waker,
+    joints: JointParams,
 ) {
     let start = Instant::now();
     let s = &mut *soft;
     let gyroscopic = rotation.is_none_or(|r| r.gyroscopic);
     s.waking.clear();
+    let jointed = joints.any();
     if let Some(sleep) = sleep.filter(|s| s.enabled) {
+        if jointed {
+            joints.wake_partners(&movers, &mut s.waking);
+        }
         wake_touched_sleepers(
             &mut movers,
             &contacts,
@@ -178,21 +200,30 @@ fn solve_soft_step(
     let held =
         |asleep: bool, e: Entity, waking: &[Entity]| asleep && waking.binary_search(&e).is_err();
     let awake = collect_entities(&awake, &contacts, &mut s.entities);
+    if jointed {
+        joints.add_bodies(&mut s.entities);
+        s.entities.sort_unstable();
+        s.entities.dedup();
+    }
     s.bodies.clear();
+    s.local_centers.clear();
     for &e in &s.entities {
-        let input = match movers.get(e) {
-            Ok(m) if !held(m.10, e, &s.waking) => body_input(m, &gathered, gyroscopic),
-            _ => BodyInput {
-                center: poses
-                    .get(e)
-                    .map(|(p, _)| p.0.translation)
-                    .ok()
-                    .filter(|c| c.is_finite())
-                    .unwrap_or(Vec3::ZERO),
-                ..Default::default()
-            },
+        let (input, local_center) = match movers.get(e) {
+            Ok(m) if !held(m.10, e, &s.waking) => {
+                let local_center = m.6.local_center_of_mass;
+                (body_input(m, &gathered, gyroscopic), local_center)
+            }
+            _ => (immovable_input(poses.get(e).ok().map(|p| p.0)), Vec3::ZERO),
         };
         s.bodies.push(input);
+        s.local_centers.push(local_center);
+    }
+    s.joints.clear();
+    if jointed {
+        let world = joints
+            .any_to_world()
+            .then(|| s.bodies.push(BodyInput::default()));
+        joints.gather(&s.entities, &s.local_centers, world, &mut s.joints);
     }
     add_user_forces(&gathered, &s.entities, &mut s.bodies);
     gather_springs(&gathered, &s.entities, &s.bodies, &poses, &mut s.springs);
@@ -219,7 +250,7 @@ fn solve_soft_step(
         &mut s.bodies,
         &s.contacts,
         &s.springs,
-        &[],
+        &s.joints,
         timestep.substep_dt(),
     );
     report_impulses(&s.solver, &s.sources, &mut contacts);
@@ -244,6 +275,7 @@ fn solve_soft_step(
     stats.set_counter("soft_step/bodies", s.entities.len() as f64);
     stats.set_counter("soft_step/awake_bodies", awake as f64);
     stats.set_counter("soft_step/contacts", s.contacts.len() as f64);
+    stats.set_counter("soft_step/joints", s.joints.len() as f64);
     stats.add_time(Stage::Response, start.elapsed());
     stats.count_run("soft_step");
 }
@@ -303,6 +335,19 @@ fn collect_entities(
     out.sort_unstable();
     out.dedup();
     awake
+}
+
+/// A body the solver does not move (static, sleeping, or named by a contact or joint only), at
+/// its pose (the origin if it has none usable).
+fn immovable_input(pose: Option<&GlobalPose>) -> BodyInput {
+    let pose = pose
+        .map(|p| p.0)
+        .filter(|p| p.translation.is_finite() && p.rotation.is_finite());
+    BodyInput {
+        center: pose.map_or(Vec3::ZERO, |p| p.translation),
+        orientation: pose.map_or(Quat::IDENTITY, |p| p.rotation.normalize()),
+        ..Default::default()
+    }
 }
 
 /// A moving body at the step's start: its centre of mass, inertia, gravity and damping.
