@@ -190,6 +190,17 @@ impl Joint {
         self
     }
 
+    /// The motor, to change its target while the game runs (none on fixed and spherical
+    /// joints, or before [`with_motor`](Self::with_motor)).
+    pub fn motor_mut(&mut self) -> Option<&mut JointMotor> {
+        match &mut self.kind {
+            JointKind::Revolute { motor, .. }
+            | JointKind::Prismatic { motor, .. }
+            | JointKind::Distance { motor, .. } => motor.as_mut(),
+            _ => None,
+        }
+    }
+
     /// Lets the two bodies collide with each other.
     pub fn with_collisions(mut self) -> Self {
         self.collide_connected = true;
