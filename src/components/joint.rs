@@ -105,7 +105,11 @@ impl Joint {
 
     /// A ball joint: the anchors stay together, the bodies turn freely about them.
     pub fn spherical(a: Entity, b: impl Into<JointEnd>) -> Self {
-        Self::new(a, b, JointKind::Spherical)
+        let kind = JointKind::Spherical {
+            swing: None,
+            twist: None,
+        };
+        Self::new(a, b, kind)
     }
 
     /// A hinge about the joint's axis ([`with_axis`](Self::with_axis)).
@@ -165,16 +169,25 @@ impl Joint {
         self
     }
 
-    /// Bounds on the joint's coordinate (rad for a hinge, m for a slider or a distance); no
-    /// effect on fixed and spherical joints.
+    /// Bounds on the joint's coordinate (rad for a hinge, m for a slider or a distance, the
+    /// twist about the axis for a ball joint); no effect on fixed joints.
     pub fn with_limits(mut self, min: f32, max: f32) -> Self {
         let new = JointLimit { min, max };
         match &mut self.kind {
-            JointKind::Revolute { limit, .. } | JointKind::Prismatic { limit, .. } => {
-                *limit = Some(new)
-            }
+            JointKind::Revolute { limit, .. }
+            | JointKind::Prismatic { limit, .. }
+            | JointKind::Spherical { twist: limit, .. } => *limit = Some(new),
             JointKind::Distance { limit, .. } => *limit = new,
             _ => {}
+        }
+        self
+    }
+
+    /// Keeps a ball joint's B axis within `angle` (rad) of A's (a cone); no effect on other
+    /// kinds.
+    pub fn with_swing_limit(mut self, angle: f32) -> Self {
+        if let JointKind::Spherical { swing, .. } = &mut self.kind {
+            *swing = Some(angle);
         }
         self
     }

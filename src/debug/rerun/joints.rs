@@ -99,11 +99,22 @@ fn world_frames(joint: &Joint, poses: &Query<&GlobalPose>) -> Option<(Isometry, 
 
 /// How far the joint's coordinate is past its limit (rad or m; 0 within it or without one).
 fn past_limit(joint: &Joint, a: &Isometry, b: &Isometry) -> f32 {
+    let swing = match joint.kind {
+        JointKind::Spherical {
+            swing: Some(cone), ..
+        } => {
+            let (x_a, x_b) = (a.rotation * Vec3::X, b.rotation * Vec3::X);
+            (x_a.angle_between(x_b) - cone).max(0.0)
+        }
+        _ => 0.0,
+    };
     let (Some(limit), _) = joint.kind.limit_and_motor() else {
-        return 0.0;
+        return swing;
     };
     let coordinate = match joint.kind {
-        JointKind::Revolute { .. } => twist_angle(a.rotation, b.rotation),
+        JointKind::Revolute { .. } | JointKind::Spherical { .. } => {
+            twist_angle(a.rotation, b.rotation)
+        }
         JointKind::Prismatic { .. } => (a.rotation * Vec3::X).dot(b.translation - a.translation),
         _ => a.translation.distance(b.translation),
     };

@@ -11,7 +11,7 @@
 //! | kind | point rows | angular rows | axis coordinate (limit, motor) |
 //! | --- | --- | --- | --- |
 //! | fixed | 3 (anchors together) | 3 (frames aligned) | — |
-//! | spherical | 3 | — | — |
+//! | spherical | 3 | — (a swing cone and a twist limit if asked) | — |
 //! | revolute | 3 | 2 (axes aligned) | angle of B's frame about A's axis |
 //! | prismatic | 2 (across the axis) | 3 | travel of B's anchor along A's axis |
 //! | distance | — | — | distance between the anchors |
@@ -29,9 +29,11 @@
 //! [`joint_rows`]: super::joint_rows
 
 use super::body::{BodyState, SolverBodies};
-use super::joint_rows::{AngularRows, AxisRow, PairMasses, hinge_directions, solve_point};
+use super::joint_rows::{
+    AngularRows, AxisRow, PairMasses, hinge_directions, inverse_mass, point_mass, solve_point,
+};
 use super::softness::Softness;
-use glam::{Quat, Vec3};
+use glam::{Mat3, Quat, Vec3};
 
 /// Where a joint holds a body: an anchor from its centre of mass and a basis whose x axis is
 /// the joint's axis, both in the body's frame.
@@ -117,8 +119,14 @@ impl JointMotor {
 pub enum JointKind {
     /// Welds the bodies together.
     Fixed,
-    /// Keeps the anchors together; the bodies turn freely about them.
-    Spherical,
+    /// Keeps the anchors together; the bodies turn about them, B's axis within a cone of
+    /// `swing` (rad) around A's, twisted about it within `twist` (a ragdoll's shoulder).
+    Spherical {
+        /// Largest angle between the two frames' axes (rad, in `(0, π)`).
+        swing: Option<f32>,
+        /// Bounds on the twist of B's frame about the axis (rad, in `(−π, π]`).
+        twist: Option<JointLimit>,
+    },
     /// Keeps the anchors together and the axes aligned; the bodies turn about the axis.
     Revolute {
         /// Bounds on the angle (rad, in `(−π, π]`).
@@ -149,7 +157,8 @@ impl JointKind {
         match *self {
             Self::Revolute { limit, motor } | Self::Prismatic { limit, motor } => (limit, motor),
             Self::Distance { limit, motor } => (Some(limit), motor),
-            Self::Fixed | Self::Spherical => (None, None),
+            Self::Spherical { twist, .. } => (twist, None),
+            Self::Fixed => (None, None),
         }
     }
 
@@ -165,6 +174,13 @@ impl JointKind {
         }
         if matches!(self, Self::Distance { limit, .. } if limit.min < 0.0) {
             return Some("a distance limit below 0".into());
+        }
+        if let Self::Spherical {
+            swing: Some(cone), ..
+        } = self
+            && !(*cone > 0.0 && *cone < std::f32::consts::PI)
+        {
+            return Some(format!("a swing cone of {cone} rad (must be in (0, π))"));
         }
         if let Some(m) = motor {
             let target_ok = m.target_position.is_none_or(f32::is_finite);
@@ -210,6 +226,8 @@ pub struct JointImpulses {
     pub lower: f32,
     /// The upper limit's.
     pub upper: f32,
+    /// A ball joint's swing cone's.
+    pub swing: f32,
 }
 
 /// A joint prepared for a step.
@@ -224,6 +242,9 @@ pub struct JointConstraint {
     delta_center: Vec3,
     /// The joint frames in world at the step's start.
     frames: [Quat; 2],
+    /// The angular lock's `K⁻¹ = (I_a⁻¹ + I_b⁻¹)⁻¹` (fixed and prismatic joints): its rows
+    /// are the world axes, so it holds for the whole step.
+    lock_inverse_mass: Mat3,
     /// Accumulated impulses.
     pub impulses: JointImpulses,
 }
@@ -236,6 +257,8 @@ struct Rows {
     angular: Option<(AngularRows, Vec3)>,
     across: Option<[(AxisRow, f32); 2]>,
     axis: Option<(AxisRow, f32)>,
+    /// A ball joint's swing: the row turning B's axis away from A's, and the angle between.
+    swing: Option<(AxisRow, f32)>,
 }
 
 impl JointConstraint {
@@ -243,14 +266,19 @@ impl JointConstraint {
     pub fn prepare(joint: &JointInput, bodies: &SolverBodies) -> Self {
         let (a, b) = (joint.a as usize, joint.b as usize);
         let (qa, qb) = (bodies.orientations[a], bodies.orientations[b]);
-        Self {
+        let mut c = Self {
             input: *joint,
             masses: PairMasses::of(&bodies.params, a, b),
             anchors: [qa * joint.frame_a.anchor, qb * joint.frame_b.anchor],
             delta_center: bodies.centers[b] - bodies.centers[a],
             frames: [qa * joint.frame_a.basis, qb * joint.frame_b.basis],
+            lock_inverse_mass: Mat3::ZERO,
             impulses: JointImpulses::default(),
+        };
+        if matches!(joint.kind, JointKind::Fixed | JointKind::Prismatic { .. }) {
+            c.lock_inverse_mass = AngularRows::world().inverse_mass(&c.masses);
         }
+        c
     }
 
     fn slots(&self) -> (usize, usize) {
@@ -260,24 +288,50 @@ impl JointConstraint {
     /// The rows, from the bodies' motion since the step's start.
     fn rows(&self, states: &[BodyState]) -> Rows {
         let (a, b) = self.slots();
-        let (sa, sb) = (&states[a], &states[b]);
+        self.rows_of(&states[a], &states[b])
+    }
+
+    /// The rows, from A's and B's motion since the step's start (frames only for the kinds
+    /// that turn or limit).
+    fn rows_of(&self, sa: &BodyState, sb: &BodyState) -> Rows {
         let r_a = sa.delta_rotation * self.anchors[0];
         let r_b = sb.delta_rotation * self.anchors[1];
         let separation = self.delta_center + sb.delta_position - sa.delta_position + r_b - r_a;
-        let fa = sa.delta_rotation * self.frames[0];
-        let fb = sb.delta_rotation * self.frames[1];
-        let axis = fa * Vec3::X;
         let mut rows = Rows {
             anchors: (r_a, r_b),
             separation,
             angular: None,
             across: None,
             axis: None,
+            swing: None,
         };
+        let free_ball = JointKind::Spherical {
+            swing: None,
+            twist: None,
+        };
+        if self.input.kind == free_ball {
+            return rows;
+        }
+        let fa = sa.delta_rotation * self.frames[0];
+        let fb = sb.delta_rotation * self.frames[1];
+        let axis = fa * Vec3::X;
         let lock = || (AngularRows::world(), rotation_error(fa, fb));
         match self.input.kind {
             JointKind::Fixed => rows.angular = Some(lock()),
-            JointKind::Spherical => {}
+            JointKind::Spherical { swing, twist } => {
+                let axis_b = fb * Vec3::X;
+                let m = &self.masses;
+                if swing.is_some() {
+                    let held = |(row, a): (AxisRow, f32)| (row.held_at(m, r_a, r_b), a);
+                    rows.swing = swing_row(axis, axis_b).map(held);
+                }
+                if twist.is_some() {
+                    // Twist is about the axes' bisector, where both frames see it alike.
+                    let bisector = (axis + axis_b).normalize_or(axis);
+                    let row = AxisRow::angular(bisector).held_at(m, r_a, r_b);
+                    rows.axis = Some((row, twist_angle(fa, fb)));
+                }
+            }
             JointKind::Revolute { .. } => {
                 let (d, c) = hinge_directions(axis, [fb * Vec3::Y, fb * Vec3::Z]);
                 let hinge = AngularRows {
@@ -285,7 +339,8 @@ impl JointConstraint {
                     count: 2,
                 };
                 rows.angular = Some((hinge, Vec3::new(c[0], c[1], 0.0)));
-                rows.axis = Some((AxisRow::angular(axis), twist_angle(fa, fb)));
+                let row = AxisRow::angular(axis).held_at(&self.masses, r_a, r_b);
+                rows.axis = Some((row, twist_angle(fa, fb)));
             }
             JointKind::Prismatic { .. } => {
                 rows.angular = Some(lock());
@@ -294,6 +349,7 @@ impl JointConstraint {
                         linear: dir,
                         angular_a: (r_a + separation).cross(dir),
                         angular_b: r_b.cross(dir),
+                        pivot: None,
                     };
                     (row, dir.dot(separation))
                 };
@@ -341,43 +397,84 @@ impl JointConstraint {
         if let Some((row, _)) = rows.axis {
             row.apply(m, states, ab, j.motor + j.lower - j.upper);
         }
+        if let Some((row, _)) = rows.swing {
+            row.apply(m, states, ab, -j.swing);
+        }
     }
 
     /// One pass: biased (`soft` closes the position errors) or relaxing (rigid, no bias).
     pub fn solve(&mut self, states: &mut [BodyState], soft: Softness, h: f32, use_bias: bool) {
-        let ab = self.slots();
-        let (limit, motor) = self.input.kind.limit_and_motor();
-        let bias_soft = if use_bias { soft } else { Softness::RIGID };
         let rows = self.rows(states);
+        let limited = rows.axis.is_some() || rows.swing.is_some();
+        if limited {
+            self.solve_coordinate(states, &rows, soft, h, use_bias);
+        }
+        // The hard rows last, each from the state the rows before it left.
+        let rows = if limited { self.rows(states) } else { rows };
+        self.solve_hard_rows(states, &rows, soft, use_bias);
+    }
+
+    /// The motor and the limits (a ball joint's swing cone among them).
+    fn solve_coordinate(
+        &mut self,
+        states: &mut [BodyState],
+        rows: &Rows,
+        soft: Softness,
+        h: f32,
+        use_bias: bool,
+    ) {
+        let ab = self.slots();
+        let m = self.masses;
+        let (limit, motor) = self.input.kind.limit_and_motor();
+        let soft = (h, use_bias.then_some(soft));
+        let j = &mut self.impulses;
         if let Some((row, coordinate)) = rows.axis {
-            let m = self.masses;
-            let j = &mut self.impulses;
             if let Some(motor) = motor {
                 solve_motor(&row, coordinate, &motor, &m, states, ab, h, &mut j.motor);
             }
             if let Some(limit) = limit {
-                solve_limit(
-                    &row,
-                    coordinate,
-                    limit,
-                    &m,
-                    states,
-                    ab,
-                    (h, use_bias.then_some(soft)),
-                    j,
-                );
+                let accumulated = (&mut j.lower, &mut j.upper);
+                solve_limit(&row, coordinate, limit, &m, states, ab, soft, accumulated);
             }
         }
-        // The hard rows last, each from the state the rows before it left.
-        let rows = if rows.axis.is_some() {
-            self.rows(states)
-        } else {
-            rows
-        };
+        if let (
+            Some((row, angle)),
+            JointKind::Spherical {
+                swing: Some(cone), ..
+            },
+        ) = (rows.swing, self.input.kind)
+        {
+            let limit = JointLimit {
+                min: f32::NEG_INFINITY,
+                max: cone,
+            };
+            let mut unused = 0.0;
+            let accumulated = (&mut unused, &mut j.swing);
+            solve_limit(&row, angle, limit, &m, states, ab, soft, accumulated);
+        }
+    }
+
+    /// The rows that hold the joint together: angular lock or alignment, the slider's rows
+    /// across its axis, the point rows.
+    fn solve_hard_rows(
+        &mut self,
+        states: &mut [BodyState],
+        rows: &Rows,
+        soft: Softness,
+        use_bias: bool,
+    ) {
+        let ab = self.slots();
+        let bias_soft = if use_bias { soft } else { Softness::RIGID };
         let error = |c: Vec3| use_bias.then_some(c);
         if let Some((angular, c)) = rows.angular {
             let acc = &mut self.impulses.angular;
-            angular.solve(&self.masses, states, ab, error(c), bias_soft, acc);
+            // A hinge's rows turn with B: their effective mass is taken where they are now (a
+            // stale one overshoots when the bodies spin).
+            let k = match angular.count {
+                3 => self.lock_inverse_mass,
+                _ => angular.inverse_mass(&self.masses),
+            };
+            angular.solve(&self.masses, states, ab, error(c), bias_soft, &k, acc);
         }
         if let Some(across) = rows.across {
             for ((row, c), acc) in across.iter().zip(&mut self.impulses.across) {
@@ -389,14 +486,27 @@ impl JointConstraint {
         if self.holds_point() {
             let acc = &mut self.impulses.point;
             let c = error(rows.separation);
-            solve_point(&self.masses, states, ab, rows.anchors, c, bias_soft, acc);
+            // Taken where the anchors are now, as Box2D does: a step-start one overshoots on a
+            // fast-swinging chain and diverges.
+            let (r_a, r_b) = rows.anchors;
+            let k = inverse_mass(point_mass(&self.masses, r_a, r_b));
+            solve_point(
+                &self.masses,
+                states,
+                ab,
+                rows.anchors,
+                c,
+                bias_soft,
+                &k,
+                acc,
+            );
         }
     }
 
     fn holds_point(&self) -> bool {
         matches!(
             self.input.kind,
-            JointKind::Fixed | JointKind::Spherical | JointKind::Revolute { .. }
+            JointKind::Fixed | JointKind::Spherical { .. } | JointKind::Revolute { .. }
         )
     }
 
@@ -406,9 +516,9 @@ impl JointConstraint {
         let j = &self.impulses;
         let axial = j.motor + j.lower - j.upper;
         let mut force = j.point.length() + Vec3::new(j.across[0], j.across[1], 0.0).length();
-        let mut torque = j.angular.length();
+        let mut torque = j.angular.length() + j.swing.abs();
         match self.input.kind {
-            JointKind::Revolute { .. } => torque += axial.abs(),
+            JointKind::Revolute { .. } | JointKind::Spherical { .. } => torque += axial.abs(),
             _ => force += axial.abs(),
         }
         (force / h, torque / h)
@@ -439,6 +549,15 @@ pub fn twist_angle(fa: Quat, fb: Quat) -> f32 {
     let r = fa.inverse() * fb;
     let r = if r.w < 0.0 { -r } else { r };
     2.0 * r.x.atan2(r.w)
+}
+
+/// The row of a ball joint's swing: the angle between A's axis and B's, and the direction
+/// turning B's away from A's (`n = a × b / |a × b|`: the angle's rate is `n · (ω_b − ω_a)`);
+/// none when the axes are (anti)parallel and the direction is undefined.
+fn swing_row(axis_a: Vec3, axis_b: Vec3) -> Option<(AxisRow, f32)> {
+    let n = axis_a.cross(axis_b);
+    let sin = n.length();
+    (sin > 1e-6).then(|| (AxisRow::angular(n / sin), sin.atan2(axis_a.dot(axis_b))))
 }
 
 /// The motor's row: towards its speed (rigid), or towards its position as a spring; the
@@ -483,7 +602,7 @@ fn solve_limit(
     states: &mut [BodyState],
     ab: (usize, usize),
     (h, soft): (f32, Option<Softness>),
-    j: &mut JointImpulses,
+    (lower, upper): (&mut f32, &mut f32),
 ) {
     let bias_of = |c: f32| match soft {
         Some(soft) => (soft.bias_rate * c, soft),
@@ -492,18 +611,14 @@ fn solve_limit(
     if limit.min == limit.max {
         let (bias, soft) = bias_of(coordinate - limit.min);
         let free = (f32::NEG_INFINITY, f32::INFINITY);
-        row.solve(m, states, ab, bias, soft, &mut j.lower, free);
+        row.solve(m, states, ab, bias, soft, lower, free);
         return;
     }
-    let reversed = AxisRow {
-        linear: -row.linear,
-        angular_a: -row.angular_a,
-        angular_b: -row.angular_b,
-    };
+    let reversed = row.reversed();
     let push = (0.0, f32::INFINITY);
     for (row, c, acc) in [
-        (row, coordinate - limit.min, &mut j.lower),
-        (&reversed, limit.max - coordinate, &mut j.upper),
+        (row, coordinate - limit.min, lower),
+        (&reversed, limit.max - coordinate, upper),
     ] {
         if c == f32::INFINITY {
             continue;

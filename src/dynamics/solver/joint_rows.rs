@@ -77,6 +77,52 @@ pub struct AxisRow {
     pub angular_a: Vec3,
     /// B's angular direction `u_b`.
     pub angular_b: Vec3,
+    /// For an angular row of a joint that also holds its anchors together: turn each body
+    /// about its anchor instead of its centre of mass ([`Pivot`]).
+    pub pivot: Option<Pivot>,
+}
+
+/// How an angular row of a joint that also holds its anchors together moves its bodies: with
+/// the point rows' answer folded in. A unit impulse along the row alone turns the bodies by
+/// `w_a = −I_a⁻¹ u_a`, `w_b = I_b⁻¹ u_b`, which moves the anchors apart at
+/// `d = w_b × r_b − w_a × r_a`; the point rows answer with `P = −K_p⁻¹ d` (see
+/// [`point_mass`]). The row's impulse and that answer together change the velocities by
+/// `Δv_a = −m_a⁻¹ P`, `Δω_a = w_a − I_a⁻¹ (r_a × P)`, `Δv_b = m_b⁻¹ P`,
+/// `Δω_b = w_b + I_b⁻¹ (r_b × P)`, and the row's velocity by `K = u_b·Δω_b − u_a·Δω_a`: the
+/// effective mass of the row with the anchors held (the Schur complement of the point rows).
+/// Solved about the centres instead, a limb pinned at its end takes only `I/I'` of the impulse
+/// it needs (a quarter for a bar), the point rows hand the rest back as rotation, and a swing
+/// cone gave way by 2° under a kick.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pivot {
+    /// `Δv_a, Δω_a, Δv_b, Δω_b` per unit impulse.
+    pub response: [Vec3; 4],
+    /// The row's velocity change per unit impulse.
+    pub k: f32,
+}
+
+impl Pivot {
+    /// The pivot of the angular row `(u_a, u_b)` between bodies with masses `m` held together
+    /// at anchors `r_a`, `r_b`.
+    pub fn new(m: &PairMasses, (u_a, u_b): (Vec3, Vec3), r_a: Vec3, r_b: Vec3) -> Self {
+        let [ia, ib] = m.inverse_inertia;
+        let (w_a, w_b) = (-(ia * u_a), ib * u_b);
+        let d = w_b.cross(r_b) - w_a.cross(r_a);
+        let p = -(inverse_mass(point_mass(m, r_a, r_b)) * d);
+        let [ma, mb] = m.inverse_mass;
+        let dw_a = w_a - ia * r_a.cross(p);
+        let dw_b = w_b + ib * r_b.cross(p);
+        let keep = |dynamic: bool, v: Vec3| if dynamic { v } else { Vec3::ZERO };
+        Self {
+            response: [
+                keep(m.dynamic[0], -p * ma),
+                keep(m.dynamic[0], dw_a),
+                keep(m.dynamic[1], p * mb),
+                keep(m.dynamic[1], dw_b),
+            ],
+            k: u_b.dot(dw_b) - u_a.dot(dw_a),
+        }
+    }
 }
 
 impl AxisRow {
@@ -86,6 +132,28 @@ impl AxisRow {
             linear: Vec3::ZERO,
             angular_a: axis,
             angular_b: axis,
+            pivot: None,
+        }
+    }
+
+    /// The angular row with its bodies held together at anchors `r_a`, `r_b` (see [`Pivot`]).
+    pub fn held_at(mut self, m: &PairMasses, r_a: Vec3, r_b: Vec3) -> Self {
+        let dirs = (self.angular_a, self.angular_b);
+        self.pivot = Some(Pivot::new(m, dirs, r_a, r_b));
+        self
+    }
+
+    /// The same row, pushing the other way.
+    pub fn reversed(&self) -> Self {
+        let pivot = self.pivot.map(|p| Pivot {
+            response: p.response.map(|v| -v),
+            k: p.k,
+        });
+        Self {
+            linear: -self.linear,
+            angular_a: -self.angular_a,
+            angular_b: -self.angular_b,
+            pivot,
         }
     }
 
@@ -96,6 +164,7 @@ impl AxisRow {
             linear: direction,
             angular_a: r_a.cross(direction),
             angular_b: r_b.cross(direction),
+            pivot: None,
         }
     }
 
@@ -106,8 +175,11 @@ impl AxisRow {
             - self.angular_a.dot(sa.angular_velocity)
     }
 
-    /// `K = J M⁻¹ Jᵀ`.
+    /// `K = J M⁻¹ Jᵀ` (with the anchors held, for a row [`held_at`](Self::held_at) them).
     pub fn k(&self, m: &PairMasses) -> f32 {
+        if let Some(p) = &self.pivot {
+            return p.k;
+        }
         let [ia, ib] = m.inverse_inertia;
         (m.inverse_mass[0] + m.inverse_mass[1]) * self.linear.length_squared()
             + self.angular_a.dot(ia * self.angular_a)
@@ -116,6 +188,14 @@ impl AxisRow {
 
     /// Applies `λ` along the row.
     pub fn apply(&self, m: &PairMasses, states: &mut [BodyState], ab: (usize, usize), lambda: f32) {
+        if let Some(p) = &self.pivot {
+            let [va, wa, vb, wb] = p.response;
+            states[ab.0].linear_velocity += va * lambda;
+            states[ab.0].angular_velocity += wa * lambda;
+            states[ab.1].linear_velocity += vb * lambda;
+            states[ab.1].angular_velocity += wb * lambda;
+            return;
+        }
         m.apply(
             states,
             ab,
@@ -170,7 +250,8 @@ pub fn point_mass(m: &PairMasses, r_a: Vec3, r_b: Vec3) -> Mat3 {
 }
 
 /// Solves the point rows: anchors `r_a`, `r_b` (world, now), position error `c` (`None` in a
-/// relax pass); `accumulated` is the world impulse on B. Returns the impulse applied.
+/// relax pass), `k_inverse` the rows' effective mass ([`point_mass`] inverted by
+/// [`inverse_mass`]); `accumulated` is the world impulse on B. Returns the impulse applied.
 #[allow(clippy::too_many_arguments)]
 pub fn solve_point(
     m: &PairMasses,
@@ -179,6 +260,7 @@ pub fn solve_point(
     (r_a, r_b): (Vec3, Vec3),
     error: Option<Vec3>,
     soft: Softness,
+    k_inverse: &Mat3,
     accumulated: &mut Vec3,
 ) -> Vec3 {
     let (sa, sb) = (&states[a], &states[b]);
@@ -189,8 +271,8 @@ pub fn solve_point(
         Some(c) => (c * soft.bias_rate, soft),
         None => (Vec3::ZERO, Softness::RIGID),
     };
-    let k = point_mass(m, r_a, r_b);
-    let impulse = -soft.mass_scale * solve3(k, cdot + bias) - soft.impulse_scale * *accumulated;
+    let impulse =
+        -soft.mass_scale * (*k_inverse * (cdot + bias)) - soft.impulse_scale * *accumulated;
     *accumulated += impulse;
     m.apply(
         states,
@@ -201,17 +283,17 @@ pub fn solve_point(
     impulse
 }
 
-/// `K⁻¹ x` for a symmetric positive semi-definite `K`: the inverse when it is well
+/// `K⁻¹` for a symmetric positive semi-definite `K`: the inverse when it is well
 /// conditioned, else row by row (a body turning about some axes only, or two immovable
 /// bodies: those rows take no impulse).
-pub fn solve3(k: Mat3, x: Vec3) -> Vec3 {
+pub fn inverse_mass(k: Mat3) -> Mat3 {
     let det = k.determinant();
     let scale = k.x_axis.x * k.y_axis.y * k.z_axis.z;
     if det.is_finite() && det > 1e-6 * scale && scale > 0.0 {
-        return k.inverse() * x;
+        return k.inverse();
     }
     let inv = |d: f32| if d > 0.0 { 1.0 / d } else { 0.0 };
-    x * Vec3::new(inv(k.x_axis.x), inv(k.y_axis.y), inv(k.z_axis.z))
+    Mat3::from_diagonal(Vec3::new(inv(k.x_axis.x), inv(k.y_axis.y), inv(k.z_axis.z)))
 }
 
 /// Two or three rows on the relative angular velocity (see the module doc); the directions
@@ -225,7 +307,12 @@ pub struct AngularRows {
 }
 
 impl AngularRows {
-    /// `K` restricted to the rows (the unused third row is the identity, so it takes nothing).
+    /// `K⁻¹` of the rows (the unused third row of two is the identity, and takes nothing).
+    pub fn inverse_mass(&self, m: &PairMasses) -> Mat3 {
+        inverse_mass(self.k(m))
+    }
+
+    /// `K` restricted to the rows.
     fn k(&self, m: &PairMasses) -> Mat3 {
         let i = m.inverse_inertia[0] + m.inverse_inertia[1];
         let d = self.directions;
@@ -239,8 +326,9 @@ impl AngularRows {
     }
 
     /// Solves the rows towards zero relative turn, with per-row position errors `error`
-    /// (`None` in a relax pass); `accumulated` holds one impulse per row. Returns the world
-    /// angular impulse applied to B.
+    /// (`None` in a relax pass) and the rows' `k_inverse` ([`Self::inverse_mass`]);
+    /// `accumulated` holds one impulse per row. Returns the world angular impulse applied to B.
+    #[allow(clippy::too_many_arguments)]
     pub fn solve(
         &self,
         m: &PairMasses,
@@ -248,6 +336,7 @@ impl AngularRows {
         (a, b): (usize, usize),
         error: Option<Vec3>,
         soft: Softness,
+        k_inverse: &Mat3,
         accumulated: &mut Vec3,
     ) -> Vec3 {
         let relative = states[b].angular_velocity - states[a].angular_velocity;
@@ -261,7 +350,7 @@ impl AngularRows {
             None => (Vec3::ZERO, Softness::RIGID),
         };
         let mut impulse =
-            -soft.mass_scale * solve3(self.k(m), cdot + bias) - soft.impulse_scale * *accumulated;
+            -soft.mass_scale * (*k_inverse * (cdot + bias)) - soft.impulse_scale * *accumulated;
         if self.count == 2 {
             impulse.z = 0.0;
         }
@@ -308,6 +397,7 @@ mod tests {
         states[1].angular_velocity = Vec3::new(-1.0, 0.2, 0.7);
         let (ra, rb) = (Vec3::new(0.5, 0.2, -0.1), Vec3::new(-0.3, 0.4, 0.6));
         let mut acc = Vec3::ZERO;
+        let k_inverse = inverse_mass(point_mass(&m, ra, rb));
         solve_point(
             &m,
             &mut states,
@@ -315,6 +405,7 @@ mod tests {
             (ra, rb),
             None,
             Softness::RIGID,
+            &k_inverse,
             &mut acc,
         );
         let (sa, sb) = (states[0], states[1]);
@@ -356,7 +447,8 @@ mod tests {
         };
         let mut acc = Vec3::ZERO;
         let mut locked = states;
-        lock.solve(&m, &mut locked, (0, 1), None, Softness::RIGID, &mut acc);
+        let k = lock.inverse_mass(&m);
+        lock.solve(&m, &mut locked, (0, 1), None, Softness::RIGID, &k, &mut acc);
         let rel = locked[1].angular_velocity - locked[0].angular_velocity;
         assert!(rel.length() < 1e-5, "{rel}");
         let hinge = AngularRows {
@@ -364,15 +456,51 @@ mod tests {
             count: 2,
         };
         let mut acc = Vec3::ZERO;
-        hinge.solve(&m, &mut states, (0, 1), None, Softness::RIGID, &mut acc);
+        let k = hinge.inverse_mass(&m);
+        hinge.solve(&m, &mut states, (0, 1), None, Softness::RIGID, &k, &mut acc);
         let rel = states[1].angular_velocity - states[0].angular_velocity;
         assert!(rel.x.abs() < 1e-5 && rel.y.abs() < 1e-5, "{rel}");
         assert!((rel.z - 3.0).abs() < 1e-5, "the free axis kept {rel}");
     }
 
     #[test]
+    fn a_row_held_at_the_anchors_stops_the_turn_and_leaves_the_anchor_still_within_1e_5() {
+        // A bar's end pinned to an immovable body: stop its turn about y in one solve.
+        let mut m = masses(1.0, 1.0);
+        m.inverse_mass[0] = 0.0;
+        m.inverse_inertia[0] = Mat3::ZERO;
+        m.dynamic[0] = false;
+        m.inverse_inertia[1] = Mat3::from_diagonal(Vec3::new(12.0, 12.0, 600.0));
+        let r_b = Vec3::new(0.0, 0.0, 0.5);
+        let mut states = [BodyState::default(); 2];
+        states[1].angular_velocity = Vec3::Y * 2.0;
+        states[1].linear_velocity = -(Vec3::Y * 2.0).cross(r_b);
+        let row = AxisRow::angular(Vec3::Y).held_at(&m, Vec3::ZERO, r_b);
+        let mut acc = 0.0;
+        let free = (f32::NEG_INFINITY, f32::INFINITY);
+        row.solve(
+            &m,
+            &mut states,
+            (0, 1),
+            0.0,
+            Softness::RIGID,
+            &mut acc,
+            free,
+        );
+        let s = states[1];
+        assert!(s.angular_velocity.length() < 1e-5, "{}", s.angular_velocity);
+        let anchor = s.linear_velocity + s.angular_velocity.cross(r_b);
+        assert!(anchor.length() < 1e-5, "{anchor}");
+        // The impulse is the one about the pivot: I' ω = (1/12 + 1/4) · 2.
+        assert!(
+            (acc.abs() - (1.0 / 12.0 + 0.25) * 2.0).abs() < 1e-4,
+            "{acc}"
+        );
+    }
+
+    #[test]
     fn a_singular_mass_takes_no_impulse_on_its_empty_rows() {
         let k = Mat3::from_diagonal(Vec3::new(2.0, 0.0, 0.0));
-        assert_eq!(solve3(k, Vec3::ONE), Vec3::new(0.5, 0.0, 0.0));
+        assert_eq!(inverse_mass(k) * Vec3::ONE, Vec3::new(0.5, 0.0, 0.0));
     }
 }

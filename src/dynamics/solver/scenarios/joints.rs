@@ -5,6 +5,11 @@
 use super::*;
 use crate::dynamics::solver::joint::twist_angle;
 
+const BALL: JointKind = JointKind::Spherical {
+    swing: None,
+    twist: None,
+};
+
 /// A joint of `kind` holding `a` at `anchor_a` and `b` at `anchor_b` (body frames, from the
 /// centres of mass), its axis along `axis` in both bodies' frames; the two no longer collide.
 fn join(
@@ -76,7 +81,7 @@ fn pendulum_period(kind: JointKind) -> (f32, f32) {
 
 #[test]
 fn a_pendulum_on_a_ball_joint_swings_with_the_analytic_period_within_1_percent() {
-    let (t, expected) = pendulum_period(JointKind::Spherical);
+    let (t, expected) = pendulum_period(BALL);
     assert!(
         (t / expected - 1.0).abs() < 0.01,
         "{t} s against {expected} s"
@@ -126,7 +131,7 @@ fn chain(n: usize, direction: Vec3, mass: impl Fn(usize) -> f32) -> (Scene, Vec<
             (previous.0, link),
             (previous.1, local_top),
             Vec3::X,
-            JointKind::Spherical,
+            BALL,
         );
         previous = (link, -local_top);
         links.push(link);
@@ -284,13 +289,14 @@ fn a_position_motor_turns_a_hinge_to_its_target_within_half_a_degree() {
     );
     scene.run(4.0);
     // Held against gravity by the spring: gravity's torque m g (L/2) cos θ balances
-    // k_θ (θ − 1), with k_θ = I ω² about the row's own effective mass, the arm's inertia about
-    // its centre (Box2D's spring convention), solved by fixed point.
+    // k_θ (θ − 1), with k_θ = I ω² and I the arm's inertia about its hinge (the motor's row
+    // moves the arm with its anchor held: its effective mass is that inertia), solved by fixed
+    // point.
     let angle = twist_angle(
         Quat::from_rotation_arc(Vec3::X, Vec3::Y),
         scene.bodies[arm].orientation * Quat::from_rotation_arc(Vec3::X, Vec3::Y),
     );
-    let inertia = 1.0 / 12.0 * (1.0 + 0.1 * 0.1);
+    let inertia = 1.0 / 12.0 * (1.0 + 0.1 * 0.1) + 0.5 * 0.5;
     let k = inertia * (std::f32::consts::TAU * 4.0).powi(2);
     let mut expected = 1.0f32;
     for _ in 0..50 {
@@ -494,4 +500,67 @@ fn a_welded_beam_holds_its_pose_within_1_mm_and_1_mrad() {
     );
     let turned = b.orientation.angle_between(Quat::IDENTITY);
     assert!(turned < 1e-3, "turned {turned} rad");
+}
+
+/// A 1 kg ball hanging 1 m below a fixed pivot on a ball joint of `kind` (both frames' axes
+/// down), kicked with `v` and spun with `w`: the largest swing (angle of the bob's axis from
+/// down) and the largest twist over 3 s.
+fn kicked_ball_joint(kind: JointKind, v: Vec3, w: Vec3) -> (f32, f32) {
+    let mut scene = Scene::default();
+    let pivot = anchor(&mut scene, Vec3::ZERO);
+    let bob = scene.add(
+        Shape::cuboid(Vec3::splat(0.1)),
+        Vec3::new(0.0, 0.0, -1.0),
+        Quat::IDENTITY,
+        1.0,
+    );
+    scene.bodies[bob].v = v;
+    scene.bodies[bob].w = w;
+    join(
+        &mut scene,
+        (pivot, bob),
+        (Vec3::ZERO, Vec3::Z),
+        Vec3::NEG_Z,
+        kind,
+    );
+    let down = Quat::from_rotation_arc(Vec3::X, Vec3::NEG_Z);
+    let (mut swing, mut twist) = (0.0f32, 0.0f32);
+    for _ in 0..(3.0 / DT) as usize {
+        scene.step();
+        let frame = scene.bodies[bob].orientation * down;
+        swing = swing.max((frame * Vec3::X).angle_between(Vec3::NEG_Z));
+        twist = twist.max(twist_angle(down, frame).abs());
+    }
+    (swing, twist)
+}
+
+#[test]
+fn a_swing_cone_of_30_degrees_holds_a_kicked_limb_within_half_a_degree() {
+    let free = kicked_ball_joint(BALL, Vec3::X * 4.0, Vec3::ZERO);
+    assert!(free.0 > 1.0, "unlimited, the kick swings it {} rad", free.0);
+    let cone = JointKind::Spherical {
+        swing: Some(30f32.to_radians()),
+        twist: None,
+    };
+    let (swing, _) = kicked_ball_joint(cone, Vec3::X * 4.0, Vec3::ZERO);
+    assert!(
+        swing < 30.5f32.to_radians(),
+        "swung {} degrees",
+        swing.to_degrees()
+    );
+}
+
+#[test]
+fn a_twist_limit_of_half_a_radian_holds_a_spun_limb_within_half_a_degree() {
+    let free = kicked_ball_joint(BALL, Vec3::ZERO, Vec3::Z * 10.0);
+    assert!(free.1 > 1.0, "unlimited, the spin twists it {} rad", free.1);
+    let limited = JointKind::Spherical {
+        swing: None,
+        twist: Some(JointLimit {
+            min: -0.5,
+            max: 0.5,
+        }),
+    };
+    let (_, twist) = kicked_ball_joint(limited, Vec3::ZERO, Vec3::Z * 10.0);
+    assert!(twist < 0.5 + 0.5f32.to_radians(), "twisted {twist} rad");
 }
