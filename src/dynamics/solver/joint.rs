@@ -247,9 +247,14 @@ pub struct JointConstraint {
     lock_inverse_mass: Mat3,
     /// Accumulated impulses.
     pub impulses: JointImpulses,
+    /// The rows where the bodies are now ([`Self::refresh`]).
+    rows: Rows,
 }
 
-/// The joint's rows where the bodies are now.
+/// The joint's rows where the bodies are now: they depend on the bodies' positions only, so
+/// they are computed once per substep, after the positions move, and serve the relax passes,
+/// the next substep's warm start and its biased pass.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 struct Rows {
     anchors: (Vec3, Vec3),
     /// Anchor to anchor, `c_b + r_b − c_a − r_a`.
@@ -259,6 +264,11 @@ struct Rows {
     axis: Option<(AxisRow, f32)>,
     /// A ball joint's swing: the row turning B's axis away from A's, and the angle between.
     swing: Option<(AxisRow, f32)>,
+    /// The point rows' `K⁻¹` (taken where the anchors are, as Box2D does: a step-start one
+    /// overshot on a fast-swinging chain and diverged).
+    point_inverse_mass: Mat3,
+    /// The angular rows' `K⁻¹`.
+    angular_inverse_mass: Mat3,
 }
 
 impl JointConstraint {
@@ -274,21 +284,25 @@ impl JointConstraint {
             frames: [qa * joint.frame_a.basis, qb * joint.frame_b.basis],
             lock_inverse_mass: Mat3::ZERO,
             impulses: JointImpulses::default(),
+            rows: Rows::default(),
         };
         if matches!(joint.kind, JointKind::Fixed | JointKind::Prismatic { .. }) {
             c.lock_inverse_mass = AngularRows::world().inverse_mass(&c.masses);
         }
+        // The bodies have not moved yet.
+        let start = BodyState::default();
+        c.rows = c.rows_of(&start, &start);
         c
+    }
+
+    /// Takes the rows where the bodies are now (after their positions moved).
+    pub fn refresh(&mut self, states: &[BodyState]) {
+        let (a, b) = self.slots();
+        self.rows = self.rows_of(&states[a], &states[b]);
     }
 
     fn slots(&self) -> (usize, usize) {
         (self.input.a as usize, self.input.b as usize)
-    }
-
-    /// The rows, from the bodies' motion since the step's start.
-    fn rows(&self, states: &[BodyState]) -> Rows {
-        let (a, b) = self.slots();
-        self.rows_of(&states[a], &states[b])
     }
 
     /// The rows, from A's and B's motion since the step's start (frames only for the kinds
@@ -300,11 +314,11 @@ impl JointConstraint {
         let mut rows = Rows {
             anchors: (r_a, r_b),
             separation,
-            angular: None,
-            across: None,
-            axis: None,
-            swing: None,
+            ..Default::default()
         };
+        if self.holds_point() {
+            rows.point_inverse_mass = inverse_mass(point_mass(&self.masses, r_a, r_b));
+        }
         let free_ball = JointKind::Spherical {
             swing: None,
             twist: None,
@@ -317,7 +331,10 @@ impl JointConstraint {
         let axis = fa * Vec3::X;
         let lock = || (AngularRows::world(), rotation_error(fa, fb));
         match self.input.kind {
-            JointKind::Fixed => rows.angular = Some(lock()),
+            JointKind::Fixed => {
+                rows.angular = Some(lock());
+                rows.angular_inverse_mass = self.lock_inverse_mass;
+            }
             JointKind::Spherical { swing, twist } => {
                 let axis_b = fb * Vec3::X;
                 let m = &self.masses;
@@ -339,11 +356,14 @@ impl JointConstraint {
                     count: 2,
                 };
                 rows.angular = Some((hinge, Vec3::new(c[0], c[1], 0.0)));
+                // The alignment rows turn with B: their effective mass is taken where they are.
+                rows.angular_inverse_mass = hinge.inverse_mass(&self.masses);
                 let row = AxisRow::angular(axis).held_at(&self.masses, r_a, r_b);
                 rows.axis = Some((row, twist_angle(fa, fb)));
             }
             JointKind::Prismatic { .. } => {
                 rows.angular = Some(lock());
+                rows.angular_inverse_mass = self.lock_inverse_mass;
                 let slide = |dir: Vec3| {
                     let row = AxisRow {
                         linear: dir,
@@ -371,7 +391,7 @@ impl JointConstraint {
 
     /// Applies the accumulated impulses.
     pub fn warm_start(&self, states: &mut [BodyState]) {
-        let rows = self.rows(states);
+        let rows = &self.rows;
         let ab = self.slots();
         let m = &self.masses;
         let j = &self.impulses;
@@ -404,13 +424,11 @@ impl JointConstraint {
 
     /// One pass: biased (`soft` closes the position errors) or relaxing (rigid, no bias).
     pub fn solve(&mut self, states: &mut [BodyState], soft: Softness, h: f32, use_bias: bool) {
-        let rows = self.rows(states);
-        let limited = rows.axis.is_some() || rows.swing.is_some();
-        if limited {
+        let rows = self.rows;
+        if rows.axis.is_some() || rows.swing.is_some() {
             self.solve_coordinate(states, &rows, soft, h, use_bias);
         }
-        // The hard rows last, each from the state the rows before it left.
-        let rows = if limited { self.rows(states) } else { rows };
+        // The hard rows last, so that they win.
         self.solve_hard_rows(states, &rows, soft, use_bias);
     }
 
@@ -468,13 +486,8 @@ impl JointConstraint {
         let error = |c: Vec3| use_bias.then_some(c);
         if let Some((angular, c)) = rows.angular {
             let acc = &mut self.impulses.angular;
-            // A hinge's rows turn with B: their effective mass is taken where they are now (a
-            // stale one overshoots when the bodies spin).
-            let k = match angular.count {
-                3 => self.lock_inverse_mass,
-                _ => angular.inverse_mass(&self.masses),
-            };
-            angular.solve(&self.masses, states, ab, error(c), bias_soft, &k, acc);
+            let k = &rows.angular_inverse_mass;
+            angular.solve(&self.masses, states, ab, error(c), bias_soft, k, acc);
         }
         if let Some(across) = rows.across {
             for ((row, c), acc) in across.iter().zip(&mut self.impulses.across) {

@@ -266,6 +266,9 @@ impl Solver {
             self.solve_joints(bodies, joint_soft, h, true);
             self.solve_contacts(bodies, inv_h, true, flip);
             integrate_positions(bodies, h, s.max_rotation_per_substep);
+            for j in &mut self.joints {
+                j.refresh(&bodies.states);
+            }
             for _ in 0..s.relax_iterations {
                 self.solve_joints(bodies, joint_soft, h, false);
                 self.solve_contacts(bodies, inv_h, false, flip);
