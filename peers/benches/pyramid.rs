@@ -21,14 +21,16 @@ use criterion::{
 };
 use glam::{Quat, Vec3};
 use rapier3d::prelude as rp;
-use std::hint::black_box;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 use urto::dynamics::solver::SoftStepSettings;
 use urto::prelude::*;
 
+#[path = "common/fresh_runs.rs"]
+mod fresh_runs;
+use fresh_runs::timed;
 #[path = "common/rapier_world.rs"]
 mod rapier_world;
-use rapier_world::RapierWorld;
+use rapier_world::{RapierWorld, rv};
 
 const DT: f32 = 1.0 / 60.0;
 const HALF: f32 = 0.5;
@@ -153,10 +155,6 @@ struct Rapier {
     boxes: Vec<rp::RigidBodyHandle>,
 }
 
-fn rv(v: Vec3) -> rp::Vector {
-    rp::Vector::new(v.x, v.y, v.z)
-}
-
 impl Rapier {
     /// Rotations free (rapier's default); sleeping on (its default) or off.
     fn new(start: &[Vec3], can_sleep: bool) -> Self {
@@ -202,18 +200,6 @@ impl Rapier {
             .filter(|h| self.world.bodies[**h].is_sleeping())
             .count()
     }
-}
-
-fn timed<S>(iters: u64, mut build: impl FnMut() -> S, mut run: impl FnMut(&mut S)) -> Duration {
-    let mut total = Duration::ZERO;
-    for _ in 0..iters {
-        let mut sim = build();
-        let start = Instant::now();
-        run(&mut sim);
-        total += start.elapsed();
-        black_box(&sim);
-    }
-    total
 }
 
 fn bench_pyramid(c: &mut Criterion) {

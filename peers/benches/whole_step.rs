@@ -45,7 +45,7 @@ use urto::prelude::*;
 
 #[path = "common/rapier_world.rs"]
 mod rapier_world;
-use rapier_world::RapierWorld;
+use rapier_world::{RapierWorld, rv};
 
 /// dt of both engines (urto's default `PhysicsTimestep`, rapier's default `IntegrationParameters`).
 const DT: f32 = 1.0 / 60.0;
@@ -366,10 +366,6 @@ fn urto_step_staged(app: &mut App, n: u32) -> String {
 }
 
 // ---------------------------------------------------------------- rapier
-
-fn rv(v: Vec3) -> rp::Vector {
-    rp::Vector::new(v.x, v.y, v.z)
-}
 
 fn gv(v: rp::Vector) -> Vec3 {
     Vec3::new(v.x, v.y, v.z)

@@ -3,6 +3,11 @@
 
 use rapier3d::prelude as rp;
 
+/// A glam vector as rapier's.
+pub fn rv(v: glam::Vec3) -> rp::Vector {
+    rp::Vector::new(v.x, v.y, v.z)
+}
+
 /// Everything `PhysicsPipeline::step` takes.
 pub struct RapierWorld {
     pub gravity: rp::Vector,

@@ -45,6 +45,7 @@ pub mod batch;
 pub mod body;
 pub mod contact;
 pub mod joint;
+pub mod joint_input;
 pub mod joint_rows;
 pub mod lanes;
 pub mod ordered_batches;

@@ -409,19 +409,14 @@ fn a_slider_on_a_30_degree_rail_stops_at_its_limit_and_stays_on_the_rail_within_
     assert!(turned < 1e-3, "turned {turned} rad");
 }
 
-#[test]
-fn a_falling_ball_is_caught_by_a_2_m_rope_within_1_percent_and_a_rod_pushes_back() {
+/// A 1 kg ball of radius 0.1 at `at`, tied to a fixed point at `pivot` by a distance joint
+/// between `min` and `max`.
+fn ball_on_a_line(pivot: Vec3, at: Vec3, (min, max): (f32, f32)) -> (Scene, usize) {
     let mut scene = Scene::default();
-    let top = anchor(&mut scene, Vec3::new(0.0, 0.0, 10.0));
-    // Starts 0.5 m below the anchor: slack until it has fallen 1.5 m.
-    let ball = scene.add(
-        Shape::sphere(0.1),
-        Vec3::new(0.0, 0.0, 9.5),
-        Quat::IDENTITY,
-        1.0,
-    );
-    let rope = JointKind::Distance {
-        limit: JointLimit { min: 0.0, max: 2.0 },
+    let top = anchor(&mut scene, pivot);
+    let ball = scene.add(Shape::sphere(0.1), at, Quat::IDENTITY, 1.0);
+    let line = JointKind::Distance {
+        limit: JointLimit { min, max },
         motor: None,
     };
     join(
@@ -429,8 +424,16 @@ fn a_falling_ball_is_caught_by_a_2_m_rope_within_1_percent_and_a_rod_pushes_back
         (top, ball),
         (Vec3::ZERO, Vec3::ZERO),
         Vec3::X,
-        rope,
+        line,
     );
+    (scene, ball)
+}
+
+#[test]
+fn a_falling_ball_is_caught_by_a_2_m_rope_within_1_percent_and_a_rod_pushes_back() {
+    // Starts 0.5 m below the anchor: slack until it has fallen 1.5 m.
+    let top = Vec3::new(0.0, 0.0, 10.0);
+    let (mut scene, ball) = ball_on_a_line(top, Vec3::new(0.0, 0.0, 9.5), (0.0, 2.0));
     let mut longest = 0.0f32;
     let mut slack_fall = 0.0f32;
     for i in 0..(3.0 / DT) as usize {
@@ -447,25 +450,7 @@ fn a_falling_ball_is_caught_by_a_2_m_rope_within_1_percent_and_a_rod_pushes_back
     );
     assert!(longest < 2.02, "the rope stretched to {longest} m");
     // A rod of 1 m holds a ball placed 0.5 m from its end out at 1 m.
-    let mut scene = Scene::default();
-    let top = anchor(&mut scene, Vec3::ZERO);
-    let ball = scene.add(
-        Shape::sphere(0.1),
-        Vec3::new(0.5, 0.0, 0.0),
-        Quat::IDENTITY,
-        1.0,
-    );
-    let rod = JointKind::Distance {
-        limit: JointLimit { min: 1.0, max: 1.0 },
-        motor: None,
-    };
-    join(
-        &mut scene,
-        (top, ball),
-        (Vec3::ZERO, Vec3::ZERO),
-        Vec3::X,
-        rod,
-    );
+    let (mut scene, ball) = ball_on_a_line(Vec3::ZERO, Vec3::new(0.5, 0.0, 0.0), (1.0, 1.0));
     scene.run(2.0);
     let length = scene.bodies[ball].center.length();
     assert!(
