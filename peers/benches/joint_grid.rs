@@ -7,7 +7,8 @@
 //! 10,000 bodies and 19,800 joints). Collisions between the balls are switched off in both
 //! engines (Box2D's group index −1): urto by `CollisionLayers::NONE`-style layers, rapier by
 //! `InteractionGroups::none()`; both still carry the colliders. dt = 1/60, gravity 9.81 m/s²
-//! down Z. urto runs its defaults (4 substeps, 60 Hz joints, sleeping on), rapier its defaults
+//! down Z. urto runs its defaults (4 substeps, 60 Hz joints, sleeping on) and 2 substeps with
+//! one relax pass (about rapier's error), rapier its defaults
 //! (TGS-soft, 4 iterations, sleeping on, single-threaded). One criterion iteration is the first
 //! `STEPS` steps of a fresh net (the build is not timed).
 //!
@@ -111,10 +112,19 @@ struct Urto {
     balls: Vec<Entity>,
 }
 
+/// urto's defaults, and with 2 substeps and one relax pass (about rapier's joint gap, for a
+/// comparison at equal error): `(label, substeps, relax passes)`.
+const URTO_VARIANTS: [(&str, u32, u32); 2] = [("urto", 4, 2), ("urto (2 substeps, relax 1)", 2, 1)];
+
 impl Urto {
-    fn new(net: &Net) -> Self {
+    fn new(net: &Net, substeps: u32, relax_iterations: u32) -> Self {
+        let settings = urto::dynamics::solver::SoftStepSettings {
+            substeps,
+            relax_iterations,
+            ..Default::default()
+        };
         let mut app = App::new();
-        app.add_plugins(UrtoPlugins::default())
+        app.add_plugins(UrtoPlugins::default().set(SoftStepPlugin { settings }))
             .insert_resource(Gravity::new(Vec3::new(0.0, 0.0, -9.81)).expect("finite"));
         let alone = CollisionLayers::new(LayerMask::NONE, LayerMask::NONE);
         let world = app.world_mut();
@@ -212,21 +222,23 @@ fn bench_joint_grid(c: &mut Criterion) {
     let n = side();
     let net = Net::new(n);
     let bodies = net.centers.len();
-    let mut u = Urto::new(&net);
-    u.step(STEPS);
-    let (gap, sag) = net.quality(&u.poses());
-    let joints = u
-        .app
-        .world()
-        .resource::<PhysicsStats>()
-        .counter("soft_step/joints")
-        .unwrap_or(0.0);
-    eprintln!(
-        "[sanity] joint grid {n}x{n} ({bodies} balls, {} joints) urto after {STEPS} steps: worst joint gap {:.2} mm, bottom sag {:.3} m, joints solved {joints}",
-        net.joints.len(),
-        gap * 1e3,
-        sag
-    );
+    for (label, substeps, relax) in URTO_VARIANTS {
+        let mut u = Urto::new(&net, substeps, relax);
+        u.step(STEPS);
+        let (gap, sag) = net.quality(&u.poses());
+        let joints = u
+            .app
+            .world()
+            .resource::<PhysicsStats>()
+            .counter("soft_step/joints")
+            .unwrap_or(0.0);
+        eprintln!(
+            "[sanity] joint grid {n}x{n} ({bodies} balls, {} joints) {label} after {STEPS} steps: worst joint gap {:.2} mm, bottom sag {:.3} m, joints solved {joints}",
+            net.joints.len(),
+            gap * 1e3,
+            sag
+        );
+    }
     let mut r = Rapier::new(&net);
     r.step(STEPS);
     let (gap, sag) = net.quality(&r.poses());
@@ -242,9 +254,17 @@ fn bench_joint_grid(c: &mut Criterion) {
         .sampling_mode(SamplingMode::Flat)
         .measurement_time(Duration::from_secs(10))
         .throughput(Throughput::Elements(u64::from(STEPS)));
-    group.bench_function(BenchmarkId::new("urto", bodies), |b| {
-        b.iter_custom(|iters| timed(iters, || Urto::new(&net), |u| u.step(STEPS)))
-    });
+    for (label, substeps, relax) in URTO_VARIANTS {
+        group.bench_function(BenchmarkId::new(label, bodies), |b| {
+            b.iter_custom(|iters| {
+                timed(
+                    iters,
+                    || Urto::new(&net, substeps, relax),
+                    |u| u.step(STEPS),
+                )
+            })
+        });
+    }
     group.bench_function(BenchmarkId::new("rapier", bodies), |b| {
         b.iter_custom(|iters| timed(iters, || Rapier::new(&net), |r| r.step(STEPS)))
     });
