@@ -138,22 +138,16 @@ fn overlapping_pair(collide: bool) -> (f32, usize) {
     let mut app = app();
     app.world_mut()
         .spawn((Collider::half_space(Vec3::Z), Static));
-    let a = app
-        .world_mut()
-        .spawn((
+    let unit_box = |app: &mut App, at: Vec3| {
+        let body = (
             Collider::cuboid(0.5, 0.5, 0.5),
-            Position::new(0.0, 0.0, 0.5),
+            Position(at),
             Velocity::default(),
-        ))
-        .id();
-    let b = app
-        .world_mut()
-        .spawn((
-            Collider::cuboid(0.5, 0.5, 0.5),
-            Position::new(0.5, 0.0, 0.5),
-            Velocity::default(),
-        ))
-        .id();
+        );
+        app.world_mut().spawn(body).id()
+    };
+    let a = unit_box(&mut app, Vec3::new(0.0, 0.0, 0.5));
+    let b = unit_box(&mut app, Vec3::new(0.5, 0.0, 0.5));
     let mut joint =
         Joint::spherical(a, b).with_anchors(Vec3::new(0.25, 0.0, 0.0), Vec3::new(-0.25, 0.0, 0.0));
     if collide {

@@ -38,11 +38,13 @@ use criterion::{
 };
 use glam::Vec3;
 use rapier3d::prelude as rp;
-use std::hint::black_box;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 use urto::plugins::Contacts;
 use urto::prelude::*;
 
+#[path = "common/fresh_runs.rs"]
+mod fresh_runs;
+use fresh_runs::timed;
 #[path = "common/rapier_world.rs"]
 mod rapier_world;
 use rapier_world::{RapierWorld, rv};
@@ -542,23 +544,6 @@ fn bench_resting(c: &mut Criterion) {
     }
 }
 
-/// Times the first [`PILE_STEPS`] steps of a fresh scene per iteration (the build is not timed).
-fn timed_runs<S>(
-    iters: u64,
-    mut build: impl FnMut() -> S,
-    mut run: impl FnMut(&mut S),
-) -> Duration {
-    let mut total = Duration::ZERO;
-    for _ in 0..iters {
-        let mut sim = build();
-        let start = Instant::now();
-        run(&mut sim);
-        total += start.elapsed();
-        black_box(&sim);
-    }
-    total
-}
-
 fn bench_falling_pile(c: &mut Criterion) {
     for walls in wall_kinds() {
         let scene = falling_pile(walls);
@@ -600,7 +585,7 @@ fn bench_falling_pile(c: &mut Criterion) {
         for (label, can_sleep) in URTO_SLEEP_VARIANTS {
             group.bench_function(BenchmarkId::new(label, n), |b| {
                 b.iter_custom(|iters| {
-                    timed_runs(
+                    timed(
                         iters,
                         || urto_app(&scene, can_sleep).0,
                         |app| urto_step(app, PILE_STEPS),
@@ -611,7 +596,7 @@ fn bench_falling_pile(c: &mut Criterion) {
         for (label, can_sleep) in RAPIER_SLEEP_VARIANTS {
             group.bench_function(BenchmarkId::new(label, n), |b| {
                 b.iter_custom(|iters| {
-                    timed_runs(
+                    timed(
                         iters,
                         || Rapier::new(&scene, can_sleep),
                         |r| r.step(PILE_STEPS),
