@@ -8,7 +8,9 @@
 //!   the ends tied to the world, crossed by a rolling ball;
 //! - a **wrecking ball**: a 50 kg ball at the end of a 12-link chain, released sideways into a
 //!   stack of boxes;
-//! - a **door** on a limited hinge closed by a spring (a position motor), hit by a thrown ball.
+//! - a **door** on a limited hinge closed by a spring (a position motor), hit by a thrown ball;
+//! - a **ragdoll** of boxes (ball joints with swing cones and twist limits at the neck,
+//!   shoulders and hips, limited hinges at the elbows and knees) pushed down a flight of stairs.
 //!
 //! The recording shows each joint's anchors and axis (orange, red past a limit) and what the
 //! first joints hold as time series (`joints/<entity>/force`).
@@ -55,11 +57,13 @@ fn main() -> Result<(), Box<dyn Error>> {
     let (bridge, ball_start) = build_bridge(&mut app, args.planks);
     let wrecking = build_wrecking_ball(&mut app);
     let door = build_door(&mut app);
+    let ragdoll = build_ragdoll(&mut app);
 
     let mut timer = StepTimer::start();
     let steps = (args.seconds * 60.0) as u32;
     let start: Vec<Vec3> = props.iter().map(|&e| position(&app, e)).collect();
     let (mut sag, mut door_swing, mut turret_speed) = (0.0f32, 0.0f32, Vec::new());
+    let mut worst_limit = 0.0f32;
     let mut hanging_sag = 0.0;
     let deck_low = |app: &App| {
         let deck = bridge.iter().map(|&p| position(app, p).z);
@@ -87,6 +91,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             sag = sag.max(deck_low(&app));
         }
         door_swing = door_swing.max(angle_about_z(&app, door).abs());
+        worst_limit = worst_limit.max(past_limits(&mut app, &ragdoll.joints));
         if t > 3.0 {
             turret_speed.push(angular_speed_z(&app, arm.turret));
         }
@@ -122,6 +127,14 @@ fn main() -> Result<(), Box<dyn Error>> {
         "  door: swung open {:.0} degrees (limit 100), back to {:.1} degrees",
         door_swing.to_degrees(),
         angle_about_z(&app, door).to_degrees()
+    );
+    let pelvis = position(&app, ragdoll.torso);
+    println!(
+        "  ragdoll: {} bodies, {} joints, fell {:.1} m down the stairs; its joints at most {:.1} degrees past a limit",
+        ragdoll.bodies,
+        ragdoll.joints.len(),
+        STAIRS_TOP - pelvis.z,
+        worst_limit.to_degrees()
     );
     println!("  {}", timer.summary());
     support::print_recording(&args.recording.path("joints"));
@@ -375,4 +388,125 @@ fn knocked(app: &App, stack: &[(Entity, Vec3)]) -> usize {
         .iter()
         .filter(|(e, at)| position(app, *e).distance(*at) > 0.3)
         .count()
+}
+
+const STAIRS_TOP: f32 = 2.4;
+
+struct Ragdoll {
+    torso: Entity,
+    bodies: usize,
+    joints: Vec<Entity>,
+}
+
+/// Eight steps 0.3 m high and 0.5 m deep going down along +x at y = −12, and a ragdoll of
+/// boxes standing at the top, pushed forward.
+fn build_ragdoll(app: &mut App) -> Ragdoll {
+    let y = -12.0;
+    for k in 0..8 {
+        let top = STAIRS_TOP - 0.3 * k as f32;
+        let at = Vec3::new(8.0 + 0.5 * k as f32, y, 0.5 * top);
+        app.world_mut().spawn((
+            Collider::cuboid(0.25, 1.0, 0.5 * top),
+            Position(at),
+            Static,
+            Friction(0.6),
+        ));
+    }
+    let z = STAIRS_TOP + 0.02;
+    let x = 8.15;
+    let mut part = |half: Vec3, at: Vec3, mass: f32| {
+        let e = dynamic(app, Collider::cuboid(half.x, half.y, half.z), at, mass);
+        app.world_mut().entity_mut(e).insert(Friction(0.6));
+        e
+    };
+    // Standing: shins, thighs, torso, head; arms hanging at the sides.
+    let torso = part(Vec3::new(0.12, 0.18, 0.25), Vec3::new(x, y, z + 1.05), 15.0);
+    let head = part(Vec3::splat(0.11), Vec3::new(x, y, z + 1.45), 4.0);
+    let mut limbs = Vec::new();
+    for side in [-1.0f32, 1.0] {
+        let upper_arm = part(
+            Vec3::new(0.05, 0.05, 0.15),
+            Vec3::new(x, y + side * 0.25, z + 1.13),
+            2.0,
+        );
+        let forearm = part(
+            Vec3::new(0.045, 0.045, 0.14),
+            Vec3::new(x, y + side * 0.25, z + 0.83),
+            1.5,
+        );
+        let thigh = part(
+            Vec3::new(0.07, 0.07, 0.2),
+            Vec3::new(x, y + side * 0.1, z + 0.6),
+            6.0,
+        );
+        let shin = part(
+            Vec3::new(0.06, 0.06, 0.19),
+            Vec3::new(x, y + side * 0.1, z + 0.19),
+            4.0,
+        );
+        limbs.push((side, upper_arm, forearm, thigh, shin));
+    }
+    let down = Vec3::NEG_Z;
+    let world = app.world_mut();
+    let mut joints = vec![
+        world
+            .spawn(
+                Joint::spherical(torso, head)
+                    .with_axis(Vec3::Z)
+                    .with_anchors(Vec3::new(0.0, 0.0, 0.27), Vec3::new(0.0, 0.0, -0.13))
+                    .with_swing_limit(0.6)
+                    .with_limits(-0.6, 0.6),
+            )
+            .id(),
+    ];
+    for (side, upper_arm, forearm, thigh, shin) in limbs {
+        let shoulder = Joint::spherical(torso, upper_arm)
+            .with_axis(down)
+            .with_anchors(Vec3::new(0.0, side * 0.25, 0.23), Vec3::new(0.0, 0.0, 0.15))
+            .with_swing_limit(1.5)
+            .with_limits(-0.8, 0.8);
+        let elbow = Joint::revolute(upper_arm, forearm)
+            .with_axis(Vec3::Y)
+            .with_anchors(Vec3::new(0.0, 0.0, -0.16), Vec3::new(0.0, 0.0, 0.15))
+            .with_limits(-2.4, 0.0);
+        let hip = Joint::spherical(torso, thigh)
+            .with_axis(down)
+            .with_anchors(Vec3::new(0.0, side * 0.1, -0.26), Vec3::new(0.0, 0.0, 0.2))
+            .with_swing_limit(1.2)
+            .with_limits(-0.5, 0.5);
+        let knee = Joint::revolute(thigh, shin)
+            .with_axis(Vec3::Y)
+            .with_anchors(Vec3::new(0.0, 0.0, -0.205), Vec3::new(0.0, 0.0, 0.195))
+            .with_limits(0.0, 2.4);
+        for joint in [shoulder, elbow, hip, knee] {
+            joints.push(world.spawn(joint).id());
+        }
+    }
+    world.entity_mut(torso).insert(Velocity::new(4.0, 0.0, 0.0));
+    Ragdoll {
+        torso,
+        bodies: 10,
+        joints,
+    }
+}
+
+/// The worst of `joints`' distances past their limits (rad or m).
+fn past_limits(app: &mut App, joints: &[Entity]) -> f32 {
+    let pose = |app: &App, e: Entity| {
+        let p = position(app, e);
+        let r = app
+            .world()
+            .get::<Rotation>(e)
+            .map_or(glam::Quat::IDENTITY, |r| r.0);
+        urto::geometry::Isometry::new(p, r)
+    };
+    joints
+        .iter()
+        .filter_map(|&j| app.world().get::<Joint>(j).copied())
+        .map(|joint| {
+            let b = joint.body_b_entity().map(|b| pose(app, b));
+            let (a, b) = joint.world_frames(pose(app, joint.body_a), b);
+            joint.past_limit(&a, &b)
+        })
+        .fold(0.0, f32::max)
 }

@@ -35,7 +35,9 @@
 //! naming a part is refused with a warning.
 
 use crate::dynamics::solver::JointFrame;
+use crate::dynamics::solver::joint::twist_angle;
 pub use crate::dynamics::solver::{JointKind, JointLimit, JointMotor};
+use crate::geometry::Isometry;
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
 
@@ -234,6 +236,50 @@ impl Joint {
             JointEnd::Body(e) => Some(e),
             JointEnd::World => None,
         }
+    }
+
+    /// The joint's frame on each end in world coordinates (anchor and basis), for A at `pose_a`
+    /// and B at `pose_b` (`None` for the world).
+    pub fn world_frames(&self, pose_a: Isometry, pose_b: Option<Isometry>) -> (Isometry, Isometry) {
+        let frame = |pose: Isometry, anchor: Vec3, basis| {
+            Isometry::new(pose.transform_point(anchor), pose.rotation * basis)
+        };
+        (
+            frame(pose_a, self.anchor_a, self.basis_a),
+            frame(pose_b.unwrap_or_default(), self.anchor_b, self.basis_b),
+        )
+    }
+
+    /// How far the joint is past its limits (rad or m; 0 within them or without any), its
+    /// frames in world coordinates being `a` and `b` ([`world_frames`](Self::world_frames)):
+    /// a ball joint's swing past its cone, its twist, a hinge's angle, a slider's travel, a
+    /// distance, each past its bounds.
+    pub fn past_limit(&self, a: &Isometry, b: &Isometry) -> f32 {
+        let swing = match self.kind {
+            JointKind::Spherical {
+                swing: Some(cone), ..
+            } => {
+                let (x_a, x_b) = (a.rotation * Vec3::X, b.rotation * Vec3::X);
+                (x_a.angle_between(x_b) - cone).max(0.0)
+            }
+            _ => 0.0,
+        };
+        let (Some(limit), _) = self.kind.limit_and_motor() else {
+            return swing;
+        };
+        let coordinate = match self.kind {
+            JointKind::Revolute { .. } | JointKind::Spherical { .. } => {
+                twist_angle(a.rotation, b.rotation)
+            }
+            JointKind::Prismatic { .. } => {
+                (a.rotation * Vec3::X).dot(b.translation - a.translation)
+            }
+            _ => a.translation.distance(b.translation),
+        };
+        (limit.min - coordinate)
+            .max(coordinate - limit.max)
+            .max(swing)
+            .max(0.0)
     }
 
     /// Why the joint cannot be solved, if it cannot: non-finite or non-unit frames, a body

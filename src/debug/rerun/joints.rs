@@ -4,7 +4,6 @@
 
 use super::{RerunRecording, arr, color, report};
 use crate::components::*;
-use crate::dynamics::solver::joint::twist_angle;
 use crate::geometry::Isometry;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
@@ -44,7 +43,7 @@ pub(super) fn record_joints(
             continue;
         };
         let (a, b) = (frame_a.translation, frame_b.translation);
-        let past = past_limit(joint, &frame_a, &frame_b);
+        let past = joint.past_limit(&frame_a, &frame_b);
         worst = worst.max(past);
         let hue = if disabled || quarantined {
             DISABLED
@@ -80,45 +79,13 @@ pub(super) fn record_joints(
     report(stream.log("joints/past_limit", &rerun::Scalars::single(worst)));
 }
 
-/// The joint's frame on each end in world coordinates (anchor and basis).
+/// The joint's frame on each end in world coordinates, if its bodies are placed.
 fn world_frames(joint: &Joint, poses: &Query<&GlobalPose>) -> Option<(Isometry, Isometry)> {
-    let frame = |pose: Isometry, anchor: Vec3, basis| {
-        Isometry::new(pose.transform_point(anchor), pose.rotation * basis)
-    };
     let a = poses.get(joint.body_a).ok()?.0;
     let b = match joint.body_b {
-        JointEnd::Body(b) => poses.get(b).ok()?.0,
-        JointEnd::World => Isometry::default(),
+        JointEnd::Body(b) => Some(poses.get(b).ok()?.0),
+        JointEnd::World => None,
     };
-    let frames = (
-        frame(a, joint.anchor_a, joint.basis_a),
-        frame(b, joint.anchor_b, joint.basis_b),
-    );
+    let frames = joint.world_frames(a, b);
     (frames.0.translation.is_finite() && frames.1.translation.is_finite()).then_some(frames)
-}
-
-/// How far the joint's coordinate is past its limit (rad or m; 0 within it or without one).
-fn past_limit(joint: &Joint, a: &Isometry, b: &Isometry) -> f32 {
-    let swing = match joint.kind {
-        JointKind::Spherical {
-            swing: Some(cone), ..
-        } => {
-            let (x_a, x_b) = (a.rotation * Vec3::X, b.rotation * Vec3::X);
-            (x_a.angle_between(x_b) - cone).max(0.0)
-        }
-        _ => 0.0,
-    };
-    let (Some(limit), _) = joint.kind.limit_and_motor() else {
-        return swing;
-    };
-    let coordinate = match joint.kind {
-        JointKind::Revolute { .. } | JointKind::Spherical { .. } => {
-            twist_angle(a.rotation, b.rotation)
-        }
-        JointKind::Prismatic { .. } => (a.rotation * Vec3::X).dot(b.translation - a.translation),
-        _ => a.translation.distance(b.translation),
-    };
-    (limit.min - coordinate)
-        .max(coordinate - limit.max)
-        .max(0.0)
 }
