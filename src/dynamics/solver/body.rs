@@ -119,6 +119,15 @@ pub struct SolverBodies {
     pub orientations: Vec<Quat>,
 }
 
+/// Whether the three principal moments are equal (a ball, a cube): then `ω × Iω = 0` and the
+/// gyroscopic term vanishes; the linearised update then turns the body by `2 atan(|ω| h / 2)`
+/// instead of `|ω| h` (0.08 % short at 0.1 rad per substep), for a fraction of the exact
+/// flow's cost.
+fn isotropic(inverse_moments: Vec3) -> bool {
+    inverse_moments.max_element() - inverse_moments.min_element()
+        <= 1e-6 * inverse_moments.max_element()
+}
+
 impl SolverBodies {
     /// Empties the arrays (keeping their memory).
     pub fn clear(&mut self) {
@@ -171,7 +180,8 @@ impl SolverBodies {
                 && dynamic
                 && b.free_axes == Vec3::ONE
                 && b.inverse_principal_inertia.cmpgt(Vec3::ZERO).all()
-                && b.inverse_principal_inertia.is_finite())
+                && b.inverse_principal_inertia.is_finite()
+                && !isotropic(b.inverse_principal_inertia))
             .then_some((b.inertia_frame, b.inverse_principal_inertia)),
         });
         self.centers.push(b.center);
