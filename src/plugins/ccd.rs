@@ -12,8 +12,9 @@
 //!
 //! Only static scenery is swept against; fast bodies meeting each other are left to the
 //! discrete step (and substeps). Sensors neither sweep nor stop a sweep, and colliders whose
-//! [`CollisionLayers`] do not interact pass through each other here too. A body already touching a surface at the start of its motion
-//! is the contact solver's business, not an impact.
+//! [`CollisionLayers`] do not interact pass through each other here too, as do bodies a
+//! [`Joint`](crate::components::Joint) keeps from colliding. A body already touching a surface
+//! at the start of its motion is the contact solver's business, not an impact.
 
 use crate::bvh::QueryScratch;
 use crate::ccd::{InitialOverlap, SphereSweep, Toi, toi_sphere_shape};
@@ -22,6 +23,7 @@ use crate::dynamics::response::reflect;
 use crate::geometry::ContactManifold;
 use crate::plugins::broad_phase::BroadPhaseIndex;
 use crate::plugins::integration::IntegrateBodies;
+use crate::plugins::joints::JointedPairs;
 use crate::plugins::narrow_phase::{ComputeContacts, ContactPair, Contacts};
 use crate::plugins::required_resources::RequireResource;
 use crate::plugins::response::ReportCollisions;
@@ -198,8 +200,10 @@ fn sweep_fast_bodies(
     mut scratch: ResMut<CcdScratch>,
     mut impacts: ResMut<CcdImpacts>,
     mut stats: ResMut<PhysicsStats>,
+    jointed: Option<Res<JointedPairs>>,
 ) {
     impacts.contacts.clear();
+    let jointed = jointed.as_deref().filter(|j| !j.is_empty());
     // Without a broad phase there is no indexed scenery to sweep against.
     let Some(mut index) = index else {
         return;
@@ -229,7 +233,7 @@ fn sweep_fast_bodies(
             };
             let sweep = sweep.with_initial_overlap(InitialOverlap::ApproachingOnly);
             let Some((hit, root, leaf, e_obstacle)) =
-                first_impact(&sweep, layers, &obstacles, &mut index, s)
+                first_impact(&sweep, (body, layers, jointed), &obstacles, &mut index, s)
             else {
                 at += motion;
                 motion = Vec3::ZERO;
@@ -271,12 +275,12 @@ fn sweep_fast_bodies(
 /// below which it is rounding (a body sliding along its support), not an impact.
 const TOUCHING_TOLERANCE: f32 = 1e-4;
 
-/// The earliest impact of `sweep` (a body with `layers`) with the static scenery its swept
-/// volume meets and its layers interact with: the hit, the obstacle's root, the collider hit,
-/// and that collider's restitution.
+/// The earliest impact of `sweep` (`body`, with `layers`) with the static scenery its swept
+/// volume meets, its layers interact with and no joint keeps it from colliding with: the hit,
+/// the obstacle's root, the collider hit, and that collider's restitution.
 fn first_impact(
     sweep: &SphereSweep,
-    layers: CollisionLayers,
+    (body, layers, jointed): (Entity, CollisionLayers, Option<&JointedPairs>),
     obstacles: &Query<Obstacle, Without<Quarantined>>,
     index: &mut BroadPhaseIndex,
     s: &mut CcdScratch,
@@ -286,6 +290,9 @@ fn first_impact(
     index.statics_touching(&swept, &mut s.candidates);
     let mut best: Option<(Toi, Entity, Entity, Option<f32>)> = None;
     for &root in &s.candidates {
+        if jointed.is_some_and(|j| j.contains(body, root)) {
+            continue;
+        }
         s.stack.clear();
         s.stack.push(root);
         while let Some(node) = s.stack.pop() {

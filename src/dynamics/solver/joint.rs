@@ -314,7 +314,12 @@ impl Pass<'_> {
             if let Some(motor) = motor {
                 solve_motor(row, *coordinate, &motor, m, states, ab, h, &mut j.motor);
             }
-            if let Some(limit) = limit {
+            if let Some(mut limit) = limit {
+                // A distance is never below 0: a rope's lower bound of 0 would only stop a body
+                // passing through the other's anchor.
+                if matches!(kind, JointKind::Distance { .. }) && limit.min <= 0.0 {
+                    limit.min = f32::NEG_INFINITY;
+                }
                 let accumulated = (&mut j.lower, &mut j.upper);
                 solve_limit(row, *coordinate, limit, m, states, ab, soft, accumulated);
             }
