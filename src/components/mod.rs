@@ -43,7 +43,7 @@ use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
 
 /// Where a body is: the position of its origin (centre of mass) in its parent's frame — the
-/// world for a body without [`ChildOf`](bevy_ecs::hierarchy::ChildOf), the parent body for a
+/// world for a body without [`ChildOf`], the parent body for a
 /// part of a compound (a wheel of a car, a link of an arm).
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 #[require(Rotation, GlobalPose, BoundingVolume)]

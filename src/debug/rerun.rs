@@ -103,7 +103,7 @@ pub struct RerunConfig {
     pub bvh_levels: u32,
     /// Log the hierarchy leaves through which meshes touch, every recorded step. Makes the
     /// narrow phase record them (see
-    /// [`OverlappingLeaves`](crate::plugins::narrow_phase::OverlappingLeaves)).
+    /// [`OverlappingLeaves`]).
     pub overlapping_leaves: bool,
     /// Log, every recorded step, the static grid's cells each moving body's volume touches and
     /// the statics those cells list (the candidates the grid hands on); the layout then adds a

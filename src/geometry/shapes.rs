@@ -54,7 +54,7 @@ pub const MAX_SHAPE_EXTENT: f32 = 1.0e6;
 /// Why a shape cannot be simulated.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ShapeError {
-    /// A radius or half extent above [`MAX_SHAPE_EXTENT`].
+    /// A radius or half extent above `MAX_SHAPE_EXTENT` (1,000 km).
     TooLarge(f32),
     /// A radius that is negative, NaN or infinite.
     BadRadius(f32),

@@ -30,7 +30,7 @@ pub fn refit_order<N: Copy + Ord + Hash>(
 
 /// Climbs from `start` towards its root, pushing onto `path` each node that `known` does not
 /// answer for, and returns the answer for the first node it does (`None`: the climb ended at a
-/// root, the last node of `path`, or after [`MAX_PATH`] nodes, on a loop of parents, which
+/// root, the last node of `path`, or after `MAX_PATH` nodes, on a loop of parents, which
 /// validation quarantines). The memoised walk shared by the hierarchy's climbs: with `known`
 /// filled from each climb's `path`, many climbs up one chain cost linear time together.
 pub fn climb<N: Copy, V>(

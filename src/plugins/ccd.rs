@@ -13,7 +13,7 @@
 //! Only static scenery is swept against; fast bodies meeting each other are left to the
 //! discrete step (and substeps). Sensors neither sweep nor stop a sweep, and colliders whose
 //! [`CollisionLayers`] do not interact pass through each other here too, as do bodies a
-//! [`Joint`](crate::components::Joint) keeps from colliding. A body already touching a surface
+//! [`Joint`] keeps from colliding. A body already touching a surface
 //! at the start of its motion is the contact solver's business, not an impact.
 
 use crate::bvh::QueryScratch;
