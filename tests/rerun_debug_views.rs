@@ -344,3 +344,69 @@ fn the_views_are_off_by_default_and_change_no_result() {
     assert_eq!(positions(&with_views, &views_scene), expected);
     assert_eq!(positions(&app, &scene), expected);
 }
+
+#[test]
+fn joints_are_drawn_at_their_anchors_with_their_axes_and_loads() {
+    let (rec, storage) = rerun::RecordingStreamBuilder::new("urto_joint_views")
+        .memory()
+        .expect("memory sink");
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    app.add_plugins(RerunDebugPlugin::from_stream(
+        rec.clone(),
+        RerunConfig::file("unused.rrd"),
+    ));
+    let bob = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.1),
+            Position::new(1.0, 0.0, 2.0),
+            Velocity::default(),
+        ))
+        .id();
+    let pivot = Vec3::new(0.0, 0.0, 2.0);
+    app.world_mut().spawn(
+        Joint::revolute(bob, JointEnd::World)
+            .with_axis(Vec3::Y)
+            .with_anchors(Vec3::new(-1.0, 0.0, 0.0), pivot),
+    );
+    urto::step(app.world_mut(), STEPS).unwrap();
+    let store = common::recording::read_back(&rec, &storage);
+    let names = entities(&store);
+    for path in [
+        "/world/joints/links",
+        "/world/joints/anchors",
+        "/world/joints/axes",
+        "/joints/past_limit",
+    ] {
+        assert!(names.contains(path), "{path} missing from {names:?}");
+    }
+    assert!(
+        names
+            .iter()
+            .any(|n| n.starts_with("/joints/") && n.ends_with("/force"))
+    );
+    // The last anchors drawn: the bob's anchor where the bob is now, and the pivot.
+    let positions = rerun::Points3D::descriptor_positions().component;
+    let mut last = Vec::new();
+    for chunk in store.iter_physical_chunks() {
+        if chunk.entity_path().to_string() == "/world/joints/anchors" {
+            for batch in chunk.iter_component::<rerun::components::Position3D>(positions) {
+                last = batch.iter().map(|p| Vec3::from_array(p.0.into())).collect();
+            }
+        }
+    }
+    let p = app.world().get::<Position>(bob).unwrap().0;
+    let r = app.world().get::<Rotation>(bob).unwrap().0;
+    let bob_anchor = p + r * Vec3::new(-1.0, 0.0, 0.0);
+    assert_eq!(last.len(), 2, "{last:?}");
+    assert!(
+        (last[0] - bob_anchor).length() < 1e-5,
+        "{last:?} vs {bob_anchor}"
+    );
+    assert!((last[1] - pivot).length() < 1e-5, "{last:?}");
+    assert!(
+        (bob_anchor - pivot).length() < 0.01,
+        "the hinge holds: {bob_anchor}"
+    );
+}
