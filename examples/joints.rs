@@ -271,7 +271,7 @@ fn build_bridge(app: &mut App, planks: u32) -> (Vec<Entity>, Vec3) {
 }
 
 struct Wrecking {
-    links: Vec<Entity>,
+    ball: Entity,
     top: Vec3,
     rest: f32,
     stack: Vec<(Entity, Vec3)>,
@@ -285,7 +285,6 @@ fn build_wrecking_ball(app: &mut App) -> Wrecking {
     let top = Vec3::new(0.0, -6.0, 6.0);
     let direction = Vec3::new(-1.0, 0.0, 0.0);
     let rotation = glam::Quat::from_rotation_arc(Vec3::NEG_Z, direction);
-    let mut links = Vec::new();
     let mut previous = (JointEnd::World, top);
     let end = Vec3::new(0.0, 0.0, half + 0.5 * gap);
     for i in 0..n {
@@ -295,14 +294,12 @@ fn build_wrecking_ball(app: &mut App) -> Wrecking {
         app.world_mut()
             .spawn(Joint::spherical(link, previous.0).with_anchors(end, previous.1));
         previous = (JointEnd::Body(link), -end);
-        links.push(link);
     }
-    let last = *links.last().unwrap();
     let ball_at = top + direction * (pitch * n as f32 + 0.5);
     let ball = dynamic(app, Collider::sphere(0.5), ball_at, 50.0);
-    app.world_mut()
-        .spawn(Joint::spherical(ball, last).with_anchors(Vec3::new(0.5, 0.0, 0.0), -end));
-    links.push(ball);
+    app.world_mut().spawn(
+        Joint::spherical(ball, previous.0).with_anchors(Vec3::new(0.5, 0.0, 0.0), previous.1),
+    );
     let mut stack = Vec::new();
     for level in 0..3 {
         for k in 0..(3 - level) {
@@ -316,7 +313,7 @@ fn build_wrecking_ball(app: &mut App) -> Wrecking {
     }
     let rest = pitch * n as f32;
     Wrecking {
-        links,
+        ball,
         top,
         rest,
         stack,
@@ -374,7 +371,7 @@ fn angular_speed_z(app: &App, e: Entity) -> f32 {
 /// How much longer than its links the chain hangs, from its top to the ball's anchor (the
 /// chain is straight under the ball's weight).
 fn chain_stretch(app: &App, w: &Wrecking) -> f32 {
-    let ball = *w.links.last().unwrap();
+    let ball = w.ball;
     let r = app
         .world()
         .get::<Rotation>(ball)

@@ -63,10 +63,10 @@ impl JointedPairs {
 /// The joints the solver takes: not disabled, not quarantined.
 pub(crate) type ActiveJoint = (Without<JointDisabled>, Without<Quarantined>);
 
-/// Quarantines joints with unusable values or bodies (checked every step: joints are few, and a
-/// body can vanish or become a part at any time).
+/// Quarantines joints with unusable values (checked when the joint changes) or bodies (checked
+/// every step: a body can vanish or become a part at any time, and it is two lookups).
 fn quarantine_invalid_joints(
-    joints: Query<(Entity, &Joint), ActiveJoint>,
+    joints: Query<(Entity, Ref<Joint>), ActiveJoint>,
     bodies: Query<Has<ChildOf>, With<Position>>,
     mut commands: Commands,
 ) {
@@ -83,7 +83,8 @@ fn quarantine_invalid_joints(
                 )),
                 Ok(false) => None,
             });
-        if let Some(problem) = joint.problem().or(body_problem) {
+        let value_problem = joint.is_changed().then(|| joint.problem()).flatten();
+        if let Some(problem) = value_problem.or(body_problem) {
             quarantine(&mut commands, e, format!("joint {problem}"));
         }
     }

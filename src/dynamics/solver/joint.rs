@@ -71,10 +71,46 @@ pub struct JointConstraint {
     /// The angular lock's `K⁻¹ = (I_a⁻¹ + I_b⁻¹)⁻¹` (fixed and prismatic joints): its rows
     /// are the world axes, so it holds for the whole step.
     lock_inverse_mass: Mat3,
+    /// The limits and motor on the joint's coordinate, as the passes apply them.
+    limits: Limits,
     /// Accumulated impulses.
     pub impulses: JointImpulses,
     /// The rows where the bodies are now ([`Self::refresh`]).
     rows: Rows,
+}
+
+/// The bounds and motor a joint's passes apply, taken from its kind once per step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Limits {
+    /// On the axis coordinate (a hinge's angle, a slider's travel, a distance, a twist).
+    axis: Option<JointLimit>,
+    /// On a ball joint's swing: at most the cone's angle.
+    swing: Option<JointLimit>,
+    /// On the axis coordinate.
+    motor: Option<JointMotor>,
+}
+
+impl Limits {
+    fn of(kind: JointKind) -> Self {
+        let (mut axis, motor) = kind.limit_and_motor();
+        // A distance is never below 0: a rope's lower bound of 0 would only stop a body
+        // passing through the other's anchor.
+        if let (JointKind::Distance { .. }, Some(l)) = (kind, axis.as_mut())
+            && l.min <= 0.0
+        {
+            l.min = f32::NEG_INFINITY;
+        }
+        let swing = match kind {
+            JointKind::Spherical {
+                swing: Some(cone), ..
+            } => Some(JointLimit {
+                min: f32::NEG_INFINITY,
+                max: cone,
+            }),
+            _ => None,
+        };
+        Self { axis, swing, motor }
+    }
 }
 
 /// The joint's rows where the bodies are now: they depend on the bodies' positions only, so
@@ -109,6 +145,7 @@ impl JointConstraint {
             delta_center: bodies.centers[b] - bodies.centers[a],
             frames: [qa * joint.frame_a.basis, qb * joint.frame_b.basis],
             lock_inverse_mass: Mat3::ZERO,
+            limits: Limits::of(joint.kind),
             impulses: JointImpulses::default(),
             rows: Rows::default(),
         };
@@ -260,7 +297,7 @@ impl JointConstraint {
         };
         let (rows, impulses) = (&self.rows, &mut self.impulses);
         if rows.axis.is_some() || rows.swing.is_some() {
-            pass.solve_coordinate(states, self.input.kind, rows, impulses);
+            pass.solve_coordinate(states, &self.limits, rows, impulses);
         }
         // The hard rows last, so that they win.
         pass.solve_hard_rows(states, rows, impulses, holds_point);
@@ -303,38 +340,22 @@ impl Pass<'_> {
     fn solve_coordinate(
         &self,
         states: &mut [BodyState],
-        kind: JointKind,
+        limits: &Limits,
         rows: &Rows,
         j: &mut JointImpulses,
     ) {
         let (m, ab, h) = (self.masses, self.ab, self.h);
-        let (limit, motor) = kind.limit_and_motor();
         let soft = (h, self.use_bias.then_some(self.soft));
         if let Some((row, coordinate)) = &rows.axis {
-            if let Some(motor) = motor {
-                solve_motor(row, *coordinate, &motor, m, states, ab, h, &mut j.motor);
+            if let Some(motor) = &limits.motor {
+                solve_motor(row, *coordinate, motor, m, states, ab, h, &mut j.motor);
             }
-            if let Some(mut limit) = limit {
-                // A distance is never below 0: a rope's lower bound of 0 would only stop a body
-                // passing through the other's anchor.
-                if matches!(kind, JointKind::Distance { .. }) && limit.min <= 0.0 {
-                    limit.min = f32::NEG_INFINITY;
-                }
+            if let Some(limit) = limits.axis {
                 let accumulated = (&mut j.lower, &mut j.upper);
                 solve_limit(row, *coordinate, limit, m, states, ab, soft, accumulated);
             }
         }
-        if let (
-            Some((row, angle)),
-            JointKind::Spherical {
-                swing: Some(cone), ..
-            },
-        ) = (&rows.swing, kind)
-        {
-            let limit = JointLimit {
-                min: f32::NEG_INFINITY,
-                max: cone,
-            };
+        if let (Some((row, angle)), Some(limit)) = (&rows.swing, limits.swing) {
             let mut unused = 0.0;
             let accumulated = (&mut unused, &mut j.swing);
             solve_limit(row, *angle, limit, m, states, ab, soft, accumulated);
@@ -372,16 +393,6 @@ impl Pass<'_> {
             let c = error(rows.separation);
             let k = &rows.point_inverse_mass;
             solve_point(m, states, ab, rows.anchors, c, bias_soft, k, &mut j.point);
-        }
-    }
-}
-
-impl AngularRows {
-    /// The three world axes: a lock of the relative turn.
-    pub fn world() -> Self {
-        Self {
-            directions: [Vec3::X, Vec3::Y, Vec3::Z],
-            count: 3,
         }
     }
 }

@@ -307,6 +307,14 @@ pub struct AngularRows {
 }
 
 impl AngularRows {
+    /// The three world axes: a lock of the relative turn.
+    pub fn world() -> Self {
+        Self {
+            directions: [Vec3::X, Vec3::Y, Vec3::Z],
+            count: 3,
+        }
+    }
+
     /// `K⁻¹` of the rows (the unused third row of two is the identity, and takes nothing).
     pub fn inverse_mass(&self, m: &PairMasses) -> Mat3 {
         inverse_mass(self.k(m))

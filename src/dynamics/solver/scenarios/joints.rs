@@ -549,3 +549,73 @@ fn a_twist_limit_of_half_a_radian_holds_a_spun_limb_within_half_a_degree() {
     let (_, twist) = kicked_ball_joint(limited, Vec3::ZERO, Vec3::Z * 10.0);
     assert!(twist < 0.5 + 0.5f32.to_radians(), "twisted {twist} rad");
 }
+
+#[test]
+fn an_unusable_joint_is_skipped_and_a_nan_joint_setting_steps_with_the_defaults() {
+    // A NaN anchor, an empty limit and a negative motor force: the bob falls freely, finite.
+    let bad_kinds = [
+        (Vec3::NAN, BALL),
+        (
+            Vec3::Z,
+            JointKind::Revolute {
+                limit: Some(JointLimit {
+                    min: 1.0,
+                    max: -1.0,
+                }),
+                motor: None,
+            },
+        ),
+        (
+            Vec3::Z,
+            JointKind::Revolute {
+                limit: None,
+                motor: Some(JointMotor::velocity(1.0, -5.0)),
+            },
+        ),
+    ];
+    for (bob_anchor, kind) in bad_kinds {
+        let mut scene = Scene::default();
+        let pivot = anchor(&mut scene, Vec3::ZERO);
+        let bob = scene.add(
+            Shape::sphere(0.1),
+            Vec3::new(0.0, 0.0, -1.0),
+            Quat::IDENTITY,
+            1.0,
+        );
+        join(
+            &mut scene,
+            (pivot, bob),
+            (Vec3::ZERO, bob_anchor),
+            Vec3::Y,
+            kind,
+        );
+        scene.run(0.5);
+        let z = scene.bodies[bob].center.z;
+        assert!(
+            z.is_finite() && z < -1.0 - 0.5 * 9.81 * 0.25 * 0.9,
+            "{kind:?}: z = {z}"
+        );
+        assert!(scene.solver.joints().is_empty(), "{kind:?} was solved");
+    }
+    // A NaN joint stiffness: the solver steps with its defaults and the joint holds.
+    let mut scene = Scene::default();
+    scene.solver.settings.joint_hertz = f32::NAN;
+    let pivot = anchor(&mut scene, Vec3::ZERO);
+    let bob = scene.add(
+        Shape::sphere(0.1),
+        Vec3::new(0.0, 0.0, -1.0),
+        Quat::IDENTITY,
+        1.0,
+    );
+    join(
+        &mut scene,
+        (pivot, bob),
+        (Vec3::ZERO, Vec3::Z),
+        Vec3::Y,
+        BALL,
+    );
+    scene.run(0.5);
+    assert_eq!(scene.solver.settings, SoftStepSettings::default());
+    let z = scene.bodies[bob].center.z;
+    assert!((z + 1.0).abs() < 0.01, "the joint let go: z = {z}");
+}
