@@ -204,7 +204,7 @@ fn rotated(mesh: &TriMesh, rotation: Quat) -> Vec<Vec3> {
 }
 
 #[test]
-fn spheres_boxes_and_half_spaces_match_parry_within_1e_6_relative() {
+fn spheres_boxes_capsules_and_half_spaces_match_parry_within_1e_6_relative() {
     let mut worst = Errors::default();
     for (r, density) in [(0.01, 7800.0), (0.5, 1000.0), (3.0, 1.0), (250.0, 0.1)] {
         let ours = Shape::sphere(r).mass_properties(density);
@@ -220,7 +220,13 @@ fn spheres_boxes_and_half_spaces_match_parry_within_1e_6_relative() {
         let parry = parry3d::shape::Cuboid::new(h).mass_properties(density);
         worst = worst.worst(Errors::of_shape(&ours, &parry, h.length()));
     }
-    println!("spheres and boxes, worst relative errors: {worst:?}");
+    for (half_length, r, density) in [(0.5, 0.25, 1000.0), (0.0, 1.0, 1.0), (3.0, 0.05, 7800.0)]
+    {
+        let ours = Shape::capsule(half_length, r).mass_properties(density);
+        let parry = parry3d::shape::Capsule::new_z(half_length, r).mass_properties(density);
+        worst = worst.worst(Errors::of_shape(&ours, &parry, half_length + r));
+    }
+    println!("spheres, boxes and capsules, worst relative errors: {worst:?}");
     assert!(worst.max().max(worst.moments) < 1e-6, "{worst:?}");
     let ground = Shape::half_space(Vec3::Z).mass_properties(1000.0);
     assert_eq!(ground, MassProperties::infinite());

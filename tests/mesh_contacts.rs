@@ -20,12 +20,12 @@ mod common;
 use common::rng::Rng;
 use glam::Vec3;
 use urto::geometry::contacts::{
-    ContactScratch, NO_TRIANGLE, contact, contact_triangle_cuboid, contact_triangle_triangle,
-    contact_with_scratch,
+    ContactScratch, NO_TRIANGLE, contact, contact_triangle_capsule, contact_triangle_cuboid,
+    contact_triangle_triangle, contact_with_scratch,
 };
 use urto::geometry::mesh_io::load_ply;
 use urto::geometry::{
-    ContactManifold, Cuboid, HalfSpace, Isometry, MeshCollider, Shape, Sphere, TriMesh,
+    Capsule, ContactManifold, Cuboid, HalfSpace, Isometry, MeshCollider, Shape, Sphere, TriMesh,
     contact_triangle_sphere, intersects_triangle_cuboid,
 };
 
@@ -206,6 +206,94 @@ fn mesh_sphere_matches_every_triangle_tested() {
         }
     }
     assert!(touching > 300 && apart > 100, "{touching} / {apart}");
+}
+
+#[test]
+fn mesh_capsule_matches_every_triangle_tested() {
+    let mut rng = Rng::new(16);
+    let mut scratch = ContactScratch::new();
+    scratch.set_record_hits(true);
+    let (mut touching, mut apart) = (0, 0);
+    for (name, mesh) in meshes() {
+        let shape = Shape::TriMesh(mesh.clone());
+        for _ in 0..300 {
+            let pose = rng.placement(0.5);
+            let capsule = Capsule {
+                half_length: rng.range(0.0, 0.6),
+                radius: rng.range(0.05, 0.5),
+            };
+            let reach = mesh.bounding_radius() + capsule.radius + capsule.half_length;
+            let at = Isometry::new(pose.transform_point(rng.in_ball(reach)), rng.rotation());
+            let body = Shape::Capsule(capsule);
+            let got = contact_with_scratch(&shape, &pose, &body, &at, &mut scratch);
+            // Brute force in the mesh's frame, where the library works.
+            let (p0, p1) = capsule.segment(&pose.inv_mul(&at));
+            let brute: Vec<(u32, Vec3, f32)> = mesh
+                .mesh()
+                .iter_triangles()
+                .enumerate()
+                .filter_map(|(t, tri)| {
+                    contact_triangle_capsule(&tri, p0, p1, capsule.radius)
+                        .map(|m| (t as u32, pose.transform_vector(m.normal), m.max_depth()))
+                })
+                .collect();
+            assert_eq!(got.is_some(), !brute.is_empty(), "{name}");
+            let Some(m) = got else {
+                apart += 1;
+                continue;
+            };
+            touching += 1;
+            assert_well_formed(&m, name);
+            let expected: Vec<u32> = brute.iter().map(|b| b.0).collect();
+            assert_eq!(sorted_mesh_hits(&scratch), expected, "{name}: triangles");
+            let pairs: Vec<(Vec3, f32, u8)> = brute.iter().map(|b| (b.1, b.2, 0)).collect();
+            let (normal, deepest) = merged(&pairs);
+            assert!((m.max_depth() - deepest).abs() < 1e-6, "{name}");
+            assert_normal_close(m.normal, normal, name);
+            let flipped = contact(&body, &at, &shape, &pose).expect("symmetric");
+            assert_eq!(flipped, m.flipped(), "{name}: swapping flips the normal");
+        }
+    }
+    assert!(touching > 300 && apart > 100, "{touching} / {apart}");
+}
+
+#[test]
+fn triangle_capsule_depth_agrees_with_parrys_segment_distance_within_1e_4() {
+    use parry3d::math::{Pose, Vector};
+    let v = |x: Vec3| Vector::from_array(x.to_array());
+    let mut rng = Rng::new(17);
+    let (mut apart, mut touching, mut pierced) = (0, 0, 0);
+    for _ in 0..5000 {
+        let tri =
+            urto::geometry::Triangle::new(rng.in_ball(1.2), rng.in_ball(1.2), rng.in_ball(1.2));
+        let (p0, p1) = (rng.in_ball(1.5), rng.in_ball(1.5));
+        let radius = rng.range(0.0, 0.5);
+        let ours = contact_triangle_capsule(&tri, p0, p1, radius);
+        let pt = parry3d::shape::Triangle::new(v(tri.a), v(tri.b), v(tri.c));
+        let ps = parry3d::shape::Segment::new(v(p0), v(p1));
+        let gap = parry3d::query::distance(&Pose::IDENTITY, &pt, &Pose::IDENTITY, &ps)
+            .expect("supported")
+            .distance;
+        if (gap - radius).abs() < BAND {
+            continue;
+        }
+        if gap > 1e-5 {
+            assert_eq!(ours.is_some(), gap < radius, "{tri:?} {p0} {p1} {radius}: {gap}");
+            if let Some(m) = ours {
+                assert!((m.max_depth() - (radius - gap)).abs() < 1e-4, "{m:?} vs {gap}");
+                touching += 1;
+            } else {
+                apart += 1;
+            }
+        } else if tri.normal().is_some() {
+            // The segment crosses the triangle: pushed out at least the radius.
+            let m = ours.expect("a crossing segment touches");
+            assert!(m.max_depth() >= radius - 1e-5, "{m:?}");
+            pierced += 1;
+        }
+    }
+    println!("triangle-capsule vs parry: {touching} touching, {apart} apart, {pierced} pierced");
+    assert!(touching > 300 && apart > 300 && pierced > 100, "{touching} {apart} {pierced}");
 }
 
 #[test]

@@ -23,8 +23,9 @@ fn scene(rng: &mut Rng, n: usize) -> Vec<(Shape, Isometry)> {
     let mut out: Vec<(Shape, Isometry)> = (0..n)
         .map(|_| {
             let pose = Isometry::new(rng.in_ball(20.0), rng.rotation());
-            let shape = match rng.below(10) {
+            let shape = match rng.below(12) {
                 0..4 => Shape::sphere(rng.range(0.2, 1.5)),
+                10 | 11 => Shape::capsule(rng.range(0.0, 1.5), rng.range(0.1, 0.8)),
                 4..8 => Shape::cuboid(Vec3::new(
                     rng.range(0.1, 1.2),
                     rng.range(0.1, 1.2),
@@ -226,13 +227,18 @@ fn parry_ray(
 }
 
 #[test]
-fn ray_distances_agree_with_parry3d_within_1e_4_on_8000_rays_at_four_shapes() {
+fn ray_distances_agree_with_parry3d_within_1e_4_on_10000_rays_at_five_shapes() {
     let mut rng = Rng::new(15);
     let mesh = TriMesh::torus(1.5, 0.5, 24, 12).unwrap();
     let parry_mesh =
         parry3d::shape::TriMesh::new(mesh.vertices().to_vec(), mesh.triangles().to_vec()).unwrap();
     let half = Vec3::new(1.0, 0.4, 0.7);
-    let shapes: [(Shape, Box<dyn parry3d::shape::Shape>, bool); 4] = [
+    let shapes: [(Shape, Box<dyn parry3d::shape::Shape>, bool); 5] = [
+        (
+            Shape::capsule(0.9, 0.4),
+            Box::new(parry3d::shape::Capsule::new_z(0.9, 0.4)),
+            true,
+        ),
         (
             Shape::sphere(0.8),
             Box::new(parry3d::shape::Ball::new(0.8)),

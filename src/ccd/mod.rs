@@ -19,6 +19,7 @@
 //! | half-space    | the half-space moved out by `r`         | one division                   |
 //! | sphere        | a ball of radius `r + r_b`              | a quadratic, `‖m + t·d‖ = R`   |
 //! | oriented box  | a rounded box: 3 slabs, 12 cylinders, 8 balls | exact (slabs first)      |
+//! | capsule       | a capsule of radius `r + r_b`: 1 cylinder, 2 balls | exact               |
 //! | triangle      | a prism, 3 edge cylinders, 3 vertex balls | exact (face first)           |
 //! | triangle mesh | the union of its triangles' sums        | BVH descent, earliest triangle |
 //!
@@ -76,6 +77,7 @@ mod sweep_cull;
 mod swept_aabb;
 mod swept_point;
 mod toi;
+mod toi_sphere_capsule;
 mod toi_sphere_cuboid;
 mod toi_sphere_halfspace;
 mod toi_sphere_sphere;
@@ -90,6 +92,7 @@ pub use sweep::{CONTACT_TOLERANCE_RELATIVE, InitialOverlap, SphereSweep, SweepEr
 pub use sweep_cull::SweepCull;
 pub use swept_aabb::swept_aabb;
 pub use toi::{MeshToi, Toi, toi_sphere_shape};
+pub use toi_sphere_capsule::toi_sphere_capsule;
 pub use toi_sphere_cuboid::toi_sphere_cuboid;
 pub use toi_sphere_halfspace::toi_sphere_halfspace;
 pub use toi_sphere_sphere::{toi_sphere_sphere, toi_spheres_moving};

@@ -1,7 +1,7 @@
 //! The answer of a time-of-impact query, and the dispatch of a sweep against any [`Shape`].
 
 use super::{
-    SphereSweep, toi_sphere_cuboid, toi_sphere_halfspace, toi_sphere_sphere, toi_sphere_trimesh,
+    SphereSweep, toi_sphere_capsule, toi_sphere_cuboid, toi_sphere_halfspace, toi_sphere_sphere, toi_sphere_trimesh,
 };
 use crate::bvh::QueryScratch;
 use crate::geometry::{Isometry, Shape};
@@ -41,6 +41,7 @@ pub fn toi_sphere_shape(
         Shape::Sphere(s) => toi_sphere_sphere(sweep, pose.translation, s),
         Shape::Cuboid(c) => toi_sphere_cuboid(sweep, pose, c),
         Shape::HalfSpace(h) => toi_sphere_halfspace(sweep, pose, h),
+        Shape::Capsule(c) => toi_sphere_capsule(sweep, pose, c),
         Shape::TriMesh(m) => toi_sphere_trimesh(sweep, m.mesh(), m.bvh(), pose, scratch)
             .0
             .map(|hit| hit.toi),
@@ -61,6 +62,7 @@ mod tests {
         let cases = [
             (Shape::sphere(1.0), 0.35),
             (Shape::cuboid(Vec3::ONE), 0.35),
+            (Shape::capsule(0.5, 0.5), 0.35),
             (
                 Shape::half_space(Vec3::Z),
                 (5.0 - 0.5) / 10.0, // plane through the origin

@@ -189,6 +189,14 @@ impl Collider {
         }
     }
 
+    /// A capsule along the body's local z axis (standing up when unrotated): `half_length` from
+    /// the centre to each cap's centre, and `radius`. Characters and limbs are capsules.
+    pub fn capsule(half_length: f32, radius: f32) -> Self {
+        Self {
+            shape: Shape::capsule(half_length, radius),
+        }
+    }
+
     /// The solid below a plane through the body's position with outward `normal` (a ground).
     pub fn half_space(normal: Vec3) -> Self {
         Self {

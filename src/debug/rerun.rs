@@ -6,8 +6,8 @@
 //!
 //! | entity path | what | archetype |
 //! |---|---|---|
-//! | `world/bodies/spheres`, `world/bodies/boxes` | moving bodies (orange dynamic, blue kinematic, red quarantined) | `Ellipsoids3D`, `Boxes3D` |
-//! | `world/static/...` | static scenery (grey), re-logged only when it changes | `Ellipsoids3D`, `Boxes3D` |
+//! | `world/bodies/spheres`, `…/boxes`, `…/capsules` | moving bodies (orange dynamic, blue kinematic, red quarantined) | `Ellipsoids3D`, `Boxes3D`, `Capsules3D` |
+//! | `world/static/...` | static scenery (grey), re-logged only when it changes | `Ellipsoids3D`, `Boxes3D`, `Capsules3D` |
 //! | `world/meshes/<name>_<entity>` | each mesh body: its triangles once (grey static, orange dynamic, blue kinematic) and its pose per recorded step (static meshes: when moved) | `Mesh3D` + `Transform3D` |
 //! | `hierarchy/level_<k>/moving`, `…/static` | the OBBs of level `k` (root 0) of every mesh's hierarchy, world space (static meshes' re-logged only when they change); only with [`RerunConfig::bvh_levels`], each level in its own tab of the layout | `Boxes3D` |
 //! | `narrow_phase/overlapping_leaves` | the triangles of the hierarchy leaves through which meshes touched (cyan: first body, pink: second); only with [`RerunConfig::overlapping_leaves`] | `LineStrips3D` |
@@ -338,7 +338,19 @@ struct ShapeBatch {
     box_rotations: Vec<rerun::Quaternion>,
     box_colors: Vec<rerun::Color>,
     box_labels: Vec<String>,
+    capsules: CapsuleBatch,
     named: bool,
+}
+
+/// Capsules as rerun draws them: from the bottom cap's centre along the rotated +z.
+#[derive(Default)]
+struct CapsuleBatch {
+    bottoms: Vec<[f32; 3]>,
+    lengths: Vec<f32>,
+    radii: Vec<f32>,
+    rotations: Vec<rerun::Quaternion>,
+    colors: Vec<rerun::Color>,
+    labels: Vec<String>,
 }
 
 impl ShapeBatch {
@@ -363,6 +375,15 @@ impl ShapeBatch {
                 self.sphere_labels.push(label);
             }
             Shape::Cuboid(c) => self.push_box(p, c.half_extents, r, color, label),
+            Shape::Capsule(c) => {
+                let batch = &mut self.capsules;
+                batch.bottoms.push(arr(p - r * Vec3::Z * c.half_length));
+                batch.lengths.push(2.0 * c.half_length);
+                batch.radii.push(c.radius);
+                batch.rotations.push(quat(r));
+                batch.colors.push(color);
+                batch.labels.push(label);
+            }
             Shape::HalfSpace(h) => {
                 // A thin square slab just below the plane, facing along the normal.
                 let normal = r * h.normal;
@@ -393,14 +414,22 @@ impl ShapeBatch {
                 .with_quaternions(self.box_rotations)
                 .with_colors(self.box_colors)
                 .with_fill_mode(rerun::FillMode::Solid);
+        let c = self.capsules;
+        let mut capsules = rerun::Capsules3D::from_lengths_and_radii(c.lengths, c.radii)
+            .with_translations(c.bottoms)
+            .with_quaternions(c.rotations)
+            .with_colors(c.colors)
+            .with_fill_mode(rerun::FillMode::Solid);
         if self.named {
             spheres = spheres
                 .with_labels(self.sphere_labels)
                 .with_show_labels(true);
             boxes = boxes.with_labels(self.box_labels).with_show_labels(true);
+            capsules = capsules.with_labels(c.labels).with_show_labels(true);
         }
         report(rec.log(format!("{path}/spheres"), &spheres));
         report(rec.log(format!("{path}/boxes"), &boxes));
+        report(rec.log(format!("{path}/capsules"), &capsules));
     }
 }
 

@@ -2,6 +2,10 @@
 //!
 //! - **Sphere and box**: closed forms, `I = 2/5 m r²` and `I_xx = m/12 (b² + c²)` (b, c the
 //!   box's sizes along the other two axes).
+//! - **Capsule** (along z, half length `h`, radius `r`): a cylinder of length `2h` and a ball
+//!   split into two caps. About the axis `I_zz = m_c r²/2 + 2/5 m_b r²`; across it each cap is a
+//!   half ball whose centre sits `3r/8` beyond its flat face, moved to the capsule's centre by the
+//!   parallel-axis theorem, which sums to `I_xx = m_c (r²/4 + h²/3) + m_b (2/5 r² + h² + 3/4 h r)`.
 //! - **Closed triangle meshes**: the volume integrals of Mirtich ("Fast and Accurate Computation
 //!   of Polyhedral Mass Properties", 1996) in the form of Eberly ("Polyhedral Mass Properties
 //!   (Revisited)", 2002): the divergence theorem turns the ten integrals of `1, x, y, z, x², y²,
@@ -106,6 +110,20 @@ impl MassProperties {
         let s = h * h;
         let moments = DVec3::new(s.y + s.z, s.z + s.x, s.x + s.y) * (mass / 3.0);
         Self::from_f64(mass, DVec3::ZERO, DMat3::from_diagonal(moments))
+    }
+
+    /// A solid capsule along z (see the module notes) of `half_length`, `radius` and `density`
+    /// (kg/m³), centred on the origin.
+    pub fn capsule(half_length: f32, radius: f32, density: f32) -> Self {
+        let (h, r, rho) = (half_length as f64, radius as f64, density as f64);
+        let pi = std::f64::consts::PI;
+        let cylinder = pi * r * r * 2.0 * h * rho;
+        let ball = 4.0 / 3.0 * pi * r * r * r * rho;
+        let axial = cylinder * r * r / 2.0 + ball * 0.4 * r * r;
+        let across =
+            cylinder * (r * r / 4.0 + h * h / 3.0) + ball * (0.4 * r * r + h * h + 0.75 * h * r);
+        let tensor = DMat3::from_diagonal(DVec3::new(across, across, axial));
+        Self::from_f64(cylinder + ball, DVec3::ZERO, tensor)
     }
 
     /// A triangle mesh at `density` (kg/m³): the enclosed solid if the mesh is closed and has
@@ -222,13 +240,14 @@ impl MassProperties {
 }
 
 impl Shape {
-    /// Mass properties at `density` (kg/m³): sphere, cuboid, half-space (infinite), triangle
+    /// Mass properties at `density` (kg/m³): sphere, cuboid, capsule, half-space (infinite), triangle
     /// mesh (solid if closed, else a thin shell: see [`MassProperties::trimesh`]).
     pub fn mass_properties(&self, density: f32) -> MassProperties {
         match self {
             Self::Sphere(s) => MassProperties::sphere(s.radius, density),
             Self::Cuboid(c) => MassProperties::cuboid(c.half_extents, density),
             Self::HalfSpace(_) => MassProperties::infinite(),
+            Self::Capsule(c) => MassProperties::capsule(c.half_length, c.radius, density),
             Self::TriMesh(m) => MassProperties::trimesh(m.mesh(), density),
         }
     }

@@ -20,7 +20,7 @@ pub use isometry::Isometry;
 pub use mass_properties::MassProperties;
 pub use mesh_collider::{MeshCollider, MeshColliderError};
 pub use primitives_mesh::MAX_PROCEDURAL_VERTICES;
-pub use shapes::{Cuboid, HalfSpace, Shape, ShapeError, Sphere};
+pub use shapes::{Capsule, Cuboid, HalfSpace, Shape, ShapeError, Sphere};
 pub use tri_tri::{TriTriIntersection, tri_tri_intersect, tri_tri_intersection};
 pub use triangle::{
     Triangle, contact_triangle_halfspace, contact_triangle_sphere, intersects_triangle_aabb,

@@ -1,5 +1,7 @@
 //! Collision shapes in their local frames: the slides' closed-form shapes (sphere, plane),
-//! the box that OBB tests and games both need, and triangle meshes with their hierarchy.
+//! the box that OBB tests and games both need, the capsule that game characters and limbs are
+//! made of (a sphere swept along a segment: every closed-form sphere test becomes a segment
+//! test), and triangle meshes with their hierarchy.
 //!
 //! A shape never stores its pose: the pose comes with every query (see [`Isometry`]).
 
@@ -22,6 +24,26 @@ pub struct Cuboid {
     pub half_extents: Vec3,
 }
 
+/// A capsule: the points within `radius` of the segment from `-half_length` to `+half_length`
+/// along the local **z** axis (urto's vertical, so a standing character is unrotated; Bevy's
+/// and parry's `Capsule3d` run along y). Zero length is a sphere.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Capsule {
+    /// Half the length of the inner segment (between the caps' centres), `>= 0`.
+    pub half_length: f32,
+    /// Radius of the caps and of the cylinder, `>= 0`.
+    pub radius: f32,
+}
+
+impl Capsule {
+    /// The inner segment's two ends, `(bottom, top)`, placed at `pose`.
+    #[inline]
+    pub fn segment(&self, pose: &Isometry) -> (Vec3, Vec3) {
+        let half = pose.rotation * Vec3::new(0.0, 0.0, self.half_length);
+        (pose.translation - half, pose.translation + half)
+    }
+}
+
 /// The solid half-space below a plane through the local origin: points `x` with `normal·x <= 0`.
 ///
 /// Used for grounds and walls: the body is unbounded, so it is always static and never enters the
@@ -41,6 +63,8 @@ pub enum Shape {
     Cuboid(Cuboid),
     /// See [`HalfSpace`].
     HalfSpace(HalfSpace),
+    /// See [`Capsule`].
+    Capsule(Capsule),
     /// A triangle mesh (a surface: open meshes are fine) with its hierarchy; see
     /// [`MeshCollider`]. Cheap to clone (shared).
     TriMesh(MeshCollider),
@@ -62,6 +86,8 @@ pub enum ShapeError {
     BadHalfExtents(Vec3),
     /// A plane normal that is zero, NaN or infinite.
     BadNormal(Vec3),
+    /// A capsule's half length that is negative, NaN or infinite.
+    BadLength(f32),
 }
 
 impl fmt::Display for ShapeError {
@@ -72,6 +98,9 @@ impl fmt::Display for ShapeError {
                 write!(f, "box half extents must be finite and >= 0, got {h}")
             }
             Self::BadNormal(n) => write!(f, "plane normal must be finite and non-zero, got {n}"),
+            Self::BadLength(l) => {
+                write!(f, "capsule half length must be finite and >= 0, got {l}")
+            }
             Self::TooLarge(x) => write!(
                 f,
                 "shape size {x} m is above the largest supported, {MAX_SHAPE_EXTENT} m (use a \
@@ -94,6 +123,15 @@ impl Shape {
         Self::Cuboid(Cuboid { half_extents })
     }
 
+    /// A capsule along local z: `half_length` from its centre to each cap's centre, and
+    /// `radius`.
+    pub fn capsule(half_length: f32, radius: f32) -> Self {
+        Self::Capsule(Capsule {
+            half_length,
+            radius,
+        })
+    }
+
     /// The half-space below the plane of outward `normal` (normalised here, after scaling by
     /// its largest component so that huge or tiny finite normals normalise too; a zero or
     /// non-finite normal is kept as is and refused by [`Shape::validate`]).
@@ -111,8 +149,16 @@ impl Shape {
     /// [`MeshCollider`] is built, so they always pass.
     pub fn validate(&self) -> Result<(), ShapeError> {
         match self {
-            Self::Sphere(s) if !(s.radius.is_finite() && s.radius >= 0.0) => {
-                Err(ShapeError::BadRadius(s.radius))
+            Self::Sphere(Sphere { radius }) | Self::Capsule(Capsule { radius, .. })
+                if !(radius.is_finite() && *radius >= 0.0) =>
+            {
+                Err(ShapeError::BadRadius(*radius))
+            }
+            Self::Capsule(c) if !(c.half_length.is_finite() && c.half_length >= 0.0) => {
+                Err(ShapeError::BadLength(c.half_length))
+            }
+            Self::Capsule(c) if c.half_length.max(c.radius) > MAX_SHAPE_EXTENT => {
+                Err(ShapeError::TooLarge(c.half_length.max(c.radius)))
             }
             Self::Cuboid(c)
                 if !(c.half_extents.is_finite() && c.half_extents.cmpge(Vec3::ZERO).all()) =>
@@ -147,6 +193,10 @@ impl Shape {
                 Aabb::from_center_half_extents(Vec3::ZERO, c.half_extents).transformed(pose)
             }
             Self::HalfSpace(_) => Aabb::new(Vec3::NEG_INFINITY, Vec3::INFINITY),
+            Self::Capsule(c) => {
+                let (bottom, top) = c.segment(pose);
+                Aabb::new(bottom.min(top), bottom.max(top)).expanded(c.radius)
+            }
             Self::TriMesh(m) => m.world_aabb(pose),
         }
     }
@@ -157,6 +207,7 @@ impl Shape {
             Self::Sphere(s) => s.radius,
             Self::Cuboid(c) => c.half_extents.length(),
             Self::HalfSpace(_) => f32::INFINITY,
+            Self::Capsule(c) => c.half_length + c.radius,
             Self::TriMesh(m) => m.bounding_radius(),
         }
     }
@@ -173,6 +224,11 @@ mod tests {
         assert!(Shape::sphere(f32::NAN).validate().is_err());
         assert!(Shape::cuboid(Vec3::new(1.0, -0.1, 1.0)).validate().is_err());
         assert!(Shape::half_space(Vec3::ZERO).validate().is_err());
+        assert!(Shape::capsule(0.0, 0.0).validate().is_ok());
+        assert!(Shape::capsule(-0.1, 0.5).validate().is_err());
+        assert!(Shape::capsule(0.5, f32::NAN).validate().is_err());
+        assert!(Shape::capsule(f32::INFINITY, 0.5).validate().is_err());
+        assert!(Shape::capsule(2e6, 0.5).validate().is_err());
         assert!(
             Shape::half_space(Vec3::new(0.0, 0.0, 3.0))
                 .validate()

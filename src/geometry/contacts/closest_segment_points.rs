@@ -12,6 +12,18 @@ pub(crate) struct Segment {
     pub end: Vec3,
 }
 
+/// The point of the segment from `start` to `end` closest to `p` (`start` for a segment of zero
+/// length).
+#[inline]
+pub(crate) fn closest_point_on_segment(start: Vec3, end: Vec3, p: Vec3) -> Vec3 {
+    let d = end - start;
+    let len2 = d.length_squared();
+    if len2 <= f32::MIN_POSITIVE {
+        return start;
+    }
+    start + d * ((p - start).dot(d) / len2).clamp(0.0, 1.0)
+}
+
 /// The closest points `(on a, on b)` of segments `a` and `b`.
 ///
 /// Degenerate segments (zero length) act as points; parallel segments return the pair found

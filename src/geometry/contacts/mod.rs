@@ -8,12 +8,13 @@
 //!
 //! # The pairs
 //!
-//! | A \ B         | `Sphere`                      | `Cuboid`                          | `HalfSpace`                   | `TriMesh`                     |
-//! |---------------|-------------------------------|-----------------------------------|-------------------------------|-------------------------------|
-//! | **Sphere**    | [`contact_sphere_sphere`]     | [`contact_sphere_cuboid`]         | [`contact_sphere_halfspace`]  | mesh–sphere, flipped          |
-//! | **Cuboid**    | sphere–cuboid, flipped        | [`contact_cuboid_cuboid`] (SAT)   | [`contact_cuboid_halfspace`]  | mesh–box, flipped             |
-//! | **HalfSpace** | sphere–half-space, flipped    | cuboid–half-space, flipped        | `None` (both static, infinite) | mesh–half-space, flipped      |
-//! | **TriMesh**   | [`contact_trimesh_sphere`]    | [`contact_trimesh_cuboid`]        | [`contact_trimesh_halfspace`] | [`contact_trimesh_trimesh`]   |
+//! | A \ B         | `Sphere`                      | `Cuboid`                          | `HalfSpace`                   | `Capsule`                      | `TriMesh`                     |
+//! |---------------|-------------------------------|-----------------------------------|-------------------------------|--------------------------------|-------------------------------|
+//! | **Sphere**    | [`contact_sphere_sphere`]     | [`contact_sphere_cuboid`]         | [`contact_sphere_halfspace`]  | capsule–sphere, flipped        | mesh–sphere, flipped          |
+//! | **Cuboid**    | sphere–cuboid, flipped        | [`contact_cuboid_cuboid`] (SAT)   | [`contact_cuboid_halfspace`]  | capsule–cuboid, flipped        | mesh–box, flipped             |
+//! | **HalfSpace** | sphere–half-space, flipped    | cuboid–half-space, flipped        | `None` (both static, infinite) | capsule–half-space, flipped   | mesh–half-space, flipped      |
+//! | **Capsule**   | [`contact_capsule_sphere`]    | [`contact_capsule_cuboid`]        | [`contact_capsule_halfspace`] | [`contact_capsule_capsule`]    | mesh–capsule, flipped         |
+//! | **TriMesh**   | [`contact_trimesh_sphere`]    | [`contact_trimesh_cuboid`]        | [`contact_trimesh_halfspace`] | [`contact_trimesh_capsule`]    | [`contact_trimesh_trimesh`]   |
 //!
 //! "Flipped" means the test runs with the arguments swapped and the manifold is turned around
 //! with [`ContactManifold::flipped`] (normal negated, points unchanged). Box–box and mesh–mesh put
@@ -43,6 +44,10 @@
 //! [`Isometry::is_finite`]); given them anyway, the tests do not panic but their output is
 //! unspecified.
 
+mod capsule_capsule;
+mod capsule_cuboid;
+mod capsule_halfspace;
+mod capsule_sphere;
 mod closest_segment_points;
 mod cuboid_cuboid;
 mod cuboid_halfspace;
@@ -55,13 +60,19 @@ mod speculative;
 mod sphere_cuboid;
 mod sphere_halfspace;
 mod sphere_sphere;
+mod triangle_capsule;
 mod triangle_cuboid;
 mod triangle_distance;
+mod trimesh_capsule;
 mod trimesh_cuboid;
 mod trimesh_halfspace;
 mod trimesh_sphere;
 mod trimesh_trimesh;
 
+pub use capsule_capsule::contact_capsule_capsule;
+pub use capsule_cuboid::contact_capsule_cuboid;
+pub use capsule_halfspace::contact_capsule_halfspace;
+pub use capsule_sphere::contact_capsule_sphere;
 pub use cuboid_cuboid::contact_cuboid_cuboid;
 pub use cuboid_halfspace::contact_cuboid_halfspace;
 pub use manifold_cache::{MAX_SHIFT, ManifoldCache};
@@ -70,8 +81,10 @@ pub use speculative::{motion_bound, speculative_contact, speculative_contact_wit
 pub use sphere_cuboid::contact_sphere_cuboid;
 pub use sphere_halfspace::contact_sphere_halfspace;
 pub use sphere_sphere::contact_sphere_sphere;
+pub use triangle_capsule::contact_triangle_capsule;
 pub use triangle_cuboid::contact_triangle_cuboid;
 pub use triangle_distance::closest_points_triangle_triangle;
+pub use trimesh_capsule::contact_trimesh_capsule;
 pub use trimesh_cuboid::contact_trimesh_cuboid;
 pub use trimesh_halfspace::contact_trimesh_halfspace;
 pub use trimesh_sphere::contact_trimesh_sphere;
@@ -146,8 +159,9 @@ pub fn contact_with_scratch(
         }
         (TriMesh(m), Cuboid(c)) => contact_trimesh_cuboid(pose_a, m, pose_b, c, scratch),
         (TriMesh(m), HalfSpace(h)) => contact_trimesh_halfspace(pose_a, m, pose_b, h, scratch),
+        (TriMesh(m), Capsule(c)) => contact_trimesh_capsule(pose_a, m, pose_b, c, scratch),
         (TriMesh(ma), TriMesh(mb)) => contact_trimesh_trimesh(pose_a, ma, pose_b, mb, scratch),
-        (Sphere(_) | Cuboid(_) | HalfSpace(_), TriMesh(_)) => {
+        (Sphere(_) | Cuboid(_) | HalfSpace(_) | Capsule(_), TriMesh(_)) => {
             let m = contact_with_scratch(b, pose_b, a, pose_a, scratch);
             scratch.flip_hits();
             m.map(ContactManifold::flipped)
@@ -175,7 +189,13 @@ fn primitive_contact(
         (Sphere(s), HalfSpace(h)) => contact_sphere_halfspace(pose_a.translation, s, pose_b, h),
         (Cuboid(ca), Cuboid(cb)) => contact_cuboid_cuboid(pose_a, ca, pose_b, cb),
         (Cuboid(c), HalfSpace(h)) => contact_cuboid_halfspace(pose_a, c, pose_b, h),
-        (Cuboid(_), Sphere(_)) | (HalfSpace(_), Sphere(_)) | (HalfSpace(_), Cuboid(_)) => {
+        (Capsule(c), Sphere(s)) => contact_capsule_sphere(pose_a, c, pose_b.translation, s),
+        (Capsule(c), Cuboid(k)) => contact_capsule_cuboid(pose_a, c, pose_b, k),
+        (Capsule(c), HalfSpace(h)) => contact_capsule_halfspace(pose_a, c, pose_b, h),
+        (Capsule(ca), Capsule(cb)) => contact_capsule_capsule(pose_a, ca, pose_b, cb),
+        (Cuboid(_), Sphere(_))
+        | (HalfSpace(_), Sphere(_) | Cuboid(_) | Capsule(_))
+        | (Sphere(_) | Cuboid(_), Capsule(_)) => {
             primitive_contact(b, pose_b, a, pose_a).map(ContactManifold::flipped)
         }
         (HalfSpace(_), HalfSpace(_)) | (TriMesh(_), _) | (_, TriMesh(_)) => None,
@@ -187,12 +207,13 @@ mod tests {
     use super::*;
     use glam::Quat;
 
-    fn shapes() -> [Shape; 4] {
+    fn shapes() -> [Shape; 5] {
         let ball = crate::geometry::TriMesh::uv_sphere(0.7, 24, 12).unwrap();
         [
             Shape::sphere(0.7),
             Shape::cuboid(Vec3::new(0.5, 0.8, 0.3)),
             Shape::half_space(Vec3::new(0.1, 0.2, 1.0)),
+            Shape::capsule(0.4, 0.3),
             Shape::TriMesh(crate::geometry::MeshCollider::new(ball).unwrap()),
         ]
     }
@@ -231,6 +252,8 @@ mod tests {
                 Shape::sphere(x),
                 Shape::cuboid(Vec3::new(1.0, x, 1.0)),
                 Shape::half_space(Vec3::new(0.0, x, 1.0)),
+                Shape::capsule(x, 0.5),
+                Shape::capsule(0.5, x),
             ];
             for a in shapes().iter().chain(&bad_shapes) {
                 for b in shapes().iter().chain(&bad_shapes) {
@@ -248,8 +271,12 @@ mod tests {
     fn far_apart_pairs_give_none() {
         let pa = Isometry::IDENTITY;
         let pb = Isometry::from_translation(Vec3::new(0.0, 0.0, 10.0));
-        let [sphere, cuboid, half_space, mesh] = shapes();
+        let [sphere, cuboid, half_space, capsule, mesh] = shapes();
         for (a, b) in [
+            (&capsule, &capsule),
+            (&capsule, &cuboid),
+            (&sphere, &capsule),
+            (&mesh, &capsule),
             (&sphere, &sphere),
             (&sphere, &cuboid),
             (&cuboid, &sphere),
@@ -265,6 +292,7 @@ mod tests {
         assert!(contact(&half_space, &pa, &sphere, &pb).is_none());
         assert!(contact(&cuboid, &pa, &half_space, &pb).is_some());
         assert!(contact(&half_space, &pa, &mesh, &pb).is_none());
+        assert!(contact(&half_space, &pa, &capsule, &pb).is_none());
         assert!(contact(&mesh, &pa, &half_space, &pb).is_some());
     }
 }

@@ -5,7 +5,8 @@
 //!
 //! The closed-form tests report only touching or penetrating pairs, so one of the two shapes is
 //! tested grown by the margin — a ball's radius, a box's half extents — and each point's
-//! separation is the margin minus its depth against the grown shape. For a ball this is exact;
+//! separation is the margin minus its depth against the grown shape. For a ball and a capsule
+//! (whose radius grows) this is exact;
 //! for a box it is exact across faces and errs on the early side near edges and corners (a
 //! grown box is not a rounded one), which only makes a contact speculative sooner. A half-space
 //! grows by moving its boundary out (exact). Two meshes are not grown: their hierarchies are
@@ -13,7 +14,7 @@
 //! exact gap (`trimesh_trimesh.rs`).
 
 use super::{ContactScratch, contact_trimesh_trimesh_within, contact_with_scratch};
-use crate::geometry::{ContactManifold, ContactPoint, Cuboid, Isometry, Shape, Sphere};
+use crate::geometry::{Capsule, ContactManifold, ContactPoint, Cuboid, Isometry, Shape, Sphere};
 
 /// The shape grown by `margin`, or `None` if it cannot be grown.
 fn grown(shape: &Shape, margin: f32) -> Option<Shape> {
@@ -23,6 +24,10 @@ fn grown(shape: &Shape, margin: f32) -> Option<Shape> {
         })),
         Shape::Cuboid(c) => Some(Shape::Cuboid(Cuboid {
             half_extents: c.half_extents + margin,
+        })),
+        Shape::Capsule(c) => Some(Shape::Capsule(Capsule {
+            radius: c.radius + margin,
+            ..*c
         })),
         Shape::HalfSpace(_) | Shape::TriMesh(_) => None,
     }
