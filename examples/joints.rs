@@ -9,7 +9,7 @@
 //! - a **wrecking ball**: a 50 kg ball at the end of a 12-link chain, released sideways into a
 //!   stack of boxes;
 //! - a **door** on a limited hinge closed by a spring (a position motor), hit by a thrown ball;
-//! - a **ragdoll** of boxes (ball joints with swing cones and twist limits at the neck,
+//! - a **ragdoll** of capsules with a ball for a head (ball joints with swing cones and twist limits at the neck,
 //!   shoulders and hips, limited hinges at the elbows and knees) pushed down a flight of stairs.
 //!
 //! The recording shows each joint's anchors and axis (orange, red past a limit) and what the
@@ -396,7 +396,7 @@ struct Ragdoll {
 }
 
 /// Eight steps 0.3 m high and 0.5 m deep going down along +x at y = −12, and a ragdoll of
-/// boxes standing at the top, pushed forward.
+/// capsules (a ball for a head) standing at the top, pushed forward.
 fn build_ragdoll(app: &mut App) -> Ragdoll {
     let y = -12.0;
     for k in 0..8 {
@@ -411,33 +411,31 @@ fn build_ragdoll(app: &mut App) -> Ragdoll {
     }
     let z = STAIRS_TOP + 0.02;
     let x = 8.15;
-    let mut part = |half: Vec3, at: Vec3, mass: f32| {
-        let e = dynamic(app, Collider::cuboid(half.x, half.y, half.z), at, mass);
+    let mut part = |collider: Collider, at: Vec3, mass: f32| {
+        let e = dynamic(app, collider, at, mass);
         app.world_mut().entity_mut(e).insert(Friction(0.6));
         e
     };
+    // A limb standing along z, `half` tall from its centre, as a capsule.
+    let limb = |half: f32, radius: f32| Collider::capsule(half - radius, radius);
     // Standing: shins, thighs, torso, head; arms hanging at the sides.
-    let torso = part(Vec3::new(0.12, 0.18, 0.25), Vec3::new(x, y, z + 1.05), 15.0);
-    let head = part(Vec3::splat(0.11), Vec3::new(x, y, z + 1.45), 4.0);
+    let torso = part(limb(0.25, 0.15), Vec3::new(x, y, z + 1.05), 15.0);
+    let head = part(Collider::sphere(0.11), Vec3::new(x, y, z + 1.45), 4.0);
     let mut limbs = Vec::new();
     for side in [-1.0f32, 1.0] {
         let upper_arm = part(
-            Vec3::new(0.05, 0.05, 0.15),
+            limb(0.15, 0.05),
             Vec3::new(x, y + side * 0.25, z + 1.13),
             2.0,
         );
         let forearm = part(
-            Vec3::new(0.045, 0.045, 0.14),
+            limb(0.14, 0.045),
             Vec3::new(x, y + side * 0.25, z + 0.83),
             1.5,
         );
-        let thigh = part(
-            Vec3::new(0.07, 0.07, 0.2),
-            Vec3::new(x, y + side * 0.1, z + 0.6),
-            6.0,
-        );
+        let thigh = part(limb(0.2, 0.07), Vec3::new(x, y + side * 0.1, z + 0.6), 6.0);
         let shin = part(
-            Vec3::new(0.06, 0.06, 0.19),
+            limb(0.19, 0.06),
             Vec3::new(x, y + side * 0.1, z + 0.19),
             4.0,
         );

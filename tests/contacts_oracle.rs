@@ -391,7 +391,10 @@ fn capsule_capsule_depths_match_an_f64_segment_distance_within_1e_5_and_normals_
             assert!(error < 1e-5, "{error}: {a:?} {pa:?} {b:?} {pb:?} {m:?}");
             if gap > 1e-3 {
                 let normal = ((on_b - on_a) / gap).as_vec3();
-                assert!(m.normal.dot(normal) > 1.0 - 1e-3, "{a:?} {pa:?} {b:?} {pb:?} {m:?}");
+                assert!(
+                    m.normal.dot(normal) > 1.0 - 1e-3,
+                    "{a:?} {pa:?} {b:?} {pb:?} {m:?}"
+                );
             }
             compared += 1;
         }

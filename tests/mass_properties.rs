@@ -220,8 +220,7 @@ fn spheres_boxes_capsules_and_half_spaces_match_parry_within_1e_6_relative() {
         let parry = parry3d::shape::Cuboid::new(h).mass_properties(density);
         worst = worst.worst(Errors::of_shape(&ours, &parry, h.length()));
     }
-    for (half_length, r, density) in [(0.5, 0.25, 1000.0), (0.0, 1.0, 1.0), (3.0, 0.05, 7800.0)]
-    {
+    for (half_length, r, density) in [(0.5, 0.25, 1000.0), (0.0, 1.0, 1.0), (3.0, 0.05, 7800.0)] {
         let ours = Shape::capsule(half_length, r).mass_properties(density);
         let parry = parry3d::shape::Capsule::new_z(half_length, r).mass_properties(density);
         worst = worst.worst(Errors::of_shape(&ours, &parry, half_length + r));

@@ -19,14 +19,15 @@ mod common;
 
 use common::rng::Rng;
 use glam::Vec3;
+use urto::geometry::active_edges::ALL_EDGES_ACTIVE;
 use urto::geometry::contacts::{
     ContactScratch, NO_TRIANGLE, contact, contact_triangle_capsule, contact_triangle_cuboid,
-    contact_triangle_triangle, contact_with_scratch,
+    contact_triangle_cuboid_with_edges, contact_triangle_triangle, contact_with_scratch,
 };
 use urto::geometry::mesh_io::load_ply;
 use urto::geometry::{
     Capsule, ContactManifold, Cuboid, HalfSpace, Isometry, MeshCollider, Shape, Sphere, TriMesh,
-    contact_triangle_sphere, intersects_triangle_cuboid,
+    contact_triangle_sphere_with_edges, intersects_triangle_cuboid,
 };
 
 /// Rounding band around touching where world-space and local-space computations may disagree.
@@ -176,8 +177,13 @@ fn mesh_sphere_matches_every_triangle_tested() {
                 .iter_triangles()
                 .enumerate()
                 .filter_map(|(t, tri)| {
-                    contact_triangle_sphere(&tri, local, &sphere)
-                        .map(|m| (t as u32, pose.transform_vector(m.normal), m.max_depth()))
+                    contact_triangle_sphere_with_edges(
+                        &tri,
+                        mesh.active_edges(t as u32),
+                        local,
+                        &sphere,
+                    )
+                    .map(|m| (t as u32, pose.transform_vector(m.normal), m.max_depth()))
                 })
                 .collect();
             assert_eq!(got.is_some(), !brute.is_empty(), "{name}");
@@ -233,8 +239,14 @@ fn mesh_capsule_matches_every_triangle_tested() {
                 .iter_triangles()
                 .enumerate()
                 .filter_map(|(t, tri)| {
-                    contact_triangle_capsule(&tri, p0, p1, capsule.radius)
-                        .map(|m| (t as u32, pose.transform_vector(m.normal), m.max_depth()))
+                    contact_triangle_capsule(
+                        &tri,
+                        mesh.active_edges(t as u32),
+                        p0,
+                        p1,
+                        capsule.radius,
+                    )
+                    .map(|m| (t as u32, pose.transform_vector(m.normal), m.max_depth()))
                 })
                 .collect();
             assert_eq!(got.is_some(), !brute.is_empty(), "{name}");
@@ -268,7 +280,7 @@ fn triangle_capsule_depth_agrees_with_parrys_segment_distance_within_1e_4() {
             urto::geometry::Triangle::new(rng.in_ball(1.2), rng.in_ball(1.2), rng.in_ball(1.2));
         let (p0, p1) = (rng.in_ball(1.5), rng.in_ball(1.5));
         let radius = rng.range(0.0, 0.5);
-        let ours = contact_triangle_capsule(&tri, p0, p1, radius);
+        let ours = contact_triangle_capsule(&tri, ALL_EDGES_ACTIVE, p0, p1, radius);
         let pt = parry3d::shape::Triangle::new(v(tri.a), v(tri.b), v(tri.c));
         let ps = parry3d::shape::Segment::new(v(p0), v(p1));
         let gap = parry3d::query::distance(&Pose::IDENTITY, &pt, &Pose::IDENTITY, &ps)
@@ -278,9 +290,16 @@ fn triangle_capsule_depth_agrees_with_parrys_segment_distance_within_1e_4() {
             continue;
         }
         if gap > 1e-5 {
-            assert_eq!(ours.is_some(), gap < radius, "{tri:?} {p0} {p1} {radius}: {gap}");
+            assert_eq!(
+                ours.is_some(),
+                gap < radius,
+                "{tri:?} {p0} {p1} {radius}: {gap}"
+            );
             if let Some(m) = ours {
-                assert!((m.max_depth() - (radius - gap)).abs() < 1e-4, "{m:?} vs {gap}");
+                assert!(
+                    (m.max_depth() - (radius - gap)).abs() < 1e-4,
+                    "{m:?} vs {gap}"
+                );
                 touching += 1;
             } else {
                 apart += 1;
@@ -293,7 +312,10 @@ fn triangle_capsule_depth_agrees_with_parrys_segment_distance_within_1e_4() {
         }
     }
     println!("triangle-capsule vs parry: {touching} touching, {apart} apart, {pierced} pierced");
-    assert!(touching > 300 && apart > 300 && pierced > 100, "{touching} {apart} {pierced}");
+    assert!(
+        touching > 300 && apart > 300 && pierced > 100,
+        "{touching} {apart} {pierced}"
+    );
 }
 
 #[test]
@@ -386,7 +408,9 @@ fn mesh_box_matches_every_triangle_tested() {
                 .iter()
                 .enumerate()
                 .filter_map(|(t, tri)| {
-                    contact_triangle_cuboid(tri, &at, &cuboid).map(|m| (t as u32, m))
+                    let active = mesh.active_edges(t as u32);
+                    contact_triangle_cuboid_with_edges(tri, active, &at, &cuboid)
+                        .map(|m| (t as u32, m))
                 })
                 .collect();
             let grown = Cuboid {

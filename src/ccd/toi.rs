@@ -1,7 +1,8 @@
 //! The answer of a time-of-impact query, and the dispatch of a sweep against any [`Shape`].
 
 use super::{
-    SphereSweep, toi_sphere_capsule, toi_sphere_cuboid, toi_sphere_halfspace, toi_sphere_sphere, toi_sphere_trimesh,
+    SphereSweep, toi_sphere_capsule, toi_sphere_cuboid, toi_sphere_halfspace, toi_sphere_sphere,
+    toi_sphere_trimesh,
 };
 use crate::bvh::QueryScratch;
 use crate::geometry::{Isometry, Shape};

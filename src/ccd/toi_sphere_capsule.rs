@@ -24,7 +24,13 @@ pub fn toi_sphere_capsule(sweep: &SphereSweep, pose: &Isometry, capsule: &Capsul
     let edge = top - bottom;
     if edge.length_squared() > 0.0 {
         let entry = cylinder_entry(o - bottom, d, edge, reach);
-        earliest.consider(entry, Piece::Edge { start: bottom, edge });
+        earliest.consider(
+            entry,
+            Piece::Edge {
+                start: bottom,
+                edge,
+            },
+        );
     }
     for end in [bottom, top] {
         earliest.consider(ball_entry(o - end, d, reach), Piece::Vertex(end));

@@ -31,7 +31,6 @@
 use crate::bounding::symmetric_eigen::symmetric_eigen;
 use crate::geometry::{Isometry, Shape, TriMesh};
 use glam::{DMat3, DQuat, DVec3, Mat3, Quat, Vec3};
-use std::collections::HashMap;
 
 /// Mass, centre of mass and inertia tensor (about the centre of mass, in the shape's local axes).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -257,14 +256,7 @@ impl Shape {
 /// (a closed, consistently oriented surface). Vertices at exactly the same position count as
 /// one, so unwelded meshes (one vertex per triangle corner, as STL gives) are recognised too.
 pub(crate) fn is_closed(mesh: &TriMesh) -> bool {
-    let mut ids: HashMap<[u32; 3], u32> = HashMap::with_capacity(mesh.vertex_count());
-    // `+ 0.0` turns -0.0 into +0.0, so both zeros are one position.
-    let key = |v: &Vec3| (*v + Vec3::ZERO).to_array().map(f32::to_bits);
-    let mut id = |v| {
-        let next = ids.len() as u32;
-        *ids.entry(key(v)).or_insert(next)
-    };
-    let canonical: Vec<u32> = mesh.vertices().iter().map(&mut id).collect();
+    let canonical = mesh.position_ids();
     let mut edges = Vec::with_capacity(3 * mesh.triangle_count());
     for t in mesh.triangles() {
         let c = t.map(|i| canonical[i as usize]);

@@ -80,6 +80,8 @@ struct MeshData {
     leaf_of_triangle: Vec<u32>,
     /// Farthest vertex from the local origin.
     bounding_radius: f32,
+    /// Per triangle, its active edges (see [`active_edges`](crate::geometry::active_edges)).
+    active_edges: Vec<u8>,
 }
 
 /// A triangle mesh with its OBB hierarchy, in the mesh's local frame; a cheap, shareable handle.
@@ -127,6 +129,7 @@ impl MeshCollider {
             .iter()
             .flatten()
             .fold(0.0f32, |r, &i| r.max(mesh.vertices()[i as usize].length()));
+        let active_edges = crate::geometry::active_edges::active_edges(&mesh);
         Ok(Self {
             data: Arc::new(MeshData {
                 name: name.into(),
@@ -134,6 +137,7 @@ impl MeshCollider {
                 bvh,
                 leaf_of_triangle,
                 bounding_radius,
+                active_edges,
             }),
         })
     }
@@ -175,6 +179,17 @@ impl MeshCollider {
     /// Index (in [`Bvh::nodes`]) of the leaf holding triangle `t`, or `None` past the end.
     pub fn leaf_of_triangle(&self, t: u32) -> Option<u32> {
         self.data.leaf_of_triangle.get(t as usize).copied()
+    }
+
+    /// Triangle `t`'s active edges: bit `k` for its edge from corner `k` to corner `k + 1`
+    /// (see [`active_edges`](crate::geometry::active_edges)); all three past the end.
+    pub fn active_edges(&self, t: u32) -> u8 {
+        use crate::geometry::active_edges::ALL_EDGES_ACTIVE;
+        self.data
+            .active_edges
+            .get(t as usize)
+            .copied()
+            .unwrap_or(ALL_EDGES_ACTIVE)
     }
 
     /// Radius of the smallest origin-centred ball holding the triangles.

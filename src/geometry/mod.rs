@@ -1,6 +1,7 @@
 //! Geometry: poses, shapes (primitives and triangle meshes), and the shape-pair tests that
 //! produce contacts.
 
+pub mod active_edges;
 mod contact;
 pub mod contacts;
 mod isometry;
@@ -23,7 +24,8 @@ pub use primitives_mesh::MAX_PROCEDURAL_VERTICES;
 pub use shapes::{Capsule, Cuboid, HalfSpace, Shape, ShapeError, Sphere};
 pub use tri_tri::{TriTriIntersection, tri_tri_intersect, tri_tri_intersection};
 pub use triangle::{
-    Triangle, contact_triangle_halfspace, contact_triangle_sphere, intersects_triangle_aabb,
-    intersects_triangle_cuboid, triangle_box_overlap,
+    Triangle, contact_triangle_halfspace, contact_triangle_sphere,
+    contact_triangle_sphere_with_edges, intersects_triangle_aabb, intersects_triangle_cuboid,
+    triangle_box_overlap,
 };
 pub use trimesh::{MeshError, MeshReport, TriMesh};

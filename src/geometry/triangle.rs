@@ -12,6 +12,7 @@
 //! Triangle–triangle intersection lives in [`tri_tri`](crate::geometry::tri_tri).
 
 use crate::bounding::Aabb;
+use crate::geometry::active_edges::{ALL_EDGES_ACTIVE, face_normal_at_inactive_edge};
 use crate::geometry::contacts::FALLBACK_NORMAL;
 use crate::geometry::predicates::collinear;
 use crate::geometry::{ContactManifold, ContactPoint, Cuboid, HalfSpace, Isometry, Sphere};
@@ -176,22 +177,40 @@ pub fn contact_triangle_sphere(
     center: Vec3,
     sphere: &Sphere,
 ) -> Option<ContactManifold> {
+    contact_triangle_sphere_with_edges(tri, ALL_EDGES_ACTIVE, center, sphere)
+}
+
+/// [`contact_triangle_sphere`] for a triangle of a mesh whose `active` edges are known
+/// ([`MeshCollider::active_edges`](crate::geometry::MeshCollider::active_edges)): a closest
+/// point only on inactive edges takes the face normal, and the depth is measured along it (see
+/// [`active_edges`](crate::geometry::active_edges)).
+pub fn contact_triangle_sphere_with_edges(
+    tri: &Triangle,
+    active: u8,
+    center: Vec3,
+    sphere: &Sphere,
+) -> Option<ContactManifold> {
     let closest = tri.closest_point(center);
     let offset = center - closest;
     let dist2 = offset.length_squared();
     if dist2.is_nan() || dist2 > sphere.radius * sphere.radius {
         return None;
     }
-    let dist = dist2.sqrt();
     let normal = offset
         .try_normalize()
         .or_else(|| tri.normal())
         .unwrap_or(FALLBACK_NORMAL);
+    let (normal, closest) = match face_normal_at_inactive_edge(tri, active, closest, normal) {
+        // The flat surface continues past the inactive edge: it supports the ball right under
+        // its centre, not at the edge (a point off to the side would roll the ball).
+        Some(face) => (face, center - face * offset.dot(face)),
+        None => (normal, closest),
+    };
     let on_sphere = center - normal * sphere.radius;
     Some(ContactManifold::single(
         normal,
         (closest + on_sphere) * 0.5,
-        (sphere.radius - dist).max(0.0),
+        (sphere.radius - offset.dot(normal)).max(0.0),
     ))
 }
 

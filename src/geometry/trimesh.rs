@@ -102,6 +102,23 @@ pub struct TriMesh {
 }
 
 impl TriMesh {
+    /// One id per distinct vertex position, for every vertex: vertices at exactly the same
+    /// position share an id (so unwelded meshes, one vertex per triangle corner as STL gives,
+    /// have their shared edges recognised), ids numbered in order of first appearance.
+    pub(crate) fn position_ids(&self) -> Vec<u32> {
+        let mut ids: std::collections::HashMap<[u32; 3], u32> =
+            std::collections::HashMap::with_capacity(self.vertex_count());
+        // `+ 0.0` turns -0.0 into +0.0, so both zeros are one position.
+        let key = |v: &Vec3| (*v + Vec3::ZERO).to_array().map(f32::to_bits);
+        self.vertices()
+            .iter()
+            .map(|v| {
+                let next = ids.len() as u32;
+                *ids.entry(key(v)).or_insert(next)
+            })
+            .collect()
+    }
+
     /// Validates and builds a mesh (see the module notes for what is refused, dropped, kept).
     ///
     /// The kept triangles keep their relative order; vertices are kept as given.

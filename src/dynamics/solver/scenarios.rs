@@ -12,6 +12,8 @@ const G: Vec3 = Vec3::new(0.0, 0.0, -9.81);
 const DT: f32 = 1.0 / 60.0;
 const MARGIN: f32 = 0.02;
 
+mod capsules;
+mod ghost_edges;
 mod joints;
 
 struct Body {

@@ -39,17 +39,7 @@ pub fn contact_capsule_capsule(
 fn canonical_order(pose_a: &Isometry, a: &Capsule, pose_b: &Isometry, b: &Capsule) -> Ordering {
     let key = |pose: &Isometry, c: &Capsule| {
         let (t, q) = (pose.translation, pose.rotation);
-        [
-            c.radius,
-            c.half_length,
-            t.x,
-            t.y,
-            t.z,
-            q.x,
-            q.y,
-            q.z,
-            q.w,
-        ]
+        [c.radius, c.half_length, t.x, t.y, t.z, q.x, q.y, q.z, q.w]
     };
     total_order(&key(pose_a, a), &key(pose_b, b))
 }

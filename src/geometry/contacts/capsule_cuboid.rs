@@ -210,13 +210,7 @@ fn point_near_edge(p0: Vec3, p1: Vec3, h: Vec3, normal: Vec3, k: usize) -> Vec3 
 /// For a face normal: the ends of the segment's part over the box face facing the capsule, with
 /// their depths (`radius` minus the height above the face), those with depth `>= 0`. None
 /// for a normal that is not a face normal.
-fn face_points(
-    p0: Vec3,
-    p1: Vec3,
-    h: Vec3,
-    normal: Vec3,
-    radius: f32,
-) -> [Option<(Vec3, f32)>; 2] {
+fn face_points(p0: Vec3, p1: Vec3, h: Vec3, normal: Vec3, radius: f32) -> [Option<(Vec3, f32)>; 2] {
     const NONE: [Option<(Vec3, f32)>; 2] = [None, None];
     let k = normal.abs().max_position();
     if normal[k].abs() < FACE_COSINE {
@@ -269,7 +263,9 @@ mod tests {
     fn segment_box_distance_matches_sampling_within_1e_4() {
         let mut seed = 1u64;
         let mut next = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             ((seed >> 40) as f32 / (1u64 << 24) as f32) * 6.0 - 3.0
         };
         let h = Vec3::new(0.5, 1.0, 0.25);
@@ -278,7 +274,10 @@ mod tests {
             let p1 = Vec3::new(next(), next(), next());
             let (p, q) = closest_segment_box(p0, p1, h);
             let exact = (p - q).length();
-            assert!((exact - sampled_distance(p0, p1, h)).abs() < 1e-4, "{p0} {p1}");
+            assert!(
+                (exact - sampled_distance(p0, p1, h)).abs() < 1e-4,
+                "{p0} {p1}"
+            );
         }
     }
 
@@ -299,7 +298,10 @@ mod tests {
         assert_eq!(m.len(), 2, "{m:?}");
         assert!((m.normal + Vec3::Z).length() < 1e-6);
         for p in m.points() {
-            assert!((p.depth - 0.01).abs() < 1e-5 && (p.point.z - 0.495).abs() < 1e-5, "{p:?}");
+            assert!(
+                (p.depth - 0.01).abs() < 1e-5 && (p.point.z - 0.495).abs() < 1e-5,
+                "{p:?}"
+            );
         }
         // Hanging over the edge: clipped at x = 2.
         let over = Isometry::new(Vec3::new(1.9, 0.0, 0.69), lying.rotation);

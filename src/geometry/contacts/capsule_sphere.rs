@@ -37,7 +37,10 @@ mod tests {
             radius: 0.5,
         };
         // Lying along x (z turned onto x), a ball beside its middle and one past its end.
-        let pose = Isometry::new(Vec3::ZERO, Quat::from_rotation_y(std::f32::consts::FRAC_PI_2));
+        let pose = Isometry::new(
+            Vec3::ZERO,
+            Quat::from_rotation_y(std::f32::consts::FRAC_PI_2),
+        );
         let ball = Sphere { radius: 0.25 };
         let side = contact_capsule_sphere(&pose, &capsule, Vec3::new(0.3, 0.7, 0.0), &ball);
         let side = side.unwrap();
@@ -45,6 +48,8 @@ mod tests {
         assert!((side.max_depth() - 0.05).abs() < 1e-6);
         let end = contact_capsule_sphere(&pose, &capsule, Vec3::new(1.7, 0.0, 0.0), &ball);
         assert!((end.unwrap().normal - Vec3::X).length() < 1e-6);
-        assert!(contact_capsule_sphere(&pose, &capsule, Vec3::new(1.76, 0.0, 0.0), &ball).is_none());
+        assert!(
+            contact_capsule_sphere(&pose, &capsule, Vec3::new(1.76, 0.0, 0.0), &ball).is_none()
+        );
     }
 }

@@ -10,6 +10,7 @@
 
 use super::FALLBACK_NORMAL;
 use super::closest_segment_points::{Segment, closest_segment_points};
+use crate::geometry::active_edges::face_normal_at_inactive_edge;
 use crate::geometry::{ContactManifold, ContactPoint, Triangle};
 use glam::Vec3;
 
@@ -19,8 +20,12 @@ const OVER_FACE_COSINE: f32 = 0.999;
 
 /// Contact between a triangle (shape A) and the capsule of `radius` around the segment from
 /// `p0` to `p1` (shape B), all in one frame; the normal points from the triangle to the capsule.
+/// `active` holds the triangle's active edges (bit `k`: edge from corner `k` to `k + 1`; all
+/// three for a lone triangle): a closest point only on inactive edges takes the face normal
+/// (see [`active_edges`](crate::geometry::active_edges)).
 pub fn contact_triangle_capsule(
     tri: &Triangle,
+    active: u8,
     p0: Vec3,
     p1: Vec3,
     radius: f32,
@@ -34,12 +39,18 @@ pub fn contact_triangle_capsule(
     if dist2.is_nan() || dist2 > radius * radius {
         return None;
     }
-    let dist = dist2.sqrt();
     let normal = gap
         .try_normalize()
         .or_else(|| tri.normal())
         .unwrap_or(FALLBACK_NORMAL);
-    let depth = (radius - dist).max(0.0);
+    let (normal, on_triangle) = match face_normal_at_inactive_edge(tri, active, on_triangle, normal)
+    {
+        // The flat surface continues past the inactive edge: it supports the capsule right
+        // under its axis, not at the edge (a point off to the side would roll it).
+        Some(face) => (face, on_segment - face * gap.dot(face)),
+        None => (normal, on_triangle),
+    };
+    let depth = (radius - gap.dot(normal)).max(0.0);
     let midway = |on_tri: Vec3, on_axis: Vec3, depth: f32| ContactPoint {
         point: (on_tri + on_axis - normal * radius) * 0.5,
         depth,
@@ -107,6 +118,7 @@ fn closest_segment_triangle(tri: &Triangle, p0: Vec3, p1: Vec3) -> (Vec3, Vec3) 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::active_edges::ALL_EDGES_ACTIVE as ALL;
 
     fn floor() -> Triangle {
         Triangle::new(
@@ -120,6 +132,7 @@ mod tests {
     fn a_capsule_lying_on_a_triangle_rests_on_both_ends() {
         let m = contact_triangle_capsule(
             &floor(),
+            ALL,
             Vec3::new(-1.0, 0.0, 0.49),
             Vec3::new(1.0, 0.0, 0.49),
             0.5,
@@ -128,10 +141,13 @@ mod tests {
         assert_eq!(m.len(), 2, "{m:?}");
         assert!((m.normal - Vec3::Z).length() < 1e-6);
         for p in m.points() {
-            assert!((p.depth - 0.01).abs() < 1e-6 && (p.point.z + 0.005).abs() < 1e-6, "{p:?}");
+            assert!(
+                (p.depth - 0.01).abs() < 1e-6 && (p.point.z + 0.005).abs() < 1e-6,
+                "{p:?}"
+            );
         }
         let tilted =
-            contact_triangle_capsule(&floor(), Vec3::new(-1.0, 0.0, 0.4), Vec3::ZERO + Vec3::Z, 0.5);
+            contact_triangle_capsule(&floor(), ALL, Vec3::new(-1.0, 0.0, 0.4), Vec3::Z, 0.5);
         let tilted = tilted.unwrap();
         assert_eq!(tilted.len(), 1);
         assert!((tilted.max_depth() - 0.1).abs() < 1e-6);
@@ -141,6 +157,7 @@ mod tests {
     fn a_piercing_capsule_leaves_to_the_side_holding_most_of_it() {
         let m = contact_triangle_capsule(
             &floor(),
+            ALL,
             Vec3::new(0.0, 0.0, -0.2),
             Vec3::new(0.0, 0.0, 1.0),
             0.1,

@@ -22,10 +22,18 @@
 //!
 //! The triangle is a two-sided surface: the box leaves through whichever side needs the shorter
 //! move, so a box pushed more than halfway through a triangle leaves through the far side.
+//!
+//! **Internal edges.** On a mesh, a box crossing onto a neighbouring triangle of a flat floor
+//! overlaps it first at its edge, where a box face or an edge axis is shallower than the
+//! triangle's normal: a sideways normal that makes a sliding box bump on the seam (a *ghost*
+//! collision). When every edge of the triangle that reaches into the box is internal (see
+//! [`active_edges`](crate::geometry::active_edges)), the triangle's normal is taken whatever the
+//! other axes say (they still separate the pair when apart).
 
 use super::manifold_reduction::spread_points;
 use super::mesh_manifold::reduce_to_manifold;
 use super::polygon_clip::{ClipPolygon, MAX_TRIANGLE_CLIP_VERTICES};
+use crate::geometry::active_edges::ALL_EDGES_ACTIVE;
 use crate::geometry::{ContactManifold, ContactPoint, Cuboid, Isometry, Triangle};
 use glam::Vec3;
 
@@ -83,8 +91,20 @@ pub fn contact_triangle_cuboid(
     pose: &Isometry,
     cuboid: &Cuboid,
 ) -> Option<ContactManifold> {
+    contact_triangle_cuboid_with_edges(tri, ALL_EDGES_ACTIVE, pose, cuboid)
+}
+
+/// [`contact_triangle_cuboid`] for a triangle of a mesh whose `active` edges are known
+/// ([`MeshCollider::active_edges`](crate::geometry::MeshCollider::active_edges)): see the
+/// module notes on internal edges.
+pub fn contact_triangle_cuboid_with_edges(
+    tri: &Triangle,
+    active: u8,
+    pose: &Isometry,
+    cuboid: &Cuboid,
+) -> Option<ContactManifold> {
     let local = tri.vertices().map(|p| pose.inverse_transform_point(p));
-    let contact = triangle_box_contact(local, cuboid.half_extents)?;
+    let contact = triangle_box_contact(local, active, cuboid.half_extents)?;
     reduce_to_manifold(contact.normal, contact.points(), pose)
 }
 
@@ -126,8 +146,9 @@ fn keep_shallower(best: &mut Option<Axis>, candidate: Axis) {
     }
 }
 
-/// Step 1 and 2 of the module notes: the chosen axis, and whether it is the triangle's normal.
-fn least_penetration_axis(v: &[Vec3; 3], h: Vec3) -> Option<(Axis, bool)> {
+/// Step 1 and 2 of the module notes: the chosen axis, and whether it is the triangle's normal
+/// (always, when `face_only` and the triangle has one: the internal-edge rule).
+fn least_penetration_axis(v: &[Vec3; 3], h: Vec3, face_only: bool) -> Option<(Axis, bool)> {
     let edges = [v[1] - v[0], v[2] - v[1], v[0] - v[2]];
     let mut face: Option<Axis> = None;
     let mut is_triangle_normal = false;
@@ -155,6 +176,9 @@ fn least_penetration_axis(v: &[Vec3; 3], h: Vec3) -> Option<(Axis, bool)> {
     }
     // There is always a face axis: the box's three are never skipped.
     let face = face?;
+    if let (true, Some(n)) = (face_only, edges[0].cross(edges[1]).try_normalize()) {
+        return Some((overlap_on(n, v, h)?, true));
+    }
     let tolerance = SWITCH_ABS_FRACTION * h.max_element();
     match edge {
         Some(e) if e.depth < EDGE_SWITCH_REL * face.depth - tolerance => Some((e, false)),
@@ -162,9 +186,16 @@ fn least_penetration_axis(v: &[Vec3; 3], h: Vec3) -> Option<(Axis, bool)> {
     }
 }
 
-/// The contact of triangle `v` with the box `[-h, h]`, both in the box's frame.
-pub(crate) fn triangle_box_contact(v: [Vec3; 3], h: Vec3) -> Option<TriangleBoxContact> {
-    let (axis, along_triangle_normal) = least_penetration_axis(&v, h)?;
+/// The contact of triangle `v` with the box `[-h, h]`, both in the box's frame; `active` holds
+/// the triangle's active edges (bit `k`: from corner `k` to `k + 1`).
+pub(crate) fn triangle_box_contact(
+    v: [Vec3; 3],
+    active: u8,
+    h: Vec3,
+) -> Option<TriangleBoxContact> {
+    let internal_only =
+        (0..3).all(|k| active & (1 << k) == 0 || !edge_reaches(v[k], v[(k + 1) % 3], h));
+    let (axis, along_triangle_normal) = least_penetration_axis(&v, h, internal_only)?;
     let n = axis.normal;
     let r = h.dot(n.abs());
     let mut out = TriangleBoxContact {
@@ -212,6 +243,24 @@ pub(crate) fn triangle_box_contact(v: [Vec3; 3], h: Vec3) -> Option<TriangleBoxC
         out.points[chosen[0]].depth = axis.depth;
     }
     Some(out)
+}
+
+/// True when the segment from `a` to `b` meets the box `[-h, h]` (slab clipping).
+fn edge_reaches(a: Vec3, b: Vec3, h: Vec3) -> bool {
+    let d = b - a;
+    let (mut lo, mut hi) = (0.0f32, 1.0f32);
+    for k in 0..3 {
+        if d[k] == 0.0 {
+            if a[k].abs() > h[k] {
+                return false;
+            }
+            continue;
+        }
+        let (t0, t1) = ((-h[k] - a[k]) / d[k], (h[k] - a[k]) / d[k]);
+        lo = lo.max(t0.min(t1));
+        hi = hi.min(t0.max(t1));
+    }
+    lo <= hi
 }
 
 fn box_corners(h: Vec3) -> [Vec3; 8] {

@@ -26,12 +26,14 @@ pub fn contact_trimesh_capsule(
     scratch.begin_query();
     let in_mesh = pose_mesh.inv_mul(pose_capsule);
     let (p0, p1) = capsule.segment(&in_mesh);
-    let half = Vec3::new(capsule.radius, capsule.radius, capsule.half_length + capsule.radius);
+    let half = Vec3::new(
+        capsule.radius,
+        capsule.radius,
+        capsule.half_length + capsule.radius,
+    );
     // Rounding slack of the carried capsule, so the node test never rejects a touching triangle.
     let pad = RELATIVE_SLACK
-        * (in_mesh.translation.abs().max_element()
-            + half.max_element()
-            + mesh.bounding_radius());
+        * (in_mesh.translation.abs().max_element() + half.max_element() + mesh.bounding_radius());
     let probe = Obb {
         center: in_mesh.translation,
         axes: in_mesh.rotation_matrix(),
@@ -53,8 +55,16 @@ pub fn contact_trimesh_capsule(
             let Some(tri) = mesh.mesh().triangle(t as usize) else {
                 return ControlFlow::Continue(());
             };
-            if let Some(m) = contact_triangle_capsule(&tri, p0, p1, capsule.radius) {
-                push_contribution(contributions, points, m.normal, m.max_depth(), 0, m.points());
+            let active = mesh.active_edges(t);
+            if let Some(m) = contact_triangle_capsule(&tri, active, p0, p1, capsule.radius) {
+                push_contribution(
+                    contributions,
+                    points,
+                    m.normal,
+                    m.max_depth(),
+                    0,
+                    m.points(),
+                );
                 if record {
                     hits.push([t, NO_TRIANGLE]);
                 }

@@ -52,7 +52,7 @@ pub fn contact_trimesh_cuboid(
                 return ControlFlow::Continue(());
             };
             let local = tri.vertices().map(|p| mesh_in_box.transform_point(p));
-            if let Some(c) = triangle_box_contact(local, h) {
+            if let Some(c) = triangle_box_contact(local, mesh.active_edges(t), h) {
                 push_contribution(contributions, points, c.normal, c.depth, 0, c.points());
                 if record {
                     hits.push([t, NO_TRIANGLE]);

@@ -1,7 +1,8 @@
 //! Mesh–sphere: the sphere, carried into the mesh's frame, descends the mesh's OBB hierarchy
 //! (a node is kept while its box comes within the radius of the centre, Arvo 1990's clamp in the
 //! box's frame), and every triangle of the leaves reached is tested exactly by
-//! [`contact_triangle_sphere`] (Ericson 2005's closest point). The triangle contacts are merged
+//! [`contact_triangle_sphere_with_edges`] (Ericson 2005's closest point; at a mesh's internal
+//! edges, the face normal: see [`active_edges`](crate::geometry::active_edges)). The triangle contacts are merged
 //! into one manifold as `mesh_manifold.rs` explains.
 //!
 //! Triangles are two-sided surfaces: a sphere is pushed away from whichever side of a triangle
@@ -9,7 +10,9 @@
 
 use super::mesh_scratch::{ContactScratch, NO_TRIANGLE, push_contribution};
 use crate::bounding::{Obb, RELATIVE_SLACK};
-use crate::geometry::{ContactManifold, Isometry, MeshCollider, Sphere, contact_triangle_sphere};
+use crate::geometry::{
+    ContactManifold, Isometry, MeshCollider, Sphere, contact_triangle_sphere_with_edges,
+};
 use glam::Vec3;
 use std::ops::ControlFlow;
 
@@ -47,7 +50,8 @@ pub fn contact_trimesh_sphere(
             let Some(tri) = mesh.mesh().triangle(t as usize) else {
                 return ControlFlow::Continue(());
             };
-            if let Some(m) = contact_triangle_sphere(&tri, local, sphere) {
+            let active = mesh.active_edges(t);
+            if let Some(m) = contact_triangle_sphere_with_edges(&tri, active, local, sphere) {
                 push_contribution(
                     contributions,
                     points,
