@@ -15,6 +15,12 @@ fn scene(app: &mut App) -> Vec<bevy_ecs::entity::Entity> {
     app.insert_resource(Gravity::EARTH_Z_UP);
     app.world_mut()
         .spawn((Collider::half_space(Vec3::Z), Static));
+    // A capsule lying far from the balls, at rest on the ground.
+    app.world_mut().spawn((
+        Collider::capsule(0.6, 0.2),
+        Position::new(-5.0, 0.0, 0.2),
+        Rotation(glam::Quat::from_rotation_x(std::f32::consts::FRAC_PI_2)),
+    ));
     (0..4)
         .map(|i| {
             let x = i as f32 * 1.5;
@@ -56,6 +62,7 @@ fn recording_holds_the_scene_the_timelines_and_the_metrics() {
     for expected in [
         "/world",
         "/world/bodies/spheres",
+        "/world/bodies/capsules",
         "/world/static/boxes",
         "/world/bounding_volumes",
         "/world/velocities",
@@ -111,6 +118,32 @@ fn logged_positions_are_the_simulated_positions_and_sampling_skips_steps() {
         pts, positions,
         "the last logged centres are the simulated positions"
     );
+}
+
+#[test]
+fn a_capsule_is_drawn_from_its_bottom_cap_along_its_axis_within_1_mm() {
+    let (store, _) = recorded_store(1, 5);
+    let translations = rerun::Capsules3D::descriptor_translations().component;
+    let lengths = rerun::Capsules3D::descriptor_lengths().component;
+    let mut seen = 0;
+    for chunk in store.iter_physical_chunks() {
+        if chunk.entity_path().to_string() != "/world/bodies/capsules" {
+            continue;
+        }
+        let at = chunk.iter_component::<rerun::components::Translation3D>(translations);
+        let length = chunk.iter_component::<rerun::components::Length>(lengths);
+        for (a, l) in at.zip(length) {
+            let bottom = Vec3::from_array(a.iter().next().unwrap().0.into());
+            // Lying along y (z turned by 90° about x): the bottom cap's centre is 0.6 towards -y.
+            assert!(
+                (bottom - Vec3::new(-5.0, 0.6, 0.2)).length() < 1e-3,
+                "{bottom}"
+            );
+            assert!((l.iter().next().unwrap().0.0 - 1.2).abs() < 1e-5);
+            seen += 1;
+        }
+    }
+    assert!(seen > 0, "no capsule logged");
 }
 
 #[test]
