@@ -26,7 +26,7 @@ use urto::geometry::contacts::{
 };
 use urto::geometry::mesh_io::load_ply;
 use urto::geometry::{
-    Capsule, ContactManifold, Cuboid, HalfSpace, Isometry, MeshCollider, Shape, Sphere, TriMesh,
+    Capsule, ContactManifold, Cuboid, HalfSpace, Isometry, MeshCollider, Shape, TriMesh, Triangle,
     contact_triangle_sphere_with_edges, intersects_triangle_cuboid,
 };
 
@@ -153,9 +153,15 @@ fn sorted_mesh_hits(scratch: &ContactScratch) -> Vec<u32> {
     hits
 }
 
-#[test]
-fn mesh_sphere_matches_every_triangle_tested() {
-    let mut rng = Rng::new(11);
+/// The hierarchy-accelerated mesh–primitive contact against `brute`, the triangle test run on
+/// every triangle (in the mesh's frame: the triangle, its active edges, the body, the body's pose
+/// in that frame), for 300 bodies `draw` places near each mesh (from the mesh and its pose).
+fn matches_every_triangle(
+    seed: u64,
+    mut draw: impl FnMut(&mut Rng, &MeshCollider, &Isometry) -> (Shape, Isometry),
+    brute: impl Fn(&Triangle, u8, &Shape, &Isometry) -> Option<ContactManifold>,
+) {
+    let mut rng = Rng::new(seed);
     let mut scratch = ContactScratch::new();
     scratch.set_record_hits(true);
     let (mut touching, mut apart) = (0, 0);
@@ -163,90 +169,16 @@ fn mesh_sphere_matches_every_triangle_tested() {
         let shape = Shape::TriMesh(mesh.clone());
         for _ in 0..300 {
             let pose = rng.placement(0.5);
-            let sphere = Sphere {
-                radius: rng.range(0.05, 0.7),
-            };
-            let center = pose.transform_point(rng.in_ball(mesh.bounding_radius() + sphere.radius));
-            let ball = Shape::Sphere(sphere);
-            let at = Isometry::from_translation(center);
-            let got = contact_with_scratch(&shape, &pose, &ball, &at, &mut scratch);
-            // Brute force in the mesh's frame, where the library works.
-            let local = pose.inverse_transform_point(center);
-            let brute: Vec<(u32, Vec3, f32)> = mesh
-                .mesh()
-                .iter_triangles()
-                .enumerate()
-                .filter_map(|(t, tri)| {
-                    contact_triangle_sphere_with_edges(
-                        &tri,
-                        mesh.active_edges(t as u32),
-                        local,
-                        &sphere,
-                    )
-                    .map(|m| (t as u32, pose.transform_vector(m.normal), m.max_depth()))
-                })
-                .collect();
-            assert_eq!(got.is_some(), !brute.is_empty(), "{name}");
-            let Some(m) = got else {
-                apart += 1;
-                continue;
-            };
-            touching += 1;
-            assert_well_formed(&m, name);
-            let expected: Vec<u32> = brute.iter().map(|b| b.0).collect();
-            assert_eq!(
-                sorted_mesh_hits(&scratch),
-                expected,
-                "{name}: triangles in contact"
-            );
-            let pairs: Vec<(Vec3, f32, u8)> = brute.iter().map(|b| (b.1, b.2, 0)).collect();
-            let (normal, deepest) = merged(&pairs);
-            assert!(
-                (m.max_depth() - deepest).abs() < 1e-6,
-                "{name}: {} vs {deepest}",
-                m.max_depth()
-            );
-            assert_normal_close(m.normal, normal, name);
-            let flipped = contact(&ball, &at, &shape, &pose).expect("symmetric");
-            assert_eq!(flipped, m.flipped(), "{name}: swapping flips the normal");
-        }
-    }
-    assert!(touching > 300 && apart > 100, "{touching} / {apart}");
-}
-
-#[test]
-fn mesh_capsule_matches_every_triangle_tested() {
-    let mut rng = Rng::new(16);
-    let mut scratch = ContactScratch::new();
-    scratch.set_record_hits(true);
-    let (mut touching, mut apart) = (0, 0);
-    for (name, mesh) in meshes() {
-        let shape = Shape::TriMesh(mesh.clone());
-        for _ in 0..300 {
-            let pose = rng.placement(0.5);
-            let capsule = Capsule {
-                half_length: rng.range(0.0, 0.6),
-                radius: rng.range(0.05, 0.5),
-            };
-            let reach = mesh.bounding_radius() + capsule.radius + capsule.half_length;
-            let at = Isometry::new(pose.transform_point(rng.in_ball(reach)), rng.rotation());
-            let body = Shape::Capsule(capsule);
+            let (body, at) = draw(&mut rng, &mesh, &pose);
             let got = contact_with_scratch(&shape, &pose, &body, &at, &mut scratch);
-            // Brute force in the mesh's frame, where the library works.
-            let (p0, p1) = capsule.segment(&pose.inv_mul(&at));
+            let local = pose.inv_mul(&at);
             let brute: Vec<(u32, Vec3, f32)> = mesh
                 .mesh()
                 .iter_triangles()
                 .enumerate()
                 .filter_map(|(t, tri)| {
-                    contact_triangle_capsule(
-                        &tri,
-                        mesh.active_edges(t as u32),
-                        p0,
-                        p1,
-                        capsule.radius,
-                    )
-                    .map(|m| (t as u32, pose.transform_vector(m.normal), m.max_depth()))
+                    brute(&tri, mesh.active_edges(t as u32), &body, &local)
+                        .map(|m| (t as u32, pose.transform_vector(m.normal), m.max_depth()))
                 })
                 .collect();
             assert_eq!(got.is_some(), !brute.is_empty(), "{name}");
@@ -260,13 +192,58 @@ fn mesh_capsule_matches_every_triangle_tested() {
             assert_eq!(sorted_mesh_hits(&scratch), expected, "{name}: triangles");
             let pairs: Vec<(Vec3, f32, u8)> = brute.iter().map(|b| (b.1, b.2, 0)).collect();
             let (normal, deepest) = merged(&pairs);
-            assert!((m.max_depth() - deepest).abs() < 1e-6, "{name}");
+            assert!(
+                (m.max_depth() - deepest).abs() < 1e-6,
+                "{name}: {} vs {deepest}",
+                m.max_depth()
+            );
             assert_normal_close(m.normal, normal, name);
             let flipped = contact(&body, &at, &shape, &pose).expect("symmetric");
             assert_eq!(flipped, m.flipped(), "{name}: swapping flips the normal");
         }
     }
     assert!(touching > 300 && apart > 100, "{touching} / {apart}");
+}
+
+#[test]
+fn mesh_sphere_matches_every_triangle_tested() {
+    matches_every_triangle(
+        11,
+        |rng, mesh, pose| {
+            let radius = rng.range(0.05, 0.7);
+            let center = pose.transform_point(rng.in_ball(mesh.bounding_radius() + radius));
+            (Shape::sphere(radius), Isometry::from_translation(center))
+        },
+        |tri, active, body, local| {
+            let Shape::Sphere(s) = body else {
+                unreachable!()
+            };
+            contact_triangle_sphere_with_edges(tri, active, local.translation, s)
+        },
+    );
+}
+
+#[test]
+fn mesh_capsule_matches_every_triangle_tested() {
+    matches_every_triangle(
+        16,
+        |rng, mesh, pose| {
+            let capsule = Capsule {
+                half_length: rng.range(0.0, 0.6),
+                radius: rng.range(0.05, 0.5),
+            };
+            let reach = mesh.bounding_radius() + capsule.radius + capsule.half_length;
+            let at = Isometry::new(pose.transform_point(rng.in_ball(reach)), rng.rotation());
+            (Shape::Capsule(capsule), at)
+        },
+        |tri, active, body, local| {
+            let Shape::Capsule(c) = body else {
+                unreachable!()
+            };
+            let (p0, p1) = c.segment(local);
+            contact_triangle_capsule(tri, active, p0, p1, c.radius)
+        },
+    );
 }
 
 #[test]

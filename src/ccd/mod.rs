@@ -91,6 +91,7 @@ pub use advancement::{
 pub use sweep::{CONTACT_TOLERANCE_RELATIVE, InitialOverlap, SphereSweep, SweepError};
 pub use sweep_cull::SweepCull;
 pub use swept_aabb::swept_aabb;
+pub(crate) use swept_point::segment_in_box;
 pub use toi::{MeshToi, Toi, toi_sphere_shape};
 pub use toi_sphere_capsule::toi_sphere_capsule;
 pub use toi_sphere_cuboid::toi_sphere_cuboid;

@@ -17,6 +17,7 @@
 //! manifold in 3D): a capsule lying on a box rests on two points instead of seesawing on one.
 
 use super::closest_segment_points::{Segment, closest_segment_points};
+use crate::ccd::segment_in_box;
 use crate::geometry::{Capsule, ContactManifold, ContactPoint, Cuboid, Isometry};
 use glam::Vec3;
 
@@ -218,22 +219,14 @@ fn face_points(p0: Vec3, p1: Vec3, h: Vec3, normal: Vec3, radius: f32) -> [Optio
     }
     // The face the capsule touches is the box's side facing it, at -sign(n_k) h_k.
     let face = -normal[k].signum() * h[k];
-    let (mut lo, mut hi) = (0.0f32, 1.0f32);
+    // The segment's part over the face: clipped by the box's side slabs, not by its own axis.
+    let mut sides = h;
+    sides[k] = f32::INFINITY;
     let d = p1 - p0;
-    for j in (0..3).filter(|&j| j != k) {
-        if d[j] == 0.0 {
-            if p0[j].abs() > h[j] {
-                return NONE;
-            }
-            continue;
-        }
-        let (a, b) = ((-h[j] - p0[j]) / d[j], (h[j] - p0[j]) / d[j]);
-        lo = lo.max(a.min(b));
-        hi = hi.min(a.max(b));
-    }
-    if hi < lo {
+    let Some(span) = segment_in_box(p0, d, sides) else {
         return NONE;
-    }
+    };
+    let (lo, hi) = (span.t_in, span.t_out);
     let end = |t: f32| {
         let x = p0 + d * t;
         let depth = radius + normal[k].signum() * (x[k] - face);

@@ -8,8 +8,11 @@
 //! the queries it served, so a caller can report the work of a whole step.
 
 use super::mesh_manifold::Contribution;
+use crate::bounding::Obb;
 use crate::bvh::{QueryScratch, QueryStats};
-use crate::geometry::ContactPoint;
+use crate::geometry::{ContactManifold, ContactPoint, MeshCollider, Triangle};
+use glam::Vec3;
+use std::ops::ControlFlow;
 
 /// Stands for "no triangle" in [`ContactScratch::hits`], on the side of a primitive shape.
 pub const NO_TRIANGLE: u32 = u32::MAX;
@@ -108,6 +111,65 @@ impl ContactScratch {
         for h in &mut self.hits {
             h.swap(0, 1);
         }
+    }
+
+    /// The leaf work of every mesh–primitive test, as a new query: descends `mesh`'s hierarchy
+    /// through the nodes `node` keeps, collects the contact `test` finds for each triangle of
+    /// the leaves reached (with the triangle's index), records the triangles when asked to, and
+    /// counts the work. The caller merges.
+    pub(crate) fn collect_triangle_contacts<C: TriangleContact>(
+        &mut self,
+        mesh: &MeshCollider,
+        node: impl FnMut(&Obb) -> bool,
+        mut test: impl FnMut(u32, &Triangle) -> Option<C>,
+    ) {
+        self.begin_query();
+        let record = self.record_hits;
+        let Self {
+            query,
+            hits,
+            contributions,
+            points,
+            ..
+        } = self;
+        let stats = mesh.bvh().descend(query, node, |t| {
+            let found = mesh
+                .mesh()
+                .triangle(t as usize)
+                .and_then(|tri| test(t, &tri));
+            if let Some(c) = found {
+                push_contribution(contributions, points, c.normal(), c.depth(), 0, c.points());
+                if record {
+                    hits.push([t, NO_TRIANGLE]);
+                }
+            }
+            ControlFlow::Continue(())
+        });
+        self.count(stats);
+    }
+}
+
+/// One triangle's contact, as [`ContactScratch::collect_triangle_contacts`] pools it.
+pub(crate) trait TriangleContact {
+    /// Unit normal, from the triangle to the other shape.
+    fn normal(&self) -> Vec3;
+    /// Its separating depth.
+    fn depth(&self) -> f32;
+    /// Its candidate points.
+    fn points(&self) -> &[ContactPoint];
+}
+
+impl TriangleContact for ContactManifold {
+    fn normal(&self) -> Vec3 {
+        self.normal
+    }
+
+    fn depth(&self) -> f32 {
+        self.max_depth()
+    }
+
+    fn points(&self) -> &[ContactPoint] {
+        ContactManifold::points(self)
     }
 }
 

@@ -33,6 +33,7 @@
 use super::manifold_reduction::spread_points;
 use super::mesh_manifold::reduce_to_manifold;
 use super::polygon_clip::{ClipPolygon, MAX_TRIANGLE_CLIP_VERTICES};
+use crate::ccd::segment_in_box;
 use crate::geometry::active_edges::ALL_EDGES_ACTIVE;
 use crate::geometry::{ContactManifold, ContactPoint, Cuboid, Isometry, Triangle};
 use glam::Vec3;
@@ -81,6 +82,20 @@ impl TriangleBoxContact {
             };
             self.len += 1;
         }
+    }
+}
+
+impl super::mesh_scratch::TriangleContact for TriangleBoxContact {
+    fn normal(&self) -> Vec3 {
+        self.normal
+    }
+
+    fn depth(&self) -> f32 {
+        self.depth
+    }
+
+    fn points(&self) -> &[ContactPoint] {
+        TriangleBoxContact::points(self)
     }
 }
 
@@ -247,20 +262,7 @@ pub(crate) fn triangle_box_contact(
 
 /// True when the segment from `a` to `b` meets the box `[-h, h]` (slab clipping).
 fn edge_reaches(a: Vec3, b: Vec3, h: Vec3) -> bool {
-    let d = b - a;
-    let (mut lo, mut hi) = (0.0f32, 1.0f32);
-    for k in 0..3 {
-        if d[k] == 0.0 {
-            if a[k].abs() > h[k] {
-                return false;
-            }
-            continue;
-        }
-        let (t0, t1) = ((-h[k] - a[k]) / d[k], (h[k] - a[k]) / d[k]);
-        lo = lo.max(t0.min(t1));
-        hi = hi.min(t0.max(t1));
-    }
-    lo <= hi
+    segment_in_box(a, b - a, h).is_some()
 }
 
 fn box_corners(h: Vec3) -> [Vec3; 8] {

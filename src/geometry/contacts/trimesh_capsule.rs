@@ -5,11 +5,11 @@
 //! `mesh_manifold.rs` explains.
 
 use super::contact_triangle_capsule;
-use super::mesh_scratch::{ContactScratch, NO_TRIANGLE, push_contribution};
-use crate::bounding::{Bv, Obb, RELATIVE_SLACK, RelativePose};
+use super::mesh_scratch::ContactScratch;
+use super::trimesh_cuboid::carried_box;
+use crate::bounding::{Bv, RelativePose};
 use crate::geometry::{Capsule, ContactManifold, Isometry, MeshCollider};
 use glam::Vec3;
-use std::ops::ControlFlow;
 
 /// Contact between a mesh at `pose_mesh` (shape A) and a capsule at `pose_capsule` (shape B).
 ///
@@ -23,55 +23,15 @@ pub fn contact_trimesh_capsule(
     capsule: &Capsule,
     scratch: &mut ContactScratch,
 ) -> Option<ContactManifold> {
-    scratch.begin_query();
     let in_mesh = pose_mesh.inv_mul(pose_capsule);
     let (p0, p1) = capsule.segment(&in_mesh);
-    let half = Vec3::new(
-        capsule.radius,
-        capsule.radius,
-        capsule.half_length + capsule.radius,
-    );
-    // Rounding slack of the carried capsule, so the node test never rejects a touching triangle.
-    let pad = RELATIVE_SLACK
-        * (in_mesh.translation.abs().max_element() + half.max_element() + mesh.bounding_radius());
-    let probe = Obb {
-        center: in_mesh.translation,
-        axes: in_mesh.rotation_matrix(),
-        half_extents: half + Vec3::splat(pad),
-    };
+    let (r, h) = (capsule.radius, capsule.half_length);
+    let probe = carried_box(&in_mesh, Vec3::new(r, r, h + r), mesh);
     let same_frame = RelativePose::new(&Isometry::IDENTITY);
-    let record = scratch.records_hits();
-    let ContactScratch {
-        query,
-        hits,
-        contributions,
-        points,
-        ..
-    } = scratch;
-    let stats = mesh.bvh().descend(
-        query,
+    scratch.collect_triangle_contacts(
+        mesh,
         |bv| bv.overlaps(&probe, &same_frame),
-        |t| {
-            let Some(tri) = mesh.mesh().triangle(t as usize) else {
-                return ControlFlow::Continue(());
-            };
-            let active = mesh.active_edges(t);
-            if let Some(m) = contact_triangle_capsule(&tri, active, p0, p1, capsule.radius) {
-                push_contribution(
-                    contributions,
-                    points,
-                    m.normal,
-                    m.max_depth(),
-                    0,
-                    m.points(),
-                );
-                if record {
-                    hits.push([t, NO_TRIANGLE]);
-                }
-            }
-            ControlFlow::Continue(())
-        },
+        |t, tri| contact_triangle_capsule(tri, mesh.active_edges(t), p0, p1, r),
     );
-    scratch.count(stats);
     scratch.merge(pose_mesh)
 }

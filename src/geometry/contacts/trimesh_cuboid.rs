@@ -4,12 +4,11 @@
 //! `triangle_cuboid.rs`. The triangle contacts are merged into one manifold as
 //! `mesh_manifold.rs` explains.
 
-use super::mesh_scratch::{ContactScratch, NO_TRIANGLE, push_contribution};
+use super::mesh_scratch::ContactScratch;
 use super::triangle_cuboid::triangle_box_contact;
 use crate::bounding::{Bv, Obb, RELATIVE_SLACK, RelativePose};
 use crate::geometry::{ContactManifold, Cuboid, Isometry, MeshCollider};
 use glam::Vec3;
-use std::ops::ControlFlow;
 
 /// Contact between a mesh at `pose_mesh` (shape A) and a box at `pose_box` (shape B).
 ///
@@ -23,44 +22,30 @@ pub fn contact_trimesh_cuboid(
     cuboid: &Cuboid,
     scratch: &mut ContactScratch,
 ) -> Option<ContactManifold> {
-    scratch.begin_query();
     let box_in_mesh = pose_mesh.inv_mul(pose_box);
     let mesh_in_box = box_in_mesh.inverse();
     let h = cuboid.half_extents;
-    // Rounding slack of the carried box, so the node test never rejects a touching triangle.
-    let pad = RELATIVE_SLACK
-        * (box_in_mesh.translation.abs().max_element() + h.max_element() + mesh.bounding_radius());
-    let probe = Obb {
-        center: box_in_mesh.translation,
-        axes: box_in_mesh.rotation_matrix(),
-        half_extents: h + Vec3::splat(pad),
-    };
+    let probe = carried_box(&box_in_mesh, h, mesh);
     let same_frame = RelativePose::new(&Isometry::IDENTITY);
-    let record = scratch.records_hits();
-    let ContactScratch {
-        query,
-        hits,
-        contributions,
-        points,
-        ..
-    } = scratch;
-    let stats = mesh.bvh().descend(
-        query,
+    scratch.collect_triangle_contacts(
+        mesh,
         |bv| bv.overlaps(&probe, &same_frame),
-        |t| {
-            let Some(tri) = mesh.mesh().triangle(t as usize) else {
-                return ControlFlow::Continue(());
-            };
+        |t, tri| {
             let local = tri.vertices().map(|p| mesh_in_box.transform_point(p));
-            if let Some(c) = triangle_box_contact(local, mesh.active_edges(t), h) {
-                push_contribution(contributions, points, c.normal, c.depth, 0, c.points());
-                if record {
-                    hits.push([t, NO_TRIANGLE]);
-                }
-            }
-            ControlFlow::Continue(())
+            triangle_box_contact(local, mesh.active_edges(t), h)
         },
     );
-    scratch.count(stats);
     scratch.merge(pose_box)
+}
+
+/// The box of half extents `half` at `in_mesh` (its pose in the mesh's frame), grown by the
+/// rounding slack of the carried pose, so that the node test never rejects a touching triangle.
+pub(crate) fn carried_box(in_mesh: &Isometry, half: Vec3, mesh: &MeshCollider) -> Obb {
+    let pad = RELATIVE_SLACK
+        * (in_mesh.translation.abs().max_element() + half.max_element() + mesh.bounding_radius());
+    Obb {
+        center: in_mesh.translation,
+        axes: in_mesh.rotation_matrix(),
+        half_extents: half + Vec3::splat(pad),
+    }
 }

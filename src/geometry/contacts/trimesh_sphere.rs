@@ -8,13 +8,12 @@
 //! Triangles are two-sided surfaces: a sphere is pushed away from whichever side of a triangle
 //! it is on, and a sphere entirely inside a closed mesh touches nothing.
 
-use super::mesh_scratch::{ContactScratch, NO_TRIANGLE, push_contribution};
+use super::mesh_scratch::ContactScratch;
 use crate::bounding::{Obb, RELATIVE_SLACK};
 use crate::geometry::{
     ContactManifold, Isometry, MeshCollider, Sphere, contact_triangle_sphere_with_edges,
 };
 use glam::Vec3;
-use std::ops::ControlFlow;
 
 /// Contact between a mesh at `pose_mesh` (shape A) and a sphere centred at `center` (shape B).
 ///
@@ -29,45 +28,16 @@ pub fn contact_trimesh_sphere(
     sphere: &Sphere,
     scratch: &mut ContactScratch,
 ) -> Option<ContactManifold> {
-    scratch.begin_query();
     let local = pose_mesh.inverse_transform_point(center);
     // Rounding slack of the carried centre, so the box test never rejects a touching sphere.
     let reach =
         sphere.radius + RELATIVE_SLACK * (local.abs().max_element() + mesh.bounding_radius());
     let reach2 = reach * reach;
-    let record = scratch.records_hits();
-    let ContactScratch {
-        query,
-        hits,
-        contributions,
-        points,
-        ..
-    } = scratch;
-    let stats = mesh.bvh().descend(
-        query,
+    scratch.collect_triangle_contacts(
+        mesh,
         |bv| obb_within(bv, local, reach2),
-        |t| {
-            let Some(tri) = mesh.mesh().triangle(t as usize) else {
-                return ControlFlow::Continue(());
-            };
-            let active = mesh.active_edges(t);
-            if let Some(m) = contact_triangle_sphere_with_edges(&tri, active, local, sphere) {
-                push_contribution(
-                    contributions,
-                    points,
-                    m.normal,
-                    m.max_depth(),
-                    0,
-                    m.points(),
-                );
-                if record {
-                    hits.push([t, NO_TRIANGLE]);
-                }
-            }
-            ControlFlow::Continue(())
-        },
+        |t, tri| contact_triangle_sphere_with_edges(tri, mesh.active_edges(t), local, sphere),
     );
-    scratch.count(stats);
     scratch.merge(pose_mesh)
 }
 
