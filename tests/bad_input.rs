@@ -86,10 +86,19 @@ fn bad_shapes_and_rotations_are_quarantined() {
             Rotation(glam::Quat::from_xyzw(0.0, 0.0, 0.0, 0.0)),
         ))
         .id();
+    let e5 = app.world_mut().spawn(Collider::capsule(f32::NAN, 0.5)).id();
+    let e6 = app.world_mut().spawn(Collider::capsule(0.5, -0.1)).id();
+    let e7 = app.world_mut().spawn(Collider::capsule(3e6, 0.5)).id();
+    // A good capsule next to the bad ones stays good.
+    let good = app
+        .world_mut()
+        .spawn((Collider::capsule(0.5, 0.25), Velocity::default()))
+        .id();
     urto::step(app.world_mut(), 1).unwrap();
-    for e in [e1, e2, e3, e4] {
+    for e in [e1, e2, e3, e4, e5, e6, e7] {
         assert!(quarantined(&app, e));
     }
+    assert!(!quarantined(&app, good));
 }
 
 #[test]
