@@ -7,11 +7,14 @@
 //!
 //! The physics' truth ([`Position`], [`Rotation`]) is untouched: only `Transform`, the render
 //! side, is blended, one step behind at most. Each step records the pose it starts from; until
-//! a body has taken a step it is drawn where it is. A body a game teleports between steps is
-//! drawn sliding there over one step. Bodies without the marker pay nothing.
+//! a body has taken a step it is drawn where it is. A body a game teleports by writing its
+//! `Transform` is moved there at once (the write is taken as the body's new pose, as
+//! `transform_sync.rs` explains, and not blended away); one teleported by writing its
+//! `Position` is drawn sliding there over one step. Bodies without the marker pay nothing.
 
 use crate::components::{Position, Quarantined, Rotation};
 use crate::plugins::core::PrepareWake;
+use crate::plugins::transform_sync::{ReadGameTransforms, TransformWritten};
 use crate::schedule::{PhysicsSchedule, PhysicsSet};
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
@@ -40,6 +43,7 @@ impl Plugin for InterpolationPlugin {
             record_previous_poses
                 .run_if(any_with_component::<TransformInterpolation>)
                 .in_set(PhysicsSet::Prepare)
+                .after(ReadGameTransforms)
                 .before(PrepareWake),
         )
         .add_systems(
@@ -61,28 +65,44 @@ fn record_previous_poses(
 }
 
 type Drawn<'a> = (
-    &'a Position,
-    Option<&'a Rotation>,
-    &'a PreviousPose,
+    Entity,
+    &'a mut Position,
+    Option<&'a mut Rotation>,
+    &'a mut PreviousPose,
     &'a mut Transform,
+    Option<&'a mut TransformWritten>,
 );
 
 fn interpolate_transforms(
     mut bodies: Query<Drawn, (With<TransformInterpolation>, Without<Quarantined>)>,
     fixed: Option<Res<Time<Fixed>>>,
+    mut commands: Commands,
 ) {
     // Without Bevy's fixed clock (a world stepped by `urto::step`) there is no frame between
     // steps: draw the current pose.
     let alpha = fixed.map_or(1.0, |t| t.overstep_fraction().clamp(0.0, 1.0));
-    for (p, r, previous, mut t) in &mut bodies {
-        let current = (p.0, r.map_or(Quat::IDENTITY, |r| r.0));
+    for (e, mut p, r, mut previous, mut t, written) in &mut bodies {
+        let mut current = (p.0, r.as_ref().map_or(Quat::IDENTITY, |r| r.0));
+        if written.as_ref().is_some_and(|w| !w.holds(&t)) {
+            // The game moved the body since the last frame: that is its pose now, drawn as is.
+            current = (t.translation, t.rotation);
+            p.0 = t.translation;
+            match r {
+                Some(mut r) => r.0 = t.rotation,
+                None if t.rotation != Quat::IDENTITY => {
+                    commands.entity(e).insert(Rotation(t.rotation));
+                }
+                None => {}
+            }
+            previous.0 = None;
+        }
         let (translation, rotation) = match previous.0 {
             Some((p0, q0)) => (p0.lerp(current.0, alpha), q0.slerp(current.1, alpha)),
             None => current,
         };
-        if t.translation != translation || t.rotation != rotation {
-            t.translation = translation;
-            t.rotation = rotation;
+        let written = written.map(Mut::into_inner);
+        if let Some(first) = TransformWritten::write(written, &mut t, translation, rotation) {
+            commands.entity(e).insert(first);
         }
     }
 }
