@@ -551,3 +551,141 @@ fn ccd_lets_a_fast_ball_through_a_thin_wall_its_layers_ignore() {
     assert!(x(stopped) < 0.0, "{}", x(stopped));
     assert!(x(ghost) > 2.5, "{}", x(ghost));
 }
+
+#[test]
+fn nearest_distances_agree_with_parrys_projections_within_1e_5_on_2500_points_at_five_shapes() {
+    use urto::spatial::nearest_point;
+    let mut rng = Rng::new(21);
+    let mesh = TriMesh::torus(1.5, 0.5, 24, 12).unwrap();
+    let parry_mesh =
+        parry3d::shape::TriMesh::new(mesh.vertices().to_vec(), mesh.triangles().to_vec()).unwrap();
+    let half = Vec3::new(1.0, 0.4, 0.7);
+    // (ours, parry's, solid: a mesh is a surface).
+    let shapes: [(Shape, Box<dyn parry3d::shape::Shape>, bool); 5] = [
+        (
+            Shape::sphere(0.8),
+            Box::new(parry3d::shape::Ball::new(0.8)),
+            true,
+        ),
+        (
+            Shape::cuboid(half),
+            Box::new(parry3d::shape::Cuboid::new(half)),
+            true,
+        ),
+        (
+            Shape::capsule(0.9, 0.4),
+            Box::new(parry3d::shape::Capsule::new_z(0.9, 0.4)),
+            true,
+        ),
+        (
+            Shape::half_space(Vec3::Z),
+            Box::new(parry3d::shape::HalfSpace::new(Vec3::Z)),
+            true,
+        ),
+        (
+            Shape::TriMesh(MeshCollider::new(mesh).unwrap()),
+            Box::new(parry_mesh),
+            false,
+        ),
+    ];
+    let mut scratch = QueryScratch::new();
+    for (shape, parry_shape, solid) in &shapes {
+        let (mut inside, mut outside) = (0, 0);
+        for _ in 0..500 {
+            let pose = Isometry::new(rng.in_ball(3.0), rng.rotation());
+            let p = pose.translation + rng.in_ball(1.6);
+            let ours = nearest_point(shape, &pose, p, &mut scratch);
+            let at = parry3d::math::Pose::from_parts(pose.translation, pose.rotation);
+            let theirs = parry_shape.project_point(&at, p, *solid);
+            let point = Vec3::from_array(theirs.point.to_array());
+            assert_eq!(
+                ours.inside, theirs.is_inside,
+                "{shape:?} {p}: {ours:?} vs {theirs:?}"
+            );
+            // The distances agree tightly; the points a little less where the nearest point
+            // slides along a nearly flat stretch of a mesh (the distance is flat there).
+            let context = format!("{shape:?} {p}: {ours:?} vs {point}");
+            assert!(
+                (ours.distance - p.distance(point)).abs() < 1e-5 * (1.0 + ours.distance),
+                "{context}"
+            );
+            assert!((ours.point - point).length() < 1e-3, "{context}");
+            assert!((ours.distance - p.distance(ours.point)).abs() < 1e-5);
+            if ours.inside {
+                inside += 1;
+            } else {
+                outside += 1;
+            }
+        }
+        assert!(outside > 100, "{shape:?}: {outside} outside");
+        assert!(!solid || inside > 20, "{shape:?}: {inside} inside");
+    }
+}
+
+#[test]
+fn nearest_colliders_equal_brute_force_on_500_points_over_402_colliders() {
+    use urto::spatial::nearest_point;
+    let mut rng = Rng::new(22);
+    let colliders = scene(&mut rng, 400);
+    let mut index = indexed(&colliders);
+    let mut scratch = QueryScratch::new();
+    let mut limited = 0;
+    for k in 0..500 {
+        let p = rng.in_ball(28.0);
+        let max = if k % 5 == 0 { 1.0 } else { f32::INFINITY };
+        let brute = colliders
+            .iter()
+            .enumerate()
+            .map(|(i, (s, pose))| (i as u32, nearest_point(s, pose, p, &mut scratch)))
+            .filter(|(_, h)| h.distance <= max)
+            .min_by(|a, b| a.1.distance.total_cmp(&b.1.distance).then(a.0.cmp(&b.0)));
+        let ours = index.nearest(&*colliders, p, max, |_| true).unwrap();
+        assert_eq!(ours.map(|o| o.0), brute.map(|b| b.0), "point {k} {p}");
+        if let (Some(o), Some(b)) = (ours, brute) {
+            assert_eq!(o.1, b.1);
+        }
+        limited += usize::from(max < 1e3 && ours.is_none());
+    }
+    assert!(limited > 10, "{limited} queries found nothing within 1 m");
+    assert!(
+        index
+            .nearest(&*colliders, Vec3::NAN, 1.0, |_| true)
+            .is_err()
+    );
+    assert!(
+        index
+            .nearest(&*colliders, Vec3::ZERO, -1.0, |_| true)
+            .is_err()
+    );
+}
+
+#[test]
+fn spatial_query_finds_the_nearest_collider_with_a_filter() {
+    let (mut app, [ground, block, ball]) = ecs_scene();
+    let world = app.world_mut();
+    let (near_ball, past_ball, inside) = world
+        .run_system_once(|q: SpatialQuery| {
+            let all = SpatialQueryFilter::default();
+            let above = Vec3::new(0.0, 0.0, 3.0);
+            let near_ball = q.nearest_point(above, f32::INFINITY, &all).unwrap();
+            let no_balls = SpatialQueryFilter::from_mask(!BALLS);
+            let past_ball = q.nearest_point(above, f32::INFINITY, &no_balls).unwrap();
+            let inside = q
+                .nearest_point(Vec3::new(5.2, 0.3, 1.5), 10.0, &all)
+                .unwrap();
+            (near_ball, past_ball, inside)
+        })
+        .unwrap();
+    let near_ball = near_ball.unwrap();
+    assert_eq!(near_ball.entity, ball);
+    // The ball rests with its top at 1 m.
+    assert!((near_ball.distance - 2.0).abs() < 0.02, "{near_ball:?}");
+    let past_ball = past_ball.unwrap();
+    assert_eq!(past_ball.entity, ground);
+    assert!((past_ball.distance - 3.0).abs() < 1e-5, "{past_ball:?}");
+    let inside = inside.unwrap();
+    assert_eq!(
+        (inside.entity, inside.inside, inside.distance),
+        (block, true, 0.0)
+    );
+}

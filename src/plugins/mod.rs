@@ -47,7 +47,8 @@ pub use rotation::RotationPlugin;
 pub use sleep::SleepPlugin;
 pub use soft_step::{SoftStepPlugin, SoftStepSolver, SolveBodies, SpeculativeMargin};
 pub use spatial_query::{
-    RayHit, SpatialQuery, SpatialQueryFilter, SpatialQueryIndex, SpatialQueryPlugin,
+    PointProjection, RayHit, SpatialQuery, SpatialQueryFilter, SpatialQueryIndex,
+    SpatialQueryPlugin,
 };
 pub use transform_sync::TransformSyncPlugin;
 pub use validation::ValidationPlugin;

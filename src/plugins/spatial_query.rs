@@ -124,6 +124,19 @@ pub struct RayHit {
     pub normal: Vec3,
 }
 
+/// The collider nearest to a point, and where.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointProjection {
+    /// The collider (a part, for a compound body).
+    pub entity: Entity,
+    /// Its point nearest to the query point (the query point itself when inside a solid).
+    pub point: Vec3,
+    /// Distance to it (0 inside a solid).
+    pub distance: f32,
+    /// True when the query point is inside (or on) a solid collider; meshes are surfaces.
+    pub inside: bool,
+}
+
 type QueryCollider = (
     Entity,
     &'static Collider,
@@ -300,6 +313,26 @@ impl SpatialQuery<'_, '_> {
                 .into_iter()
                 .map(|id| lookup.entities[id as usize])
                 .collect())
+        })
+    }
+
+    /// The collider nearest to `point` within `max_distance` (`f32::INFINITY`: no limit), and
+    /// its nearest point; a point inside a solid is its own nearest point, at distance 0.
+    /// Answered from the index, nearest boxes first (a mesh through its own hierarchy).
+    pub fn nearest_point(
+        &self,
+        point: Vec3,
+        max_distance: f32,
+        filter: &SpatialQueryFilter,
+    ) -> Result<Option<PointProjection>, QueryError> {
+        self.with_index(filter, |index, lookup, accept| {
+            let found = index.nearest(lookup, point, max_distance, accept)?;
+            Ok(found.map(|(id, hit)| PointProjection {
+                entity: lookup.entities[id as usize],
+                point: hit.point,
+                distance: hit.distance,
+                inside: hit.inside,
+            }))
         })
     }
 

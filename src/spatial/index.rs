@@ -10,6 +10,7 @@
 //! deterministic: hits at equal distances are ordered by id.
 
 use super::cast::{CastHit, QueryError, Ray, cast_sphere, check_max_distance};
+use super::nearest::{PointHit, nearest_point};
 use super::tree::{AabbTree, RaySegment};
 use crate::bounding::Aabb;
 use crate::bvh::QueryScratch;
@@ -253,6 +254,51 @@ impl SpatialIndex {
         let at = Isometry::from_translation(point);
         self.overlapping(colliders, (&Shape::sphere(0.0), &at), accept, out);
         Ok(())
+    }
+}
+
+impl SpatialIndex {
+    /// The collider `accept`ed nearest to `point` within `max_distance` (inside a solid counts
+    /// as distance 0; ties go to the lower id), with where it was met; see
+    /// [`nearest_point`](super::nearest_point). Visits boxes nearest first and stops once no box
+    /// is nearer than the best collider found.
+    pub fn nearest<L: ColliderLookup + ?Sized>(
+        &mut self,
+        colliders: &L,
+        point: Vec3,
+        max_distance: f32,
+        mut accept: impl FnMut(u32) -> bool,
+    ) -> Result<Option<(u32, PointHit)>, QueryError> {
+        if !point.is_finite() {
+            return Err(QueryError::NonFiniteOrigin(point));
+        }
+        check_max_distance(max_distance)?;
+        let mut best: Option<(u32, PointHit)> = None;
+        let mesh = &mut self.mesh;
+        let mut consider = |id: u32| -> Option<f32> {
+            if !accept(id) {
+                return None;
+            }
+            let (shape, pose) = colliders.collider(id)?;
+            let hit = nearest_point(shape, &pose, point, mesh);
+            let better = best.is_none_or(|(b, h)| {
+                hit.distance < h.distance || (hit.distance == h.distance && id < b)
+            });
+            if better && hit.distance <= max_distance {
+                best = Some((id, hit));
+                return Some(hit.distance * hit.distance);
+            }
+            None
+        };
+        let mut max2 = max_distance * max_distance;
+        for &id in &self.unbounded {
+            if let Some(d2) = consider(id) {
+                max2 = max2.min(d2);
+            }
+        }
+        self.tree
+            .near_point(point, max2, &mut self.ray_stack, |id, _| consider(id));
+        Ok(best)
     }
 }
 

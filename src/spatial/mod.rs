@@ -9,8 +9,10 @@
 //!   stay the same and rebuilt when they change.
 //! - [`cast`]: a ray or a sphere cast against one shape, through the exact times of impact of
 //!   [`crate::ccd`] (a ray is a sweep of radius 0).
+//! - [`nearest`]: the point of one collider nearest to a query point.
 //! - [`index`]: the queries over the tree — ray casts (first hit, all hits), sphere casts,
-//!   overlaps and point queries — with a filter, never a scan of every collider.
+//!   overlaps, the colliders containing a point and the nearest one — with a filter, never a
+//!   scan of every collider.
 //!
 //! The ECS face is [`SpatialQuery`](crate::plugins::SpatialQuery), which keeps a
 //! [`SpatialIndex`] of the colliders' world poses after each step.
@@ -18,9 +20,11 @@
 pub mod cast;
 pub mod index;
 pub mod layers;
+pub mod nearest;
 pub mod tree;
 
 pub use cast::{CastHit, QueryError, Ray, cast_sphere};
 pub use index::{ColliderLookup, IndexUpdate, QueryHit, SpatialIndex};
 pub use layers::{LayerMask, Layers};
+pub use nearest::{PointHit, nearest_point};
 pub use tree::{AabbTree, RaySegment};

@@ -60,6 +60,13 @@ impl WideBox {
     fn intersects(&self, other: &Self) -> bool {
         self.min.cmple(other.max).all() && other.min.cmple(self.max).all()
     }
+
+    /// The squared distance from `p` to the box (0 inside).
+    #[inline(always)]
+    fn distance_squared(&self, p: Vec3A) -> f32 {
+        let outside = (self.min - p).max(p - self.max).max(Vec3A::ZERO);
+        outside.length_squared()
+    }
 }
 
 impl From<Aabb> for WideBox {
@@ -291,6 +298,59 @@ impl AabbTree {
             }
             if t_near <= max {
                 next = Some((near, t_near));
+            }
+        }
+    }
+}
+
+impl AabbTree {
+    /// Walks the items whose box lies within `sqrt(max2)` of `p`, nearer boxes first.
+    /// `visit(id, box_distance²)` returns a new `max2` (an item found at that squared distance
+    /// makes farther boxes irrelevant) or `None` to keep it: a nearest-point query prunes as it
+    /// goes.
+    pub fn near_point(
+        &self,
+        p: Vec3,
+        mut max2: f32,
+        stack: &mut Vec<(u32, f32)>,
+        mut visit: impl FnMut(u32, f32) -> Option<f32>,
+    ) {
+        stack.clear();
+        let Some(root) = self.nodes.first() else {
+            return;
+        };
+        let p = Vec3A::from(p);
+        let mut next = Some((0u32, root.aabb.distance_squared(p)));
+        while let Some((n, d2)) = next.take().or_else(|| stack.pop()) {
+            if d2 > max2 {
+                continue;
+            }
+            let node = &self.nodes[n as usize];
+            if node.count > 0 {
+                let range = node.first as usize..(node.first + node.count) as usize;
+                for (id, b) in self.ids[range.clone()].iter().zip(&self.boxes[range]) {
+                    let d2 = b.distance_squared(p);
+                    if d2 <= max2
+                        && let Some(new_max2) = visit(*id, d2)
+                    {
+                        max2 = max2.min(new_max2);
+                    }
+                }
+                continue;
+            }
+            let (a, b) = (node.first, node.first + 1);
+            let da = self.nodes[a as usize].aabb.distance_squared(p);
+            let db = self.nodes[b as usize].aabb.distance_squared(p);
+            let ((near, d_near), (far, d_far)) = if db < da {
+                ((b, db), (a, da))
+            } else {
+                ((a, da), (b, db))
+            };
+            if d_far <= max2 {
+                stack.push((far, d_far));
+            }
+            if d_near <= max2 {
+                next = Some((near, d_near));
             }
         }
     }

@@ -73,6 +73,7 @@ pub use capsule_capsule::contact_capsule_capsule;
 pub use capsule_cuboid::contact_capsule_cuboid;
 pub use capsule_halfspace::contact_capsule_halfspace;
 pub use capsule_sphere::contact_capsule_sphere;
+pub(crate) use closest_segment_points::closest_point_on_segment;
 pub use cuboid_cuboid::contact_cuboid_cuboid;
 pub use cuboid_halfspace::contact_cuboid_halfspace;
 pub use manifold_cache::{MAX_SHIFT, ManifoldCache};
@@ -88,6 +89,7 @@ pub use trimesh_capsule::contact_trimesh_capsule;
 pub use trimesh_cuboid::contact_trimesh_cuboid;
 pub use trimesh_halfspace::contact_trimesh_halfspace;
 pub use trimesh_sphere::contact_trimesh_sphere;
+pub(crate) use trimesh_sphere::obb_distance_squared;
 pub use trimesh_trimesh::{
     contact_triangle_triangle, contact_trimesh_trimesh, contact_trimesh_trimesh_within,
 };

@@ -44,7 +44,13 @@ pub fn contact_trimesh_sphere(
 /// True when the box comes within `sqrt(reach2)` of `p` (both in the mesh's frame).
 #[inline]
 pub(crate) fn obb_within(bv: &Obb, p: Vec3, reach2: f32) -> bool {
+    obb_distance_squared(bv, p) <= reach2
+}
+
+/// The squared distance from `p` to the box (0 inside), both in the mesh's frame.
+#[inline]
+pub(crate) fn obb_distance_squared(bv: &Obb, p: Vec3) -> f32 {
     let q = bv.axes.transpose() * (p - bv.center);
     let outside = (q.abs() - bv.half_extents).max(Vec3::ZERO);
-    outside.length_squared() <= reach2
+    outside.length_squared()
 }
