@@ -142,6 +142,34 @@ fn sphere_casts_equal_brute_force_on_500_casts_of_radius_up_to_1_5() {
 }
 
 #[test]
+fn box_casts_equal_brute_force_on_300_casts_over_302_colliders() {
+    use urto::spatial::{BoxCast, cast_box};
+    let mut rng = Rng::new(24);
+    let colliders = scene(&mut rng, 300);
+    let mut index = indexed(&colliders);
+    let mut scratch = QueryScratch::new();
+    let mut found = 0;
+    for k in 0..300 {
+        let ray = random_ray(&mut rng);
+        let cast = BoxCast {
+            pose: Isometry::new(ray.origin(), rng.rotation()),
+            half_extents: Vec3::new(rng.range(0.0, 1.0), rng.range(0.0, 1.0), 0.4),
+            direction: ray.direction(),
+            max_distance: 40.0,
+        };
+        let expected = colliders
+            .iter()
+            .enumerate()
+            .filter_map(|(i, (s, p))| cast_box(&cast, s, p, &mut scratch).map(|h| (i as u32, h)))
+            .min_by(|a, b| a.1.distance.total_cmp(&b.1.distance).then(a.0.cmp(&b.0)));
+        let first = index.cast_box(&*colliders, &cast, |_| true).unwrap();
+        assert_eq!(first.map(|h| (h.id, h.hit)), expected, "cast {k}");
+        found += usize::from(first.is_some());
+    }
+    assert!(found > 100, "{found}");
+}
+
+#[test]
 fn overlaps_and_point_queries_equal_brute_force_on_400_queries() {
     let mut rng = Rng::new(13);
     let colliders = scene(&mut rng, 300);
@@ -408,7 +436,9 @@ fn spatial_query_hits_filters_and_lists_entities_in_a_bevy_world() {
                     &all,
                 )
                 .unwrap();
-            let refused = q.cast_ray(Vec3::NAN, Vec3::X, 1.0, &all).is_err();
+            let refused = q.cast_ray(Vec3::NAN, Vec3::X, 1.0, &all).is_err()
+                && q.cast_box(Vec3::ONE, Isometry::IDENTITY, Vec3::ZERO, 1.0, &all)
+                    .is_err();
             (
                 first, past_ball, excluding, every, side, inside, around, refused,
             )
@@ -660,7 +690,7 @@ fn nearest_colliders_equal_brute_force_on_500_points_over_402_colliders() {
 }
 
 #[test]
-fn spatial_query_finds_the_nearest_collider_with_a_filter() {
+fn spatial_query_finds_the_nearest_collider_and_casts_a_box_with_a_filter() {
     let (mut app, [ground, block, ball]) = ecs_scene();
     let world = app.world_mut();
     let (near_ball, past_ball, inside) = world
@@ -688,4 +718,115 @@ fn spatial_query_finds_the_nearest_collider_with_a_filter() {
         (inside.entity, inside.inside, inside.distance),
         (block, true, 0.0)
     );
+}
+
+#[test]
+fn box_casts_touch_within_1e_4_and_agree_with_parry3d_within_1e_3_on_2500_casts_at_five_shapes() {
+    use parry3d::math::{Pose, Vector};
+    use urto::spatial::{BoxCast, cast_box};
+    let mut rng = Rng::new(23);
+    let mesh = TriMesh::torus(1.5, 0.5, 24, 12).unwrap();
+    let parry_mesh =
+        parry3d::shape::TriMesh::new(mesh.vertices().to_vec(), mesh.triangles().to_vec()).unwrap();
+    let half = Vec3::new(1.0, 0.4, 0.7);
+    let shapes: [(Shape, Box<dyn parry3d::shape::Shape>); 5] = [
+        (
+            Shape::cuboid(half),
+            Box::new(parry3d::shape::Cuboid::new(half)),
+        ),
+        (Shape::sphere(0.8), Box::new(parry3d::shape::Ball::new(0.8))),
+        (
+            Shape::capsule(0.9, 0.4),
+            Box::new(parry3d::shape::Capsule::new_z(0.9, 0.4)),
+        ),
+        (
+            Shape::half_space(Vec3::Z),
+            Box::new(parry3d::shape::HalfSpace::new(Vec3::Z)),
+        ),
+        (
+            Shape::TriMesh(MeshCollider::new(mesh).unwrap()),
+            Box::new(parry_mesh),
+        ),
+    ];
+    let mut scratch = QueryScratch::new();
+    let pose_of = |p: &Isometry| Pose::from_parts(p.translation, p.rotation);
+    for (shape, parry_shape) in &shapes {
+        let (mut hits, mut misses, mut worst) = (0, 0, 0.0f32);
+        for _ in 0..500 {
+            let target = Isometry::new(rng.in_ball(2.0), rng.rotation());
+            let start = target.translation + rng.in_ball(6.0);
+            let aim = target.translation + rng.in_ball(1.5) - start;
+            let Some(direction) = aim.try_normalize() else {
+                continue;
+            };
+            let cast = BoxCast {
+                pose: Isometry::new(start, rng.rotation()),
+                half_extents: Vec3::new(rng.range(0.1, 0.6), rng.range(0.1, 0.6), 0.3),
+                direction,
+                max_distance: 12.0,
+            };
+            let ours = cast_box(&cast, shape, &target, &mut scratch);
+            let caster = parry3d::shape::Cuboid::new(cast.half_extents);
+            let options = parry3d::query::ShapeCastOptions {
+                max_time_of_impact: 12.0,
+                stop_at_penetration: true,
+                ..Default::default()
+            };
+            let theirs = parry3d::query::cast_shapes(
+                &pose_of(&cast.pose),
+                Vector::from_array(direction.to_array()),
+                &caster,
+                &pose_of(&target),
+                Vector::ZERO,
+                parry_shape.as_ref(),
+                options,
+            )
+            .expect("supported");
+            let context = format!("{shape:?} {cast:?} {target:?}: {ours:?} vs {theirs:?}");
+            match (ours, theirs) {
+                (Some(h), Some(t)) => {
+                    let error = (h.distance - t.time_of_impact).abs();
+                    assert!(error < 1e-3, "{context}");
+                    worst = worst.max(error);
+                    // Independently of parry: touching at our distance, apart 1e-4 before it.
+                    let box_at = |d: f32, grow: f32| {
+                        let at = Isometry::new(
+                            cast.pose.translation + direction * d,
+                            cast.pose.rotation,
+                        );
+                        let s = Shape::cuboid(cast.half_extents + Vec3::splat(grow));
+                        contact(&s, &at, shape, &target).is_some()
+                    };
+                    assert!(box_at(h.distance, 1e-4), "not touching: {context}");
+                    if h.distance > 1e-3 {
+                        assert!(
+                            !box_at(h.distance - 1e-4, 0.0),
+                            "already touching: {context}"
+                        );
+                    }
+                    assert!(h.normal.is_normalized(), "{context}");
+                    hits += 1;
+                }
+                (None, None) => misses += 1,
+                // A graze: the two engines' tolerances decide differently; the box then passes
+                // within a hair of the target.
+                (ours, theirs) => {
+                    let d = ours
+                        .map(|h| h.distance)
+                        .or(theirs.map(|t| t.time_of_impact));
+                    let at = Isometry::new(
+                        cast.pose.translation + direction * d.unwrap(),
+                        cast.pose.rotation,
+                    );
+                    let grown = Shape::cuboid(cast.half_extents + Vec3::splat(1e-3));
+                    assert!(contact(&grown, &at, shape, &target).is_some(), "{context}");
+                }
+            }
+        }
+        eprintln!("box cast at {shape:?}: {hits} hits, {misses} misses, worst {worst}");
+        assert!(
+            hits > 200 && misses > 10,
+            "{shape:?}: {hits} hits, {misses} misses"
+        );
+    }
 }

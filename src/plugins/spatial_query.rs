@@ -277,6 +277,29 @@ impl SpatialQuery<'_, '_> {
         })
     }
 
+    /// The nearest collider a box of `half_extents` at `pose` meets when moved (without turning)
+    /// along `direction` for at most `max_distance` (a character's or a crate's sweep). A box
+    /// starting in contact hits at distance 0.
+    pub fn cast_box(
+        &self,
+        half_extents: Vec3,
+        pose: Isometry,
+        direction: Vec3,
+        max_distance: f32,
+        filter: &SpatialQueryFilter,
+    ) -> Result<Option<RayHit>, QueryError> {
+        let cast = crate::spatial::BoxCast {
+            pose,
+            half_extents,
+            direction: Ray::new(pose.translation, direction)?.direction(),
+            max_distance,
+        };
+        self.with_index(filter, |index, lookup, accept| {
+            let hit = index.cast_box(lookup, &cast, accept)?;
+            Ok(hit.map(|h| to_ray_hit(lookup.entities, h)))
+        })
+    }
+
     /// Every collider the ray hits within `max_distance`, nearest first.
     pub fn cast_ray_all(
         &self,

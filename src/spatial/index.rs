@@ -9,6 +9,7 @@
 //! (layers, excluded entities) refuses candidates before any exact test. Results are
 //! deterministic: hits at equal distances are ordered by id.
 
+use super::box_cast::{BoxCast, cast_box};
 use super::cast::{CastHit, QueryError, Ray, cast_sphere, check_max_distance};
 use super::nearest::{PointHit, nearest_point};
 use super::tree::{AabbTree, RaySegment};
@@ -131,10 +132,54 @@ impl SpatialIndex {
         ray: &Ray,
         radius: f32,
         max_distance: f32,
-        mut accept: impl FnMut(u32) -> bool,
+        accept: impl FnMut(u32) -> bool,
     ) -> Result<Option<QueryHit>, QueryError> {
         let max = check_max_distance(max_distance)?;
         check_radius(radius)?;
+        let grow = radius + self.slack(ray, radius, max);
+        Ok(self.first_hit(ray, grow, max, accept, |id, mesh| {
+            exact_cast(colliders, id, ray, radius, max, mesh)
+        }))
+    }
+
+    /// The nearest collider `accept`ed that `cast`'s box meets (see
+    /// [`cast_box`]; its direction must be unit); the tree is walked along the
+    /// box's path, its boxes grown by the box's bounding radius.
+    pub fn cast_box<L: ColliderLookup + ?Sized>(
+        &mut self,
+        colliders: &L,
+        cast: &BoxCast,
+        accept: impl FnMut(u32) -> bool,
+    ) -> Result<Option<QueryHit>, QueryError> {
+        let max = check_max_distance(cast.max_distance)?;
+        let h = cast.half_extents;
+        if !(cast.pose.is_finite() && h.is_finite() && h.cmpge(Vec3::ZERO).all()) {
+            return Err(QueryError::NonFiniteOrigin(cast.pose.translation));
+        }
+        if !cast.direction.is_normalized() {
+            return Err(QueryError::BadDirection(cast.direction));
+        }
+        let ray = Ray::new(cast.pose.translation, cast.direction)?;
+        let radius = h.length();
+        let grow = radius + self.slack(&ray, radius, max);
+        Ok(self.first_hit(&ray, grow, max, accept, |id, mesh| {
+            let (shape, pose) = colliders.collider(id)?;
+            cast_box(cast, shape, &pose, mesh)
+        }))
+    }
+
+    /// The walk shared by the first-hit casts: every unbounded collider, then the tree's boxes
+    /// grown by `grow` in the order `ray` enters them, each candidate `accept`ed tested by
+    /// `exact`; boxes entered beyond the nearest hit so far are skipped. Ties go to the lower
+    /// id.
+    fn first_hit(
+        &mut self,
+        ray: &Ray,
+        grow: f32,
+        max: f32,
+        mut accept: impl FnMut(u32) -> bool,
+        mut exact: impl FnMut(u32, &mut QueryScratch) -> Option<CastHit>,
+    ) -> Option<QueryHit> {
         let mut best: Option<QueryHit> = None;
         let mut consider = |id: u32, mesh: &mut QueryScratch| -> Option<f32> {
             if !accept(id) {
@@ -142,7 +187,7 @@ impl SpatialIndex {
             }
             // Cast to the query's own limit, not the nearest hit's, so that a shape's distance
             // does not depend on the order the tree found it in (the sweep's length scales it).
-            if let Some(hit) = exact_cast(colliders, id, ray, radius, max, mesh) {
+            if let Some(hit) = exact(id, mesh) {
                 let nearer = best.is_none_or(|b| {
                     hit.distance < b.hit.distance || (hit.distance == b.hit.distance && id < b.id)
                 });
@@ -157,13 +202,12 @@ impl SpatialIndex {
             consider(self.unbounded[i], &mut self.mesh);
         }
         let segment = RaySegment::new(ray.origin(), ray.direction());
-        let grow = radius + self.slack(ray, radius, max);
         let mesh = &mut self.mesh;
         self.tree
             .along_ray(&segment, grow, max, &mut self.ray_stack, |id, _| {
                 consider(id, mesh)
             });
-        Ok(best)
+        best
     }
 
     /// Every collider `accept`ed that `ray` hits within `max_distance`, nearest first (ties by
@@ -260,7 +304,7 @@ impl SpatialIndex {
 impl SpatialIndex {
     /// The collider `accept`ed nearest to `point` within `max_distance` (inside a solid counts
     /// as distance 0; ties go to the lower id), with where it was met; see
-    /// [`nearest_point`](super::nearest_point). Visits boxes nearest first and stops once no box
+    /// [`nearest_point`]. Visits boxes nearest first and stops once no box
     /// is nearer than the best collider found.
     pub fn nearest<L: ColliderLookup + ?Sized>(
         &mut self,

@@ -9,6 +9,7 @@
 //!   stay the same and rebuilt when they change.
 //! - [`cast`]: a ray or a sphere cast against one shape, through the exact times of impact of
 //!   [`crate::ccd`] (a ray is a sweep of radius 0).
+//! - [`box_cast`]: a box cast against one shape (separating axes with velocity for polytopes).
 //! - [`nearest`]: the point of one collider nearest to a query point.
 //! - [`index`]: the queries over the tree — ray casts (first hit, all hits), sphere casts,
 //!   overlaps, the colliders containing a point and the nearest one — with a filter, never a
@@ -17,12 +18,14 @@
 //! The ECS face is [`SpatialQuery`](crate::plugins::SpatialQuery), which keeps a
 //! [`SpatialIndex`] of the colliders' world poses after each step.
 
+pub mod box_cast;
 pub mod cast;
 pub mod index;
 pub mod layers;
 pub mod nearest;
 pub mod tree;
 
+pub use box_cast::{BoxCast, cast_box};
 pub use cast::{CastHit, QueryError, Ray, cast_sphere};
 pub use index::{ColliderLookup, IndexUpdate, QueryHit, SpatialIndex};
 pub use layers::{LayerMask, Layers};

@@ -70,6 +70,7 @@ mod trimesh_sphere;
 mod trimesh_trimesh;
 
 pub use capsule_capsule::contact_capsule_capsule;
+pub(crate) use capsule_cuboid::closest_segment_box;
 pub use capsule_cuboid::contact_capsule_cuboid;
 pub use capsule_halfspace::contact_capsule_halfspace;
 pub use capsule_sphere::contact_capsule_sphere;
