@@ -192,6 +192,35 @@ fn with_the_soft_step_a_tilted_dumbbell_compound_falls_onto_both_ends_within_1_c
 }
 
 #[test]
+fn a_stool_of_a_box_seat_and_four_capsule_legs_lands_upright_level_within_1_cm() {
+    let mut app = soft_step_app_on_ground();
+    // A seat with four capsule legs 0.7 m long (caps included) below it, parts of one body,
+    // dropped tilted: it lands on its legs, the seat level at 0.75 m.
+    let root = app
+        .world_mut()
+        .spawn((
+            Collider::cuboid(0.3, 0.3, 0.04),
+            Position::new(0.0, 0.0, 1.2),
+            Rotation(Quat::from_rotation_x(0.2) * Quat::from_rotation_y(-0.15)),
+            Velocity::default(),
+            Mass(4.0),
+        ))
+        .id();
+    for (x, y) in [(-0.25f32, -0.25f32), (0.25, -0.25), (-0.25, 0.25), (0.25, 0.25)] {
+        app.world_mut().spawn((
+            Collider::capsule(0.3, 0.05),
+            Position::new(x, y, -0.4),
+            ChildOf(root),
+        ));
+    }
+    urto::step(app.world_mut(), 300).unwrap();
+    let up = get::<Rotation>(&app, root).0 * Vec3::Z;
+    let z = get::<Position>(&app, root).0.z;
+    assert!(up.z > 0.999, "the seat is not level: {up}");
+    assert!((z - 0.75).abs() < 0.01, "the seat's centre is at {z} m");
+}
+
+#[test]
 fn with_the_soft_step_unusable_settings_fall_back_to_the_defaults_and_a_box_still_rests_within_1_cm()
  {
     let bad = SoftStepSettings {
