@@ -42,7 +42,7 @@ pub mod settings;
 pub mod spatial;
 pub mod stats;
 
-pub use plugins::{UrtoPlugins, step};
+pub use plugins::{UrtoPlugins, step, step_app};
 
 /// The crates urto's API is made of, re-exported so a game uses the very versions urto was
 /// built with (a second `glam` in the dependency tree makes `Vec3` two different types).

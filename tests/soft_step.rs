@@ -206,7 +206,12 @@ fn a_stool_of_a_box_seat_and_four_capsule_legs_lands_upright_level_within_1_cm()
             Mass(4.0),
         ))
         .id();
-    for (x, y) in [(-0.25f32, -0.25f32), (0.25, -0.25), (-0.25, 0.25), (0.25, 0.25)] {
+    for (x, y) in [
+        (-0.25f32, -0.25f32),
+        (0.25, -0.25),
+        (-0.25, 0.25),
+        (0.25, 0.25),
+    ] {
         app.world_mut().spawn((
             Collider::capsule(0.3, 0.05),
             Position::new(x, y, -0.4),

@@ -30,6 +30,7 @@ mod settings_check;
 pub mod sleep;
 pub mod soft_step;
 pub mod spatial_query;
+mod step_app;
 pub mod transform_sync;
 pub mod validation;
 
@@ -50,6 +51,7 @@ pub use spatial_query::{
     PointProjection, RayHit, SpatialQuery, SpatialQueryFilter, SpatialQueryIndex,
     SpatialQueryPlugin,
 };
+pub use step_app::step_app;
 pub use transform_sync::TransformSyncPlugin;
 pub use validation::ValidationPlugin;
 
