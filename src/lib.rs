@@ -61,8 +61,9 @@ pub mod prelude {
     pub use crate::dynamics::Integrator;
     pub use crate::dynamics::solver::SoftStepSettings;
     pub use crate::plugins::{
-        CollisionEnded, CollisionStarted, PointProjection, RayHit, SoftStepPlugin, SpatialQuery,
-        SpatialQueryFilter, TransformInterpolation, UrtoPlugins,
+        CollisionEnd, CollisionEnded, CollisionEventsEnabled, CollisionStart, CollisionStarted,
+        PointProjection, RayHit, SoftStepPlugin, SpatialQuery, SpatialQueryFilter,
+        TransformInterpolation, UrtoPlugins,
     };
     pub use crate::schedule::{PhysicsSchedule, PhysicsSet, SubstepSchedule, SubstepSet};
     pub use crate::settings::*;

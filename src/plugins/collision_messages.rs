@@ -35,6 +35,34 @@ pub struct CollisionEnded {
     pub b: Entity,
 }
 
+/// Opt-in per entity: its collisions are also triggered on it as [`CollisionStart`] and
+/// [`CollisionEnd`] events, for observers (Avian's `CollisionEventsEnabled`): a game reacts to
+/// what hits *this* entity without filtering every pair's message. Entities without it pay
+/// nothing.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CollisionEventsEnabled;
+
+/// Triggered on an entity with [`CollisionEventsEnabled`] when it starts touching `other`
+/// (after [`CollisionStarted`]; sensors' overlaps too).
+#[derive(EntityEvent, Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CollisionStart {
+    /// The entity observed.
+    #[event_target]
+    pub entity: Entity,
+    /// What it touches.
+    pub other: Entity,
+}
+
+/// Triggered on an entity with [`CollisionEventsEnabled`] when it stops touching `other`.
+#[derive(EntityEvent, Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CollisionEnd {
+    /// The entity observed.
+    #[event_target]
+    pub entity: Entity,
+    /// What it touched.
+    pub other: Entity,
+}
+
 /// The comparison of touching pairs that writes the collision messages, as a label: whatever
 /// adds contacts after the solve (continuous collision) runs before it.
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -211,6 +239,36 @@ fn report_sensors(
     sensing.clone_from(fresh);
 }
 
+/// Triggers this substep's collision messages as entity events on the bodies that asked for
+/// them (both sides of a pair, each seeing the other).
+pub(crate) fn trigger_collision_events(
+    mut started: MessageReader<CollisionStarted>,
+    mut ended: MessageReader<CollisionEnded>,
+    enabled: Query<(), With<CollisionEventsEnabled>>,
+    mut commands: Commands,
+) {
+    if enabled.is_empty() {
+        started.clear();
+        ended.clear();
+        return;
+    }
+    let sides = |a: Entity, b: Entity| [(a, b), (b, a)];
+    for m in started.read() {
+        for (entity, other) in sides(m.a, m.b) {
+            if enabled.contains(entity) {
+                commands.trigger(CollisionStart { entity, other });
+            }
+        }
+    }
+    for m in ended.read() {
+        for (entity, other) in sides(m.a, m.b) {
+            if enabled.contains(entity) {
+                commands.trigger(CollisionEnd { entity, other });
+            }
+        }
+    }
+}
+
 /// Advances the collision message buffers once per standalone step (an `App` does this itself
 /// every frame), so unread messages live two steps, as Bevy's messages live two frames.
 pub(crate) fn update_collision_messages(world: &mut World) {
@@ -219,5 +277,60 @@ pub(crate) fn update_collision_messages(world: &mut World) {
     }
     if let Some(mut m) = world.get_resource_mut::<Messages<CollisionEnded>>() {
         m.update();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::prelude::*;
+    use glam::Vec3;
+
+    #[derive(Resource, Default)]
+    struct Seen(Vec<(&'static str, Entity, Entity)>);
+
+    #[test]
+    fn an_entity_with_collision_events_sees_its_own_start_and_end_and_no_other_pair() {
+        let mut app = App::new();
+        app.add_plugins(UrtoPlugins::default())
+            .insert_resource(Gravity::EARTH_Z_UP)
+            .init_resource::<Seen>();
+        let ground = app
+            .world_mut()
+            .spawn((Collider::half_space(Vec3::Z), Static))
+            .id();
+        let watched = app
+            .world_mut()
+            .spawn((
+                Collider::sphere(0.5),
+                Position::new(0.0, 0.0, 0.5),
+                Velocity::default(),
+                CollisionEventsEnabled,
+            ))
+            .id();
+        // Another ball rests there too, unobserved.
+        app.world_mut().spawn((
+            Collider::sphere(0.5),
+            Position::new(5.0, 0.0, 0.5),
+            Velocity::default(),
+        ));
+        app.world_mut()
+            .add_observer(|e: On<CollisionStart>, mut seen: ResMut<Seen>| {
+                seen.0.push(("start", e.entity, e.other));
+            });
+        app.world_mut()
+            .add_observer(|e: On<CollisionEnd>, mut seen: ResMut<Seen>| {
+                seen.0.push(("end", e.entity, e.other));
+            });
+        crate::step(app.world_mut(), 60).unwrap();
+        assert_eq!(
+            app.world().resource::<Seen>().0,
+            [("start", watched, ground)]
+        );
+        // Thrown up off the ground: the contact ends.
+        app.world_mut().get_mut::<Velocity>(watched).unwrap().0 = Vec3::new(0.0, 0.0, 5.0);
+        crate::step(app.world_mut(), 5).unwrap();
+        let seen = &app.world().resource::<Seen>().0;
+        assert_eq!(seen[1..], [("end", watched, ground)]);
     }
 }

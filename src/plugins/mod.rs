@@ -43,7 +43,10 @@ pub use integration::IntegrationPlugin;
 pub use interpolation::{InterpolationPlugin, PreviousPose, TransformInterpolation};
 pub use joints::{JointPlugin, JointedPairs};
 pub use narrow_phase::{ContactPair, Contacts, NarrowPhasePlugin};
-pub use response::{CollisionEnded, CollisionStarted, ReportCollisions, ResponsePlugin};
+pub use response::{
+    CollisionEnd, CollisionEnded, CollisionEventsEnabled, CollisionStart, CollisionStarted,
+    ReportCollisions, ResponsePlugin,
+};
 pub use rotation::RotationPlugin;
 pub use sleep::SleepPlugin;
 pub use soft_step::{SoftStepPlugin, SoftStepSolver, SolveBodies, SpeculativeMargin};

@@ -3,8 +3,13 @@
 //! lecture's pipeline; the soft step replaces it by default), and the collision started / ended
 //! messages game code listens to (`collision_messages.rs`).
 
-pub use super::collision_messages::{CollisionEnded, CollisionStarted, ReportCollisions};
-use super::collision_messages::{add_collision_messages, report_collisions};
+pub use super::collision_messages::{
+    CollisionEnd, CollisionEnded, CollisionEventsEnabled, CollisionStart, CollisionStarted,
+    ReportCollisions,
+};
+use super::collision_messages::{
+    add_collision_messages, report_collisions, trigger_collision_events,
+};
 use crate::components::*;
 use crate::dynamics::response::{
     ContactConstraint, SupportGraph, correct_positions, resting_displacements, solve_velocities,
@@ -36,6 +41,7 @@ impl Plugin for ResponsePlugin {
             (
                 resolve_contacts.run_if(legacy_solver),
                 report_collisions.in_set(ReportCollisions),
+                trigger_collision_events,
             )
                 .chain()
                 .run_if(any_with_component::<Collider>)
