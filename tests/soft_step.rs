@@ -697,3 +697,63 @@ fn with_the_soft_step_an_unusable_speculative_margin_leaves_a_dropped_ball_resti
         assert!((z - 0.5).abs() < 0.01, "{margin:?}: ball at {z}");
     }
 }
+
+/// A platform a body passes through from below and lands on from above.
+#[derive(Component)]
+struct OneWay;
+
+/// The hook: a pair with a one-way platform stays only while the other body is above the
+/// platform's top.
+fn one_way_platforms(
+    mut contacts: ResMut<urto::plugins::Contacts>,
+    platforms: Query<(&Position, &Collider), With<OneWay>>,
+    positions: Query<&Position>,
+) {
+    contacts.pairs.retain(|p| {
+        let (platform, other) = if platforms.contains(p.b) {
+            (p.b, p.a)
+        } else if platforms.contains(p.a) {
+            (p.a, p.b)
+        } else {
+            return true;
+        };
+        let (at, collider) = platforms.get(platform).unwrap();
+        let top = at.0.z + collider.shape.world_aabb(&Default::default()).max.z;
+        positions.get(other).is_ok_and(|p| p.0.z > top)
+    });
+}
+
+#[test]
+fn a_contact_hook_makes_a_one_way_platform_a_ball_jumps_through_and_lands_on_within_1_cm() {
+    let run = |hooked: bool| {
+        let mut app = soft_step_app_on_ground();
+        if hooked {
+            app.add_systems(
+                urto::schedule::SubstepSchedule,
+                one_way_platforms.in_set(urto::plugins::ContactHooks),
+            );
+        }
+        app.world_mut().spawn((
+            Collider::cuboid(2.0, 2.0, 0.1),
+            Position::new(0.0, 0.0, 2.0),
+            Static,
+            OneWay,
+        ));
+        let ball = app
+            .world_mut()
+            .spawn((
+                Collider::sphere(0.25),
+                Position::new(0.0, 0.0, 1.0),
+                Velocity::new(0.0, 0.0, 8.0),
+            ))
+            .id();
+        urto::step(app.world_mut(), 240).unwrap();
+        app.world().get::<Position>(ball).unwrap().0.z
+    };
+    // Hooked: through the platform on the way up, onto it on the way down (top 2.1 + 0.25).
+    let z = run(true);
+    assert!((z - 2.35).abs() < 0.01, "hooked: {z}");
+    // Without the hook the platform's underside sends it back to the ground.
+    let z = run(false);
+    assert!((z - 0.25).abs() < 0.01, "plain: {z}");
+}

@@ -42,7 +42,7 @@ pub use hierarchy::HierarchyPlugin;
 pub use integration::IntegrationPlugin;
 pub use interpolation::{InterpolationPlugin, PreviousPose, TransformInterpolation};
 pub use joints::{JointPlugin, JointedPairs};
-pub use narrow_phase::{ContactPair, Contacts, NarrowPhasePlugin};
+pub use narrow_phase::{ContactHooks, ContactPair, Contacts, NarrowPhasePlugin};
 pub use response::{
     CollisionEnd, CollisionEnded, CollisionEventsEnabled, CollisionStart, CollisionStarted,
     ReportCollisions, ResponsePlugin,

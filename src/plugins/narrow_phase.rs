@@ -62,6 +62,35 @@ pub struct NarrowPhasePlugin;
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct ComputeContacts;
 
+/// Where a game edits the contacts before they are solved (Avian's `CollisionHooks`, rapier's
+/// `PhysicsHooks`, in plain ECS): systems a game adds to [`SubstepSchedule`] in this set run
+/// after the narrow phase and before the solver, with [`Contacts`] and any other data of the
+/// world in reach. A pair removed from `Contacts.pairs` is neither solved nor reported as a
+/// collision (a one-way platform, a ghost, a team filter); its manifold can be edited (points,
+/// normal). Contacts found later in the step by continuous collision are not seen here.
+///
+/// ```
+/// # use bevy_app::App;
+/// # use bevy_ecs::prelude::*;
+/// # use urto::prelude::*;
+/// # use urto::plugins::narrow_phase::{ContactHooks, Contacts};
+/// # use urto::schedule::SubstepSchedule;
+/// #[derive(Component)]
+/// struct Ghost;
+///
+/// fn ghosts_pass_through(mut contacts: ResMut<Contacts>, ghosts: Query<(), With<Ghost>>) {
+///     contacts
+///         .pairs
+///         .retain(|p| !ghosts.contains(p.a) && !ghosts.contains(p.b));
+/// }
+///
+/// let mut app = App::new();
+/// app.add_plugins(UrtoPlugins::default())
+///     .add_systems(SubstepSchedule, ghosts_pass_through.in_set(ContactHooks));
+/// ```
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ContactHooks;
+
 /// A contact between two bodies; the manifold's normal points from `a` to `b`.
 ///
 /// `a` and `b` are the root bodies that respond (a compound body moves as a whole);
@@ -158,13 +187,20 @@ struct NarrowPhaseScratch {
 
 impl Plugin for NarrowPhasePlugin {
     fn build(&self, app: &mut App) {
-        app.init_required::<NarrowPhaseScratch>().add_systems(
-            SubstepSchedule,
-            compute_contacts
-                .run_if(any_with_component::<Collider>)
-                .in_set(ComputeContacts)
-                .in_set(SubstepSet::NarrowPhase),
-        );
+        app.init_required::<NarrowPhaseScratch>()
+            .add_systems(
+                SubstepSchedule,
+                compute_contacts
+                    .run_if(any_with_component::<Collider>)
+                    .in_set(ComputeContacts)
+                    .in_set(SubstepSet::NarrowPhase),
+            )
+            .configure_sets(
+                SubstepSchedule,
+                ContactHooks
+                    .after(ComputeContacts)
+                    .in_set(SubstepSet::NarrowPhase),
+            );
     }
 }
 
