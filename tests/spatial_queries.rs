@@ -240,6 +240,42 @@ fn a_refit_after_motion_answers_as_a_fresh_build_on_300_rays() {
     }
 }
 
+/// The five shapes the parry3d oracles check, each with its parry twin and whether it is solid
+/// (a mesh is a surface): a ball, a box, a capsule, a half-space and a torus mesh.
+fn shapes_with_parry_twins() -> Vec<(Shape, Box<dyn parry3d::shape::Shape>, bool)> {
+    let mesh = TriMesh::torus(1.5, 0.5, 24, 12).unwrap();
+    let parry_mesh =
+        parry3d::shape::TriMesh::new(mesh.vertices().to_vec(), mesh.triangles().to_vec()).unwrap();
+    let half = Vec3::new(1.0, 0.4, 0.7);
+    vec![
+        (
+            Shape::sphere(0.8),
+            Box::new(parry3d::shape::Ball::new(0.8)),
+            true,
+        ),
+        (
+            Shape::cuboid(half),
+            Box::new(parry3d::shape::Cuboid::new(half)),
+            true,
+        ),
+        (
+            Shape::capsule(0.9, 0.4),
+            Box::new(parry3d::shape::Capsule::new_z(0.9, 0.4)),
+            true,
+        ),
+        (
+            Shape::half_space(Vec3::Z),
+            Box::new(parry3d::shape::HalfSpace::new(Vec3::Z)),
+            true,
+        ),
+        (
+            Shape::TriMesh(MeshCollider::new(mesh).unwrap()),
+            Box::new(parry_mesh),
+            false,
+        ),
+    ]
+}
+
 /// parry3d's ray against one shape (`solid`: a ray starting inside hits at 0).
 fn parry_ray(
     shape: &dyn parry3d::shape::Shape,
@@ -257,37 +293,7 @@ fn parry_ray(
 #[test]
 fn ray_distances_agree_with_parry3d_within_1e_4_on_10000_rays_at_five_shapes() {
     let mut rng = Rng::new(15);
-    let mesh = TriMesh::torus(1.5, 0.5, 24, 12).unwrap();
-    let parry_mesh =
-        parry3d::shape::TriMesh::new(mesh.vertices().to_vec(), mesh.triangles().to_vec()).unwrap();
-    let half = Vec3::new(1.0, 0.4, 0.7);
-    let shapes: [(Shape, Box<dyn parry3d::shape::Shape>, bool); 5] = [
-        (
-            Shape::capsule(0.9, 0.4),
-            Box::new(parry3d::shape::Capsule::new_z(0.9, 0.4)),
-            true,
-        ),
-        (
-            Shape::sphere(0.8),
-            Box::new(parry3d::shape::Ball::new(0.8)),
-            true,
-        ),
-        (
-            Shape::cuboid(half),
-            Box::new(parry3d::shape::Cuboid::new(half)),
-            true,
-        ),
-        (
-            Shape::half_space(Vec3::Z),
-            Box::new(parry3d::shape::HalfSpace::new(Vec3::Z)),
-            true,
-        ),
-        (
-            Shape::TriMesh(MeshCollider::new(mesh).unwrap()),
-            Box::new(parry_mesh),
-            false,
-        ),
-    ];
+    let shapes = shapes_with_parry_twins();
     for (shape, parry_shape, solid) in &shapes {
         let (mut both, mut outside, mut normals_agree) = (0, 0, 0);
         for _ in 0..2000 {
@@ -586,38 +592,7 @@ fn ccd_lets_a_fast_ball_through_a_thin_wall_its_layers_ignore() {
 fn nearest_distances_agree_with_parrys_projections_within_1e_5_on_2500_points_at_five_shapes() {
     use urto::spatial::nearest_point;
     let mut rng = Rng::new(21);
-    let mesh = TriMesh::torus(1.5, 0.5, 24, 12).unwrap();
-    let parry_mesh =
-        parry3d::shape::TriMesh::new(mesh.vertices().to_vec(), mesh.triangles().to_vec()).unwrap();
-    let half = Vec3::new(1.0, 0.4, 0.7);
-    // (ours, parry's, solid: a mesh is a surface).
-    let shapes: [(Shape, Box<dyn parry3d::shape::Shape>, bool); 5] = [
-        (
-            Shape::sphere(0.8),
-            Box::new(parry3d::shape::Ball::new(0.8)),
-            true,
-        ),
-        (
-            Shape::cuboid(half),
-            Box::new(parry3d::shape::Cuboid::new(half)),
-            true,
-        ),
-        (
-            Shape::capsule(0.9, 0.4),
-            Box::new(parry3d::shape::Capsule::new_z(0.9, 0.4)),
-            true,
-        ),
-        (
-            Shape::half_space(Vec3::Z),
-            Box::new(parry3d::shape::HalfSpace::new(Vec3::Z)),
-            true,
-        ),
-        (
-            Shape::TriMesh(MeshCollider::new(mesh).unwrap()),
-            Box::new(parry_mesh),
-            false,
-        ),
-    ];
+    let shapes = shapes_with_parry_twins();
     let mut scratch = QueryScratch::new();
     for (shape, parry_shape, solid) in &shapes {
         let (mut inside, mut outside) = (0, 0);
@@ -725,32 +700,10 @@ fn box_casts_touch_within_1e_4_and_agree_with_parry3d_within_1e_3_on_2500_casts_
     use parry3d::math::{Pose, Vector};
     use urto::spatial::{BoxCast, cast_box};
     let mut rng = Rng::new(23);
-    let mesh = TriMesh::torus(1.5, 0.5, 24, 12).unwrap();
-    let parry_mesh =
-        parry3d::shape::TriMesh::new(mesh.vertices().to_vec(), mesh.triangles().to_vec()).unwrap();
-    let half = Vec3::new(1.0, 0.4, 0.7);
-    let shapes: [(Shape, Box<dyn parry3d::shape::Shape>); 5] = [
-        (
-            Shape::cuboid(half),
-            Box::new(parry3d::shape::Cuboid::new(half)),
-        ),
-        (Shape::sphere(0.8), Box::new(parry3d::shape::Ball::new(0.8))),
-        (
-            Shape::capsule(0.9, 0.4),
-            Box::new(parry3d::shape::Capsule::new_z(0.9, 0.4)),
-        ),
-        (
-            Shape::half_space(Vec3::Z),
-            Box::new(parry3d::shape::HalfSpace::new(Vec3::Z)),
-        ),
-        (
-            Shape::TriMesh(MeshCollider::new(mesh).unwrap()),
-            Box::new(parry_mesh),
-        ),
-    ];
+    let shapes = shapes_with_parry_twins();
     let mut scratch = QueryScratch::new();
     let pose_of = |p: &Isometry| Pose::from_parts(p.translation, p.rotation);
-    for (shape, parry_shape) in &shapes {
+    for (shape, parry_shape, _) in &shapes {
         let (mut hits, mut misses, mut worst) = (0, 0, 0.0f32);
         for _ in 0..500 {
             let target = Isometry::new(rng.in_ball(2.0), rng.rotation());

@@ -171,6 +171,18 @@ mod tests {
         app
     }
 
+    /// A ball of radius 0.5 at `at` moving at `v`, drawn by a `Transform` (left at its default).
+    fn ball(app: &mut App, at: Vec3, v: Vec3) -> Entity {
+        app.world_mut()
+            .spawn((
+                Collider::sphere(0.5),
+                Position(at),
+                Velocity(v),
+                Transform::default(),
+            ))
+            .id()
+    }
+
     #[test]
     fn transforms_follow_the_simulation_and_keep_their_scale() {
         let mut app = app();
@@ -199,15 +211,7 @@ mod tests {
                 Transform::from_xyz(3.0, -1.0, 5.0).with_rotation(turned),
             ))
             .id();
-        let by_position = app
-            .world_mut()
-            .spawn((
-                Collider::sphere(0.5),
-                Position::new(-4.0, 0.0, 2.0),
-                Velocity::default(),
-                Transform::default(),
-            ))
-            .id();
+        let by_position = ball(&mut app, Vec3::new(-4.0, 0.0, 2.0), Vec3::ZERO);
         crate::step(app.world_mut(), 1).unwrap();
         let w = app.world();
         assert_eq!(
@@ -228,14 +232,7 @@ mod tests {
     #[test]
     fn a_game_writing_a_transform_teleports_the_body_and_keeps_its_velocity_to_1e_5() {
         let mut app = app();
-        let e = app
-            .world_mut()
-            .spawn((
-                Collider::sphere(0.5),
-                Velocity::new(6.0, 0.0, 0.0),
-                Transform::default(),
-            ))
-            .id();
+        let e = ball(&mut app, Vec3::ZERO, Vec3::new(6.0, 0.0, 0.0));
         crate::step(app.world_mut(), 10).unwrap();
         let turned = Quat::from_rotation_x(1.0);
         {
@@ -293,15 +290,7 @@ mod tests {
         app.insert_resource(Gravity::EARTH_Z_UP);
         app.world_mut()
             .spawn((Collider::half_space(Vec3::Z), Static));
-        let ball = app
-            .world_mut()
-            .spawn((
-                Collider::sphere(0.5),
-                Position::new(0.0, 0.0, 0.5),
-                Velocity::default(),
-                Transform::default(),
-            ))
-            .id();
+        let ball = ball(&mut app, Vec3::new(0.0, 0.0, 0.5), Vec3::ZERO);
         crate::step(app.world_mut(), 120).unwrap();
         assert!(
             app.world().get::<Sleeping>(ball).is_some(),
