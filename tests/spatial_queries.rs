@@ -142,8 +142,9 @@ fn sphere_casts_equal_brute_force_on_500_casts_of_radius_up_to_1_5() {
 }
 
 #[test]
-fn box_casts_equal_brute_force_on_300_casts_over_302_colliders() {
-    use urto::spatial::{BoxCast, cast_box};
+fn box_and_capsule_casts_equal_brute_force_on_300_casts_over_302_colliders() {
+    use urto::geometry::Capsule;
+    use urto::spatial::{BoxCast, CapsuleCast, cast_box, cast_capsule};
     let mut rng = Rng::new(24);
     let colliders = scene(&mut rng, 300);
     let mut index = indexed(&colliders);
@@ -165,6 +166,24 @@ fn box_casts_equal_brute_force_on_300_casts_over_302_colliders() {
         let first = index.cast_box(&*colliders, &cast, |_| true).unwrap();
         assert_eq!(first.map(|h| (h.id, h.hit)), expected, "cast {k}");
         found += usize::from(first.is_some());
+        let capsule = CapsuleCast {
+            pose: cast.pose,
+            capsule: Capsule {
+                half_length: cast.half_extents.x,
+                radius: cast.half_extents.y + 0.05,
+            },
+            direction: cast.direction,
+            max_distance: 40.0,
+        };
+        let expected = colliders
+            .iter()
+            .enumerate()
+            .filter_map(|(i, (s, p))| {
+                cast_capsule(&capsule, s, p, &mut scratch).map(|h| (i as u32, h))
+            })
+            .min_by(|a, b| a.1.distance.total_cmp(&b.1.distance).then(a.0.cmp(&b.0)));
+        let first = index.cast_capsule(&*colliders, &capsule, |_| true).unwrap();
+        assert_eq!(first.map(|h| (h.id, h.hit)), expected, "capsule cast {k}");
     }
     assert!(found > 100, "{found}");
 }
@@ -779,6 +798,89 @@ fn box_casts_touch_within_1e_4_and_agree_with_parry3d_within_1e_3_on_2500_casts_
         eprintln!("box cast at {shape:?}: {hits} hits, {misses} misses, worst {worst}");
         assert!(
             hits > 200 && misses > 10,
+            "{shape:?}: {hits} hits, {misses} misses"
+        );
+    }
+}
+
+/// parry3d's capsule casts run up to 5e-3 from the contact (its rounded-segment GJK tolerance),
+/// so each of ours is also checked independently: touching within 1e-4, apart 1e-4 before.
+#[test]
+fn capsule_casts_touch_within_1e_4_and_agree_with_parry3d_within_1e_2_on_2500_casts() {
+    use parry3d::math::{Pose, Vector};
+    use urto::geometry::Capsule;
+    use urto::spatial::{CapsuleCast, cast_capsule};
+    let mut rng = Rng::new(25);
+    let mut scratch = QueryScratch::new();
+    let pose_of = |p: &Isometry| Pose::from_parts(p.translation, p.rotation);
+    for (shape, parry_shape, _) in &shapes_with_parry_twins() {
+        let (mut hits, mut misses, mut worst) = (0, 0, 0.0f32);
+        for _ in 0..500 {
+            let target = Isometry::new(rng.in_ball(2.0), rng.rotation());
+            let start = target.translation + rng.in_ball(6.0);
+            let aim = target.translation + rng.in_ball(1.5) - start;
+            let Some(direction) = aim.try_normalize() else {
+                continue;
+            };
+            let capsule = Capsule {
+                half_length: rng.range(0.0, 0.7),
+                radius: rng.range(0.1, 0.5),
+            };
+            let cast = CapsuleCast {
+                pose: Isometry::new(start, rng.rotation()),
+                capsule,
+                direction,
+                max_distance: 12.0,
+            };
+            let ours = cast_capsule(&cast, shape, &target, &mut scratch);
+            let caster = parry3d::shape::Capsule::new_z(capsule.half_length, capsule.radius);
+            let options = parry3d::query::ShapeCastOptions {
+                max_time_of_impact: 12.0,
+                stop_at_penetration: true,
+                ..Default::default()
+            };
+            let theirs = parry3d::query::cast_shapes(
+                &pose_of(&cast.pose),
+                Vector::from_array(direction.to_array()),
+                &caster,
+                &pose_of(&target),
+                Vector::ZERO,
+                parry_shape.as_ref(),
+                options,
+            )
+            .expect("supported");
+            let context = format!("{shape:?} {cast:?} {target:?}: {ours:?} vs {theirs:?}");
+            let capsule_at = |d: f32, grow: f32| {
+                let at = Isometry::new(cast.pose.translation + direction * d, cast.pose.rotation);
+                let s = Shape::capsule(capsule.half_length, capsule.radius + grow);
+                contact(&s, &at, shape, &target).is_some()
+            };
+            match (ours, theirs) {
+                (Some(h), Some(t)) => {
+                    assert!(h.normal.is_normalized(), "{context}");
+                    // Independently of parry: touching at our distance, apart 1e-4 before it.
+                    assert!(capsule_at(h.distance, 1e-4), "not touching: {context}");
+                    if h.distance > 1e-3 {
+                        assert!(!capsule_at(h.distance - 1e-4, 0.0), "already: {context}");
+                    }
+                    let error = (h.distance - t.time_of_impact).abs();
+                    assert!(error < 1e-2, "{context}");
+                    worst = worst.max(error);
+                    hits += 1;
+                }
+                (None, None) => misses += 1,
+                // A graze: the capsule passes within a hair of the target.
+                (ours, theirs) => {
+                    let d = ours
+                        .map(|h| h.distance)
+                        .or(theirs.map(|t| t.time_of_impact));
+                    assert!(capsule_at(d.unwrap(), 1e-3), "{context}");
+                }
+            }
+        }
+        eprintln!("capsule cast at {shape:?}: {hits} hits, {misses} misses, worst {worst}");
+        assert!(
+            hits > 200 && misses > 5,
             "{shape:?}: {hits} hits, {misses} misses"
         );
     }

@@ -300,6 +300,32 @@ impl SpatialQuery<'_, '_> {
         })
     }
 
+    /// The nearest collider a capsule (`half_length`, `radius`, along `pose`'s local z) meets
+    /// when moved (without turning) along `direction` for at most `max_distance`: the sweep a
+    /// character controller makes before it moves. A capsule starting in contact hits at 0.
+    pub fn cast_capsule(
+        &self,
+        (half_length, radius): (f32, f32),
+        pose: Isometry,
+        direction: Vec3,
+        max_distance: f32,
+        filter: &SpatialQueryFilter,
+    ) -> Result<Option<RayHit>, QueryError> {
+        let cast = crate::spatial::CapsuleCast {
+            pose,
+            capsule: crate::geometry::Capsule {
+                half_length,
+                radius,
+            },
+            direction: Ray::new(pose.translation, direction)?.direction(),
+            max_distance,
+        };
+        self.with_index(filter, |index, lookup, accept| {
+            let hit = index.cast_capsule(lookup, &cast, accept)?;
+            Ok(hit.map(|h| to_ray_hit(lookup.entities, h)))
+        })
+    }
+
     /// Every collider the ray hits within `max_distance`, nearest first.
     pub fn cast_ray_all(
         &self,

@@ -41,7 +41,7 @@ pub struct BoxCast {
 }
 
 /// Conservative advancement stops this close to the target (relative to the sizes involved).
-const ADVANCE_TOLERANCE: f32 = 1e-5;
+pub(crate) const ADVANCE_TOLERANCE: f32 = 1e-5;
 /// Conservative advancement gives up (reporting its last safe distance) after this many steps.
 const ADVANCE_ITERATIONS: u32 = 64;
 
@@ -207,8 +207,7 @@ fn against_capsule(cast: &BoxCast, pose: &Isometry, c: &Capsule) -> Option<CastH
     let (a, b) = c.segment(pose);
     let h = cast.half_extents;
     let tolerance = ADVANCE_TOLERANCE * (1.0 + h.max_element() + c.half_length + c.radius);
-    // The gap between the capsule and the box moved by `t`, and the closest points (world).
-    let gap = |t: f32| {
+    advance(cast.max_distance, tolerance, |t| {
         let at = Isometry::new(
             cast.pose.translation + cast.direction * t,
             cast.pose.rotation,
@@ -219,25 +218,46 @@ fn against_capsule(cast: &BoxCast, pose: &Isometry, c: &Capsule) -> Option<CastH
             h,
         );
         let (on_axis, on_box) = (at.transform_point(on_axis), at.transform_point(on_box));
-        (on_axis.distance(on_box) - c.radius, on_axis, on_box)
-    };
+        let out = (on_box - on_axis)
+            .try_normalize()
+            .unwrap_or(-cast.direction);
+        Gap {
+            distance: on_axis.distance(on_box) - c.radius,
+            on_target: on_axis + out * c.radius,
+            normal: out,
+        }
+    })
+}
+
+/// How far a caster is from a target: the signed distance (negative: overlapping), the
+/// target's point nearest the caster, and the unit normal out of the target towards it.
+pub(crate) struct Gap {
+    pub distance: f32,
+    pub on_target: Vec3,
+    pub normal: Vec3,
+}
+
+/// Conservative advancement (Mirtich 1996) of a caster moving at unit speed along a line:
+/// `gap(t)` is its [`Gap`] to the target once moved by `t`, which the caster cannot close faster
+/// than one per unit travelled, so it moves on by that distance until within `tolerance` (a
+/// hit) or past `max` (none). A caster that starts touching or overlapping hits at 0.
+pub(crate) fn advance(
+    max: f32,
+    tolerance: f32,
+    mut gap: impl FnMut(f32) -> Gap,
+) -> Option<CastHit> {
     let mut t = 0.0f32;
     for _ in 0..ADVANCE_ITERATIONS {
-        let (d, on_axis, on_box) = gap(t);
-        if d <= tolerance {
-            // Out of the capsule, towards the box.
-            let normal = (on_box - on_axis)
-                .try_normalize()
-                .unwrap_or(-cast.direction);
+        let g = gap(t);
+        if g.distance <= tolerance {
             return Some(CastHit {
                 distance: t,
-                point: on_axis + normal * c.radius,
-                normal,
+                point: g.on_target,
+                normal: g.normal,
             });
         }
-        // The box moves at unit speed: it cannot close the gap faster than `d` per unit.
-        t += d;
-        if t > cast.max_distance {
+        t += g.distance;
+        if t > max {
             return None;
         }
     }

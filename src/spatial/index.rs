@@ -10,6 +10,7 @@
 //! deterministic: hits at equal distances are ordered by id.
 
 use super::box_cast::{BoxCast, cast_box};
+use super::capsule_cast::{CapsuleCast, cast_capsule};
 use super::cast::{CastHit, QueryError, Ray, cast_sphere, check_max_distance};
 use super::nearest::{PointHit, nearest_point};
 use super::tree::{AabbTree, RaySegment};
@@ -165,6 +166,32 @@ impl SpatialIndex {
         Ok(self.first_hit(&ray, grow, max, accept, |id, mesh| {
             let (shape, pose) = colliders.collider(id)?;
             cast_box(cast, shape, &pose, mesh)
+        }))
+    }
+
+    /// The nearest collider `accept`ed that `cast`'s capsule meets (see [`cast_capsule`]; its
+    /// direction must be unit); the tree is walked along the capsule's path, its boxes grown by
+    /// the capsule's bounding radius.
+    pub fn cast_capsule<L: ColliderLookup + ?Sized>(
+        &mut self,
+        colliders: &L,
+        cast: &CapsuleCast,
+        accept: impl FnMut(u32) -> bool,
+    ) -> Result<Option<QueryHit>, QueryError> {
+        let max = check_max_distance(cast.max_distance)?;
+        let shape = Shape::Capsule(cast.capsule);
+        if !cast.pose.is_finite() || shape.validate().is_err() {
+            return Err(QueryError::NonFiniteOrigin(cast.pose.translation));
+        }
+        if !cast.direction.is_normalized() {
+            return Err(QueryError::BadDirection(cast.direction));
+        }
+        let ray = Ray::new(cast.pose.translation, cast.direction)?;
+        let radius = shape.bounding_radius();
+        let grow = radius + self.slack(&ray, radius, max);
+        Ok(self.first_hit(&ray, grow, max, accept, |id, mesh| {
+            let (shape, pose) = colliders.collider(id)?;
+            cast_capsule(cast, shape, &pose, mesh)
         }))
     }
 

@@ -10,6 +10,8 @@
 //! - [`cast`]: a ray or a sphere cast against one shape, through the exact times of impact of
 //!   [`crate::ccd`] (a ray is a sweep of radius 0).
 //! - [`box_cast`]: a box cast against one shape (separating axes with velocity for polytopes).
+//! - [`capsule_cast`]: a capsule cast against one shape (conservative advancement on exact
+//!   distances, closed forms for balls and planes).
 //! - [`nearest`]: the point of one collider nearest to a query point.
 //! - [`index`]: the queries over the tree — ray casts (first hit, all hits), sphere casts,
 //!   overlaps, the colliders containing a point and the nearest one — with a filter, never a
@@ -19,6 +21,7 @@
 //! [`SpatialIndex`] of the colliders' world poses after each step.
 
 pub mod box_cast;
+pub mod capsule_cast;
 pub mod cast;
 pub mod index;
 pub mod layers;
@@ -26,6 +29,7 @@ pub mod nearest;
 pub mod tree;
 
 pub use box_cast::{BoxCast, cast_box};
+pub use capsule_cast::{CapsuleCast, cast_capsule};
 pub use cast::{CastHit, QueryError, Ray, cast_sphere};
 pub use index::{ColliderLookup, IndexUpdate, QueryHit, SpatialIndex};
 pub use layers::{LayerMask, Layers};

@@ -74,7 +74,9 @@ pub(crate) use capsule_cuboid::closest_segment_box;
 pub use capsule_cuboid::contact_capsule_cuboid;
 pub use capsule_halfspace::contact_capsule_halfspace;
 pub use capsule_sphere::contact_capsule_sphere;
-pub(crate) use closest_segment_points::closest_point_on_segment;
+pub(crate) use closest_segment_points::{
+    Segment, closest_point_on_segment, closest_segment_points,
+};
 pub use cuboid_cuboid::contact_cuboid_cuboid;
 pub use cuboid_halfspace::contact_cuboid_halfspace;
 pub use manifold_cache::{MAX_SHIFT, ManifoldCache};
@@ -84,6 +86,7 @@ pub use sphere_cuboid::contact_sphere_cuboid;
 pub use sphere_halfspace::contact_sphere_halfspace;
 pub use sphere_sphere::contact_sphere_sphere;
 pub use triangle_capsule::contact_triangle_capsule;
+pub(crate) use triangle_capsule::segment_triangle_closest;
 pub use triangle_cuboid::{contact_triangle_cuboid, contact_triangle_cuboid_with_edges};
 pub use triangle_distance::closest_points_triangle_triangle;
 pub use trimesh_capsule::contact_trimesh_capsule;

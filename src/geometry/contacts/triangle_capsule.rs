@@ -73,18 +73,7 @@ pub fn contact_triangle_capsule(
 
 /// The contact of a segment crossing the triangle (module notes), or `None` when it does not.
 fn pierced(tri: &Triangle, p0: Vec3, p1: Vec3, radius: f32) -> Option<ContactManifold> {
-    let n = tri.normal()?;
-    let [a, _, _] = tri.vertices();
-    let (h0, h1) = (n.dot(p0 - a), n.dot(p1 - a));
-    let product = h0 * h1;
-    if product.is_nan() || product >= 0.0 {
-        return None;
-    }
-    let crossing = p0 + (p1 - p0) * (h0 / (h0 - h1));
-    let slack = 1e-6 * (1.0 + crossing.abs().max_element());
-    if (tri.closest_point(crossing) - crossing).length_squared() > slack * slack {
-        return None;
-    }
+    let (n, h0, h1) = crossing(tri, p0, p1)?;
     // Out towards the side holding the longer part of the segment.
     let (normal, below, end) = if h0.abs() >= h1.abs() {
         (n * h0.signum(), h1.abs(), p1)
@@ -95,6 +84,32 @@ fn pierced(tri: &Triangle, p0: Vec3, p1: Vec3, radius: f32) -> Option<ContactMan
     // Midway between the capsule's surface under `end` and the plane.
     let point = end + normal * (below - 0.5 * depth);
     Some(ContactManifold::single(normal, point, depth))
+}
+
+/// Where the segment crosses the triangle: the triangle's unit normal and the ends' heights
+/// along it (of opposite signs), or `None` when it does not cross.
+fn crossing(tri: &Triangle, p0: Vec3, p1: Vec3) -> Option<(Vec3, f32, f32)> {
+    let n = tri.normal()?;
+    let [a, _, _] = tri.vertices();
+    let (h0, h1) = (n.dot(p0 - a), n.dot(p1 - a));
+    let product = h0 * h1;
+    if product.is_nan() || product >= 0.0 {
+        return None;
+    }
+    let at = p0 + (p1 - p0) * (h0 / (h0 - h1));
+    let slack = 1e-6 * (1.0 + at.abs().max_element());
+    ((tri.closest_point(at) - at).length_squared() <= slack * slack).then_some((n, h0, h1))
+}
+
+/// The closest points `(on the segment, on the triangle)`, equal where the segment crosses it.
+pub(crate) fn segment_triangle_closest(tri: &Triangle, p0: Vec3, p1: Vec3) -> (Vec3, Vec3) {
+    match crossing(tri, p0, p1) {
+        Some((_, h0, h1)) => {
+            let at = p0 + (p1 - p0) * (h0 / (h0 - h1));
+            (at, at)
+        }
+        None => closest_segment_triangle(tri, p0, p1),
+    }
 }
 
 /// The closest points `(on the segment, on the triangle)` of a segment that does not cross the

@@ -1,0 +1,183 @@
+//! A capsule cast: the first contact of a capsule translated along a direction (its
+//! orientation fixed), the sweep a character controller makes before it moves.
+//!
+//! - **Sphere**: the sphere swept the other way against the capsule (`ccd`'s exact capsule
+//!   sweep: a cylinder and two balls); only the relative motion matters.
+//! - **Half-space**: the capsule's lower cap against the plane, one division.
+//! - **Box, capsule, mesh**: conservative advancement (Mirtich 1996) on the exact distance from
+//!   the capsule's inner segment — to a box (the piecewise-quadratic distance of
+//!   `capsule_cuboid.rs`), to a segment (Ericson §5.1.9), to a mesh's nearest triangle (through
+//!   its hierarchy, a node visited only while nearer than the best triangle).
+//!
+//! Conventions are those of [`cast_sphere`](super::cast_sphere): a capsule that starts touching
+//! or overlapping hits at distance 0, the normal points out of the target towards the capsule,
+//! meshes are two-sided surfaces.
+
+use super::box_cast::{ADVANCE_TOLERANCE, Gap, advance};
+use super::cast::CastHit;
+use crate::bvh::QueryScratch;
+use crate::ccd::{SphereSweep, toi_sphere_capsule};
+use crate::geometry::contacts::{
+    Segment, closest_segment_box, closest_segment_points, segment_triangle_closest,
+};
+use crate::geometry::{Capsule, HalfSpace, Isometry, MeshCollider, Shape, Sphere};
+use glam::Vec3;
+use std::cell::Cell;
+use std::ops::ControlFlow;
+
+/// A capsule cast: `capsule` at `pose`, moving along the unit `direction` for at most
+/// `max_distance`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CapsuleCast {
+    /// Where the capsule starts.
+    pub pose: Isometry,
+    /// Its shape.
+    pub capsule: Capsule,
+    /// Unit direction of travel.
+    pub direction: Vec3,
+    /// Farthest travel considered.
+    pub max_distance: f32,
+}
+
+impl CapsuleCast {
+    /// The inner segment's ends after travelling `t`.
+    fn segment_at(&self, t: f32) -> (Vec3, Vec3) {
+        let (a, b) = self.capsule.segment(&self.pose);
+        let moved = self.direction * t;
+        (a + moved, b + moved)
+    }
+}
+
+/// The first contact of the cast with `shape` at `target`, or `None` within its reach.
+pub fn cast_capsule(
+    cast: &CapsuleCast,
+    shape: &Shape,
+    target: &Isometry,
+    scratch: &mut QueryScratch,
+) -> Option<CastHit> {
+    let r = cast.capsule.radius;
+    let size = cast.capsule.half_length + r + shape.bounding_radius().min(1e3);
+    let tolerance = ADVANCE_TOLERANCE * (1.0 + size);
+    // The gap from the capsule's segment to the target's closest points (target, segment).
+    let gap_from = |on_target: Vec3, on_axis: Vec3, target_radius: f32| {
+        let out = (on_axis - on_target)
+            .try_normalize()
+            .unwrap_or(-cast.direction);
+        Gap {
+            distance: on_target.distance(on_axis) - r - target_radius,
+            on_target: on_target + out * target_radius,
+            normal: out,
+        }
+    };
+    match shape {
+        Shape::Sphere(s) => against_sphere(cast, target.translation, s),
+        Shape::HalfSpace(h) => against_plane(cast, target, h),
+        Shape::Cuboid(c) => advance(cast.max_distance, tolerance, |t| {
+            let (a, b) = cast.segment_at(t);
+            let local = (
+                target.inverse_transform_point(a),
+                target.inverse_transform_point(b),
+            );
+            let (on_axis, on_box) = closest_segment_box(local.0, local.1, c.half_extents);
+            gap_from(
+                target.transform_point(on_box),
+                target.transform_point(on_axis),
+                0.0,
+            )
+        }),
+        Shape::Capsule(other) => {
+            let (c0, c1) = other.segment(target);
+            advance(cast.max_distance, tolerance, |t| {
+                let (a, b) = cast.segment_at(t);
+                let (on_axis, on_other) = closest_segment_points(
+                    Segment { start: a, end: b },
+                    Segment { start: c0, end: c1 },
+                );
+                gap_from(on_other, on_axis, other.radius)
+            })
+        }
+        Shape::TriMesh(m) => advance(cast.max_distance, tolerance, |t| {
+            let (a, b) = cast.segment_at(t);
+            let (p0, p1) = (
+                target.inverse_transform_point(a),
+                target.inverse_transform_point(b),
+            );
+            let (on_mesh, on_axis) = nearest_on_mesh(m, p0, p1, scratch);
+            gap_from(
+                target.transform_point(on_mesh),
+                target.transform_point(on_axis),
+                0.0,
+            )
+        }),
+    }
+}
+
+fn against_sphere(cast: &CapsuleCast, center: Vec3, sphere: &Sphere) -> Option<CastHit> {
+    let travel = cast.direction * cast.max_distance;
+    let sweep = SphereSweep::new(center, sphere.radius, -travel).ok()?;
+    let toi = toi_sphere_capsule(&sweep, &cast.pose, &cast.capsule)?;
+    let distance = toi.t * cast.max_distance;
+    // The sweep saw the capsule at rest and the sphere moving back; in truth the capsule moved.
+    Some(CastHit {
+        distance,
+        point: toi.point + cast.direction * distance,
+        normal: -toi.normal,
+    })
+}
+
+fn against_plane(cast: &CapsuleCast, pose: &Isometry, h: &HalfSpace) -> Option<CastHit> {
+    let n = pose.transform_vector(h.normal);
+    let (a, b) = cast.segment_at(0.0);
+    let low = if n.dot(a) <= n.dot(b) { a } else { b };
+    let height = n.dot(low - pose.translation) - cast.capsule.radius;
+    let foot = low - n * cast.capsule.radius;
+    if height <= 0.0 {
+        return Some(CastHit {
+            distance: 0.0,
+            point: foot - n * (0.5 * height),
+            normal: n,
+        });
+    }
+    let closing = -n.dot(cast.direction);
+    if closing.is_nan() || closing <= 0.0 {
+        return None;
+    }
+    let distance = height / closing;
+    (distance <= cast.max_distance).then(|| CastHit {
+        distance,
+        point: foot + cast.direction * distance,
+        normal: n,
+    })
+}
+
+/// The closest points `(on the mesh, on the segment)` of the segment from `p0` to `p1` (mesh
+/// frame): a node of the hierarchy is visited while its box is nearer than the best triangle.
+fn nearest_on_mesh(
+    mesh: &MeshCollider,
+    p0: Vec3,
+    p1: Vec3,
+    scratch: &mut QueryScratch,
+) -> (Vec3, Vec3) {
+    let best = Cell::new((f32::INFINITY, p0, p0));
+    mesh.bvh().descend(
+        scratch,
+        |bv| {
+            // The segment in the box's frame, against the box.
+            let local = |p: Vec3| bv.axes.transpose() * (p - bv.center);
+            let (s, q) = closest_segment_box(local(p0), local(p1), bv.half_extents);
+            (s - q).length_squared() <= best.get().0
+        },
+        |t| {
+            if let Some(tri) = mesh.mesh().triangle(t as usize) {
+                let (on_axis, on_tri) = segment_triangle_closest(&tri, p0, p1);
+                let d2 = (on_axis - on_tri).length_squared();
+                if d2 < best.get().0 {
+                    best.set((d2, on_tri, on_axis));
+                }
+            }
+            ControlFlow::Continue(())
+        },
+    );
+    let (_, on_mesh, on_axis) = best.get();
+    (on_mesh, on_axis)
+}
