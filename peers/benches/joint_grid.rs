@@ -203,18 +203,7 @@ impl Rapier {
     }
 
     fn poses(&self) -> Vec<(Vec3, glam::Quat)> {
-        self.balls
-            .iter()
-            .map(|h| {
-                let body = &self.world.bodies[*h];
-                let t = body.translation();
-                let q = body.rotation();
-                (
-                    Vec3::new(t.x, t.y, t.z),
-                    glam::Quat::from_xyzw(q.x, q.y, q.z, q.w),
-                )
-            })
-            .collect()
+        self.world.poses(&self.balls)
     }
 }
 

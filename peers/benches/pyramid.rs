@@ -185,13 +185,8 @@ impl Rapier {
     }
 
     fn positions(&self) -> Vec<Vec3> {
-        self.boxes
-            .iter()
-            .map(|h| {
-                let t = self.world.bodies[*h].translation();
-                Vec3::new(t.x, t.y, t.z)
-            })
-            .collect()
+        let poses = self.world.poses(&self.boxes);
+        poses.into_iter().map(|(p, _)| p).collect()
     }
 
     fn asleep(&self) -> usize {

@@ -345,18 +345,7 @@ impl Rapier {
     }
 
     fn poses(&self) -> Vec<(Vec3, Quat)> {
-        self.bodies
-            .iter()
-            .map(|h| {
-                let body = &self.world.bodies[*h];
-                let t = body.translation();
-                let q = body.rotation();
-                (
-                    Vec3::new(t.x, t.y, t.z),
-                    Quat::from_xyzw(q.x, q.y, q.z, q.w),
-                )
-            })
-            .collect()
+        self.world.poses(&self.bodies)
     }
 }
 

@@ -17,11 +17,11 @@
 //! overlapping hits at distance 0, the normal points out of the target towards the box, meshes
 //! are two-sided surfaces.
 
-use super::cast::CastHit;
+use super::cast::{CastHit, Ray, cast_at_plane};
 use crate::bvh::QueryScratch;
-use crate::ccd::{SphereSweep, toi_sphere_cuboid};
+use crate::ccd::{SphereSweep, toi_sphere_shape};
 use crate::geometry::contacts::closest_segment_box;
-use crate::geometry::{Capsule, Cuboid, HalfSpace, Isometry, MeshCollider, Shape, Sphere};
+use crate::geometry::{Capsule, HalfSpace, Isometry, MeshCollider, Shape, Sphere};
 use glam::{Mat3, Vec3};
 use std::cell::Cell;
 use std::ops::ControlFlow;
@@ -64,8 +64,17 @@ pub fn cast_box(
                 &[axes.x_axis, axes.y_axis, axes.z_axis],
             )
         }
-        Shape::Sphere(s) => against_sphere(cast, target.translation, s),
-        Shape::HalfSpace(h) => against_plane(cast, target, h),
+        Shape::Sphere(s) => {
+            let me = Shape::cuboid(cast.half_extents);
+            let motion = (cast.direction, cast.max_distance);
+            against_ball((&me, &cast.pose), motion, target.translation, s, scratch)
+        }
+        Shape::HalfSpace(h) => {
+            let n = target.transform_vector(h.normal);
+            let lowest = support(&box_corners(&cast.pose, cast.half_extents), -n);
+            let motion = (cast.direction, cast.max_distance);
+            against_plane(lowest, 0.0, motion, target, h)
+        }
         Shape::Capsule(c) => against_capsule(cast, target, c),
         Shape::TriMesh(m) => against_mesh(cast, target, m, scratch),
     }
@@ -163,44 +172,43 @@ fn support(points: &[Vec3], dir: Vec3) -> Vec3 {
     sum / count.max(1.0)
 }
 
-fn against_sphere(cast: &BoxCast, center: Vec3, sphere: &Sphere) -> Option<CastHit> {
-    let travel = cast.direction * cast.max_distance;
-    let sweep = SphereSweep::new(center, sphere.radius, -travel).ok()?;
-    let cuboid = Cuboid {
-        half_extents: cast.half_extents,
-    };
-    let toi = toi_sphere_cuboid(&sweep, &cast.pose, &cuboid)?;
-    let distance = toi.t * cast.max_distance;
-    // The sweep saw the box at rest and the sphere moving back; in truth the box moved.
+/// A caster (`shape` at `pose`, moving along the unit `direction` for at most `max`) against a
+/// ball: the ball swept the other way against the caster at rest (`ccd`'s exact sweeps), since
+/// only the relative motion matters; the contact then moves with the caster.
+pub(crate) fn against_ball(
+    (shape, pose): (&Shape, &Isometry),
+    (direction, max): (Vec3, f32),
+    center: Vec3,
+    ball: &Sphere,
+    scratch: &mut QueryScratch,
+) -> Option<CastHit> {
+    let sweep = SphereSweep::new(center, ball.radius, -direction * max).ok()?;
+    let toi = toi_sphere_shape(&sweep, shape, pose, scratch)?;
+    let distance = toi.t * max;
     Some(CastHit {
         distance,
-        point: toi.point + cast.direction * distance,
+        point: toi.point + direction * distance,
         normal: -toi.normal,
     })
 }
 
-fn against_plane(cast: &BoxCast, pose: &Isometry, h: &HalfSpace) -> Option<CastHit> {
-    let n = pose.transform_vector(h.normal);
-    let corners = box_corners(&cast.pose, cast.half_extents);
-    let lowest = support(&corners, -n);
-    let height = n.dot(lowest - pose.translation);
-    if height <= 0.0 {
-        return Some(CastHit {
-            distance: 0.0,
-            point: lowest - n * (0.5 * height),
-            normal: n,
-        });
-    }
-    let closing = -n.dot(cast.direction);
-    if closing.is_nan() || closing <= 0.0 {
-        return None;
-    }
-    let distance = height / closing;
-    (distance <= cast.max_distance).then(|| CastHit {
-        distance,
-        point: lowest + cast.direction * distance,
-        normal: n,
-    })
+/// A caster whose point nearest the plane, grown by `radius`, is `lowest`, moving along the
+/// unit `direction` for at most `max`, against the half-space `h` at `pose`.
+pub(crate) fn against_plane(
+    lowest: Vec3,
+    radius: f32,
+    (direction, max): (Vec3, f32),
+    pose: &Isometry,
+    h: &HalfSpace,
+) -> Option<CastHit> {
+    let ray = Ray::new(lowest, direction).ok()?;
+    cast_at_plane(
+        &ray,
+        radius,
+        max,
+        pose.translation,
+        pose.transform_vector(h.normal),
+    )
 }
 
 fn against_capsule(cast: &BoxCast, pose: &Isometry, c: &Capsule) -> Option<CastHit> {

@@ -13,14 +13,13 @@
 //! or overlapping hits at distance 0, the normal points out of the target towards the capsule,
 //! meshes are two-sided surfaces.
 
-use super::box_cast::{ADVANCE_TOLERANCE, Gap, advance};
+use super::box_cast::{ADVANCE_TOLERANCE, Gap, advance, against_ball, against_plane};
 use super::cast::CastHit;
 use crate::bvh::QueryScratch;
-use crate::ccd::{SphereSweep, toi_sphere_capsule};
 use crate::geometry::contacts::{
     Segment, closest_segment_box, closest_segment_points, segment_triangle_closest,
 };
-use crate::geometry::{Capsule, HalfSpace, Isometry, MeshCollider, Shape, Sphere};
+use crate::geometry::{Capsule, Isometry, MeshCollider, Shape};
 use glam::Vec3;
 use std::cell::Cell;
 use std::ops::ControlFlow;
@@ -70,8 +69,17 @@ pub fn cast_capsule(
         }
     };
     match shape {
-        Shape::Sphere(s) => against_sphere(cast, target.translation, s),
-        Shape::HalfSpace(h) => against_plane(cast, target, h),
+        Shape::Sphere(s) => {
+            let me = Shape::Capsule(cast.capsule);
+            let motion = (cast.direction, cast.max_distance);
+            against_ball((&me, &cast.pose), motion, target.translation, s, scratch)
+        }
+        Shape::HalfSpace(h) => {
+            let n = target.transform_vector(h.normal);
+            let (a, b) = cast.segment_at(0.0);
+            let low = if n.dot(a) <= n.dot(b) { a } else { b };
+            against_plane(low, r, (cast.direction, cast.max_distance), target, h)
+        }
         Shape::Cuboid(c) => advance(cast.max_distance, tolerance, |t| {
             let (a, b) = cast.segment_at(t);
             let local = (
@@ -110,44 +118,6 @@ pub fn cast_capsule(
             )
         }),
     }
-}
-
-fn against_sphere(cast: &CapsuleCast, center: Vec3, sphere: &Sphere) -> Option<CastHit> {
-    let travel = cast.direction * cast.max_distance;
-    let sweep = SphereSweep::new(center, sphere.radius, -travel).ok()?;
-    let toi = toi_sphere_capsule(&sweep, &cast.pose, &cast.capsule)?;
-    let distance = toi.t * cast.max_distance;
-    // The sweep saw the capsule at rest and the sphere moving back; in truth the capsule moved.
-    Some(CastHit {
-        distance,
-        point: toi.point + cast.direction * distance,
-        normal: -toi.normal,
-    })
-}
-
-fn against_plane(cast: &CapsuleCast, pose: &Isometry, h: &HalfSpace) -> Option<CastHit> {
-    let n = pose.transform_vector(h.normal);
-    let (a, b) = cast.segment_at(0.0);
-    let low = if n.dot(a) <= n.dot(b) { a } else { b };
-    let height = n.dot(low - pose.translation) - cast.capsule.radius;
-    let foot = low - n * cast.capsule.radius;
-    if height <= 0.0 {
-        return Some(CastHit {
-            distance: 0.0,
-            point: foot - n * (0.5 * height),
-            normal: n,
-        });
-    }
-    let closing = -n.dot(cast.direction);
-    if closing.is_nan() || closing <= 0.0 {
-        return None;
-    }
-    let distance = height / closing;
-    (distance <= cast.max_distance).then(|| CastHit {
-        distance,
-        point: foot + cast.direction * distance,
-        normal: n,
-    })
 }
 
 /// The closest points `(on the mesh, on the segment)` of the segment from `p0` to `p1` (mesh

@@ -164,7 +164,13 @@ fn cast_at_ball(ray: &Ray, radius: f32, max: f32, centre: Vec3, other: f32) -> O
 }
 
 /// A ball of `radius` cast at the half-space below the plane through `at` with unit `normal`.
-fn cast_at_plane(ray: &Ray, radius: f32, max: f32, at: Vec3, normal: Vec3) -> Option<CastHit> {
+pub(crate) fn cast_at_plane(
+    ray: &Ray,
+    radius: f32,
+    max: f32,
+    at: Vec3,
+    normal: Vec3,
+) -> Option<CastHit> {
     let above = normal.dot(ray.origin - at);
     let gap = above - radius;
     if gap <= 0.0 {

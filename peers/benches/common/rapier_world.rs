@@ -58,6 +58,22 @@ impl RapierWorld {
         h
     }
 
+    /// The poses of `bodies`, as glam values (`whole_step` reads its own).
+    #[allow(dead_code)]
+    pub fn poses(&self, bodies: &[rp::RigidBodyHandle]) -> Vec<(glam::Vec3, glam::Quat)> {
+        bodies
+            .iter()
+            .map(|h| {
+                let body = &self.bodies[*h];
+                let (t, q) = (body.translation(), body.rotation());
+                (
+                    glam::Vec3::new(t.x, t.y, t.z),
+                    glam::Quat::from_xyzw(q.x, q.y, q.z, q.w),
+                )
+            })
+            .collect()
+    }
+
     /// `n` steps.
     pub fn step(&mut self, n: u32) {
         for _ in 0..n {
