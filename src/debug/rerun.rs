@@ -39,10 +39,12 @@ mod joints;
 mod layout;
 mod meshes;
 mod scene_graph;
+mod shape_batch;
 
 use body_colors::{KindView, STATIC, body_color};
 use layout::default_layout;
 use meshes::{LoggedMeshes, record_meshes, record_overlapping_leaves};
+use shape_batch::ShapeBatch;
 
 use crate::components::*;
 use crate::geometry::{MeshCollider, Shape};
@@ -324,114 +326,6 @@ fn quat(q: Quat) -> rerun::Quaternion {
 /// static); e.g. to tell a game's targets from its walls. Only the recording reads it.
 #[derive(Component, Clone, Copy, Debug, PartialEq, Eq)]
 pub struct DebugColor(pub [u8; 3]);
-
-/// Spheres and boxes of one group of bodies, ready to log, with their labels (empty for
-/// unnamed bodies; none at all when no body is named).
-#[derive(Default)]
-struct ShapeBatch {
-    sphere_centers: Vec<[f32; 3]>,
-    sphere_radii: Vec<f32>,
-    sphere_colors: Vec<rerun::Color>,
-    sphere_labels: Vec<String>,
-    box_centers: Vec<[f32; 3]>,
-    box_half_sizes: Vec<[f32; 3]>,
-    box_rotations: Vec<rerun::Quaternion>,
-    box_colors: Vec<rerun::Color>,
-    box_labels: Vec<String>,
-    capsules: CapsuleBatch,
-    named: bool,
-}
-
-/// Capsules as rerun draws them: from the bottom cap's centre along the rotated +z.
-#[derive(Default)]
-struct CapsuleBatch {
-    bottoms: Vec<[f32; 3]>,
-    lengths: Vec<f32>,
-    radii: Vec<f32>,
-    rotations: Vec<rerun::Quaternion>,
-    colors: Vec<rerun::Color>,
-    labels: Vec<String>,
-}
-
-impl ShapeBatch {
-    #[allow(clippy::too_many_arguments)]
-    fn push(
-        &mut self,
-        shape: &Shape,
-        p: Vec3,
-        r: Quat,
-        color: [u8; 3],
-        label: Option<&Name>,
-        plane_half_size: f32,
-    ) {
-        let color = rerun::Color::from_rgb(color[0], color[1], color[2]);
-        let label = label.map_or(String::new(), |n| n.as_str().to_owned());
-        self.named |= !label.is_empty();
-        match shape {
-            Shape::Sphere(s) => {
-                self.sphere_centers.push(arr(p));
-                self.sphere_radii.push(s.radius);
-                self.sphere_colors.push(color);
-                self.sphere_labels.push(label);
-            }
-            Shape::Cuboid(c) => self.push_box(p, c.half_extents, r, color, label),
-            Shape::Capsule(c) => {
-                let batch = &mut self.capsules;
-                batch.bottoms.push(arr(p - r * Vec3::Z * c.half_length));
-                batch.lengths.push(2.0 * c.half_length);
-                batch.radii.push(c.radius);
-                batch.rotations.push(quat(r));
-                batch.colors.push(color);
-                batch.labels.push(label);
-            }
-            Shape::HalfSpace(h) => {
-                // A thin square slab just below the plane, facing along the normal.
-                let normal = r * h.normal;
-                let facing = Quat::from_rotation_arc(Vec3::Z, normal);
-                let half = Vec3::new(plane_half_size, plane_half_size, 0.005);
-                self.push_box(p - normal * 0.005, half, facing, color, label);
-            }
-            // Meshes have their own entities (`record_meshes`).
-            Shape::TriMesh(_) => {}
-        }
-    }
-
-    fn push_box(&mut self, p: Vec3, half: Vec3, r: Quat, color: rerun::Color, label: String) {
-        self.box_centers.push(arr(p));
-        self.box_half_sizes.push(arr(half));
-        self.box_rotations.push(quat(r));
-        self.box_colors.push(color);
-        self.box_labels.push(label);
-    }
-
-    fn log(self, rec: &RecordingStream, path: &str) {
-        let mut spheres =
-            rerun::Ellipsoids3D::from_centers_and_radii(self.sphere_centers, self.sphere_radii)
-                .with_colors(self.sphere_colors)
-                .with_fill_mode(rerun::FillMode::Solid);
-        let mut boxes =
-            rerun::Boxes3D::from_centers_and_half_sizes(self.box_centers, self.box_half_sizes)
-                .with_quaternions(self.box_rotations)
-                .with_colors(self.box_colors)
-                .with_fill_mode(rerun::FillMode::Solid);
-        let c = self.capsules;
-        let mut capsules = rerun::Capsules3D::from_lengths_and_radii(c.lengths, c.radii)
-            .with_translations(c.bottoms)
-            .with_quaternions(c.rotations)
-            .with_colors(c.colors)
-            .with_fill_mode(rerun::FillMode::Solid);
-        if self.named {
-            spheres = spheres
-                .with_labels(self.sphere_labels)
-                .with_show_labels(true);
-            boxes = boxes.with_labels(self.box_labels).with_show_labels(true);
-            capsules = capsules.with_labels(c.labels).with_show_labels(true);
-        }
-        report(rec.log(format!("{path}/spheres"), &spheres));
-        report(rec.log(format!("{path}/boxes"), &boxes));
-        report(rec.log(format!("{path}/capsules"), &capsules));
-    }
-}
 
 type StaticChanged = (
     With<Static>,
