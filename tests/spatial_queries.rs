@@ -13,7 +13,7 @@ use urto::bvh::QueryScratch;
 use urto::geometry::contacts::contact;
 use urto::geometry::{Isometry, MeshCollider, Shape, TriMesh};
 use urto::prelude::*;
-use urto::spatial::{QueryHit, Ray, SpatialIndex, cast_sphere};
+use urto::spatial::{QueryError, QueryHit, Ray, SpatialIndex, cast_sphere};
 
 /// `n` colliders in a 40 m cube — balls, turned boxes, two meshes (a ball and a torus) — and
 /// two half-spaces: a ground below everything and a tilted wall.
@@ -184,6 +184,30 @@ fn box_and_capsule_casts_equal_brute_force_on_300_casts_over_302_colliders() {
             .min_by(|a, b| a.1.distance.total_cmp(&b.1.distance).then(a.0.cmp(&b.0)));
         let first = index.cast_capsule(&*colliders, &capsule, |_| true).unwrap();
         assert_eq!(first.map(|h| (h.id, h.hit)), expected, "capsule cast {k}");
+        if k == 0 {
+            // Unusable sizes are refused, not cast.
+            let bad_box = BoxCast {
+                half_extents: Vec3::new(0.5, f32::NAN, 0.5),
+                ..cast
+            };
+            let refused = index.cast_box(&*colliders, &bad_box, |_| true);
+            assert!(
+                matches!(refused, Err(QueryError::BadSize(_))),
+                "{refused:?}"
+            );
+            let bad_capsule = CapsuleCast {
+                capsule: Capsule {
+                    half_length: 0.5,
+                    radius: -1.0,
+                },
+                ..capsule
+            };
+            let refused = index.cast_capsule(&*colliders, &bad_capsule, |_| true);
+            assert!(
+                matches!(refused, Err(QueryError::BadSize(_))),
+                "{refused:?}"
+            );
+        }
     }
     assert!(found > 100, "{found}");
 }

@@ -55,8 +55,9 @@ pub fn cast_capsule(
     scratch: &mut QueryScratch,
 ) -> Option<CastHit> {
     let r = cast.capsule.radius;
-    let size = cast.capsule.half_length + r + shape.bounding_radius().min(1e3);
-    let tolerance = ADVANCE_TOLERANCE * (1.0 + size);
+    // Relative to the caster: a capsule cast at a kilometre-wide terrain mesh must not stop
+    // metres short of it.
+    let tolerance = ADVANCE_TOLERANCE * (1.0 + cast.capsule.half_length + r);
     // The gap from the capsule's segment to the target's closest points (target, segment).
     let gap_from = |on_target: Vec3, on_axis: Vec3, target_radius: f32| {
         let out = (on_axis - on_target)

@@ -32,6 +32,9 @@ pub enum QueryError {
     BadRadius(f32),
     /// A maximum distance that is negative or NaN.
     BadMaxDistance(f32),
+    /// A cast shape's size that is negative, not finite or above the largest supported: a box's
+    /// half extents, or a capsule's `(half_length, radius, 0)`.
+    BadSize(Vec3),
 }
 
 impl fmt::Display for QueryError {
@@ -41,6 +44,10 @@ impl fmt::Display for QueryError {
             Self::BadDirection(d) => write!(f, "query direction {d} is zero or not finite"),
             Self::BadRadius(r) => write!(f, "cast radius {r} is negative or not finite"),
             Self::BadMaxDistance(m) => write!(f, "maximum distance {m} is negative or NaN"),
+            Self::BadSize(s) => write!(
+                f,
+                "cast shape size {s} is negative, not finite or too large"
+            ),
         }
     }
 }

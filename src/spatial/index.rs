@@ -154,8 +154,11 @@ impl SpatialIndex {
     ) -> Result<Option<QueryHit>, QueryError> {
         let max = check_max_distance(cast.max_distance)?;
         let h = cast.half_extents;
-        if !(cast.pose.is_finite() && h.is_finite() && h.cmpge(Vec3::ZERO).all()) {
+        if !cast.pose.is_finite() {
             return Err(QueryError::NonFiniteOrigin(cast.pose.translation));
+        }
+        if Shape::cuboid(h).validate().is_err() {
+            return Err(QueryError::BadSize(h));
         }
         if !cast.direction.is_normalized() {
             return Err(QueryError::BadDirection(cast.direction));
@@ -180,8 +183,12 @@ impl SpatialIndex {
     ) -> Result<Option<QueryHit>, QueryError> {
         let max = check_max_distance(cast.max_distance)?;
         let shape = Shape::Capsule(cast.capsule);
-        if !cast.pose.is_finite() || shape.validate().is_err() {
+        if !cast.pose.is_finite() {
             return Err(QueryError::NonFiniteOrigin(cast.pose.translation));
+        }
+        if shape.validate().is_err() {
+            let c = cast.capsule;
+            return Err(QueryError::BadSize(Vec3::new(c.half_length, c.radius, 0.0)));
         }
         if !cast.direction.is_normalized() {
             return Err(QueryError::BadDirection(cast.direction));
