@@ -33,7 +33,9 @@ pub fn contact_triangle_capsule(
     if let Some(m) = pierced(tri, p0, p1, radius) {
         return Some(m);
     }
-    let (on_segment, on_triangle) = closest_segment_triangle(tri, p0, p1);
+    // The ends' nearest triangle points serve both the closest pair and the resting points.
+    let feet = [p0, p1].map(|p| tri.closest_point(p));
+    let (on_segment, on_triangle) = closest_segment_triangle(tri, p0, p1, feet);
     let gap = on_segment - on_triangle;
     let dist2 = gap.length_squared();
     if dist2.is_nan() || dist2 > radius * radius {
@@ -56,8 +58,7 @@ pub fn contact_triangle_capsule(
         depth,
     };
     let mut out = ContactManifold::new(normal);
-    for end in [p0, p1] {
-        let foot = tri.closest_point(end);
+    for (end, foot) in [p0, p1].into_iter().zip(feet) {
         let up = end - foot;
         let height = up.dot(normal);
         if height >= OVER_FACE_COSINE * up.length() && height <= radius {
@@ -108,16 +109,17 @@ pub(crate) fn segment_triangle_closest(tri: &Triangle, p0: Vec3, p1: Vec3) -> (V
             let at = p0 + (p1 - p0) * (h0 / (h0 - h1));
             (at, at)
         }
-        None => closest_segment_triangle(tri, p0, p1),
+        None => closest_segment_triangle(tri, p0, p1, [p0, p1].map(|p| tri.closest_point(p))),
     }
 }
 
 /// The closest points `(on the segment, on the triangle)` of a segment that does not cross the
-/// triangle: the nearer of the segment's ends to the triangle and the segment against each edge.
-fn closest_segment_triangle(tri: &Triangle, p0: Vec3, p1: Vec3) -> (Vec3, Vec3) {
+/// triangle: the nearer of the segment's ends to the triangle (`feet`, their nearest triangle
+/// points) and the segment against each edge.
+fn closest_segment_triangle(tri: &Triangle, p0: Vec3, p1: Vec3, feet: [Vec3; 2]) -> (Vec3, Vec3) {
     let segment = Segment { start: p0, end: p1 };
     let [a, b, c] = tri.vertices();
-    let ends = [p0, p1].map(|p| (p, tri.closest_point(p)));
+    let ends = [(p0, feet[0]), (p1, feet[1])];
     let edges = [(a, b), (b, c), (c, a)]
         .map(|(start, end)| closest_segment_points(segment, Segment { start, end }));
     ends.into_iter()
