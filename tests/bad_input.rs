@@ -89,13 +89,31 @@ fn bad_shapes_and_rotations_are_quarantined() {
     let e5 = app.world_mut().spawn(Collider::capsule(f32::NAN, 0.5)).id();
     let e6 = app.world_mut().spawn(Collider::capsule(0.5, -0.1)).id();
     let e7 = app.world_mut().spawn(Collider::capsule(3e6, 0.5)).id();
+    let e8 = app
+        .world_mut()
+        .spawn(Collider::cylinder(f32::NAN, 0.5))
+        .id();
+    let e9 = app.world_mut().spawn(Collider::cylinder(0.5, -1.0)).id();
+    let e10 = app
+        .world_mut()
+        .spawn(Collider::ellipsoid(0.5, f32::INFINITY, 0.5))
+        .id();
+    let e11 = app
+        .world_mut()
+        .spawn(Collider::ellipsoid(0.5, -0.1, 0.5))
+        .id();
+    // A hull is checked when it is built: unusable points are an error, nothing spawns.
+    assert!(Collider::convex_hull(&[Vec3::ZERO, Vec3::X, Vec3::Y]).is_err());
+    assert!(Collider::convex_hull(&[Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::NAN]).is_err());
+    assert!(Collider::convex_hull(&[Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::X + Vec3::Y]).is_err());
+    assert!(Collider::convex_hull_from_file("no/such/hull.obj").is_err());
     // A good capsule next to the bad ones stays good.
     let good = app
         .world_mut()
         .spawn((Collider::capsule(0.5, 0.25), Velocity::default()))
         .id();
     urto::step(app.world_mut(), 1).unwrap();
-    for e in [e1, e2, e3, e4, e5, e6, e7] {
+    for e in [e1, e2, e3, e4, e5, e6, e7, e8, e9, e10, e11] {
         assert!(quarantined(&app, e));
     }
     assert!(!quarantined(&app, good));

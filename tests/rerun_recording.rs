@@ -21,6 +21,14 @@ fn scene(app: &mut App) -> Vec<bevy_ecs::entity::Entity> {
         Position::new(-5.0, 0.0, 0.2),
         Rotation(glam::Quat::from_rotation_x(std::f32::consts::FRAC_PI_2)),
     ));
+    // A cylinder standing and a hull lying far from the balls.
+    app.world_mut()
+        .spawn((Collider::cylinder(0.3, 0.2), Position::new(-5.0, 3.0, 0.3)));
+    let tetra = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
+    app.world_mut().spawn((
+        Collider::convex_hull(&tetra).expect("a tetrahedron"),
+        Position::new(-5.0, -3.0, 0.0),
+    ));
     (0..4)
         .map(|i| {
             let x = i as f32 * 1.5;
@@ -63,6 +71,8 @@ fn recording_holds_the_scene_the_timelines_and_the_metrics() {
         "/world",
         "/world/bodies/spheres",
         "/world/bodies/capsules",
+        "/world/bodies/cylinders",
+        "/world/bodies/hulls",
         "/world/static/boxes",
         "/world/bounding_volumes",
         "/world/velocities",

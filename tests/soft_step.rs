@@ -226,6 +226,68 @@ fn a_stool_of_a_box_seat_and_four_capsule_legs_lands_upright_level_within_1_cm()
 }
 
 #[test]
+fn a_chair_of_cylinder_legs_and_a_hull_from_a_mesh_file_land_and_rest_within_1_cm() {
+    let mut app = soft_step_app_on_ground();
+    // A box seat with four cylinder legs (0.7 m tall), parts of one body, dropped tilted.
+    let chair = app
+        .world_mut()
+        .spawn((
+            Collider::cuboid(0.3, 0.3, 0.04),
+            Position::new(0.0, 0.0, 1.2),
+            Rotation(Quat::from_rotation_x(0.2) * Quat::from_rotation_y(-0.15)),
+            Velocity::default(),
+            Mass(4.0),
+        ))
+        .id();
+    for (x, y) in [
+        (-0.25f32, -0.25f32),
+        (0.25, -0.25),
+        (-0.25, 0.25),
+        (0.25, 0.25),
+    ] {
+        app.world_mut().spawn((
+            Collider::cylinder(0.35, 0.04),
+            Position::new(x, y, -0.39),
+            ChildOf(chair),
+        ));
+    }
+    // The hull of a scanned nut's vertices (in millimetres, far from its origin: moved to its
+    // box's centre and scaled to 0.3 m), dropped beside it.
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/nut.ply");
+    let urto::geometry::Shape::ConvexHull(raw) =
+        Collider::convex_hull_from_file(&path).unwrap().shape
+    else {
+        panic!("a hull")
+    };
+    let centre = raw.local_aabb().center();
+    let scale = 0.3 / raw.local_aabb().half_extents().max_element();
+    let points: Vec<Vec3> = raw
+        .vertices()
+        .iter()
+        .map(|v| (*v - centre) * scale)
+        .collect();
+    let hull = Collider::convex_hull(&points).expect("the nut's hull");
+    let nut = app
+        .world_mut()
+        .spawn((hull, Position::new(3.0, 0.0, 2.0), Velocity::default()))
+        .id();
+    urto::step(app.world_mut(), 360).unwrap();
+    let up = get::<Rotation>(&app, chair).0 * Vec3::Z;
+    let z = get::<Position>(&app, chair).0.z;
+    assert!(up.z > 0.999, "the seat is not level: {up}");
+    assert!((z - 0.74).abs() < 0.01, "the seat's centre is at {z} m");
+    let bottom = get::<BoundingVolume>(&app, nut).0.min.z;
+    assert!(
+        bottom.abs() < 0.01,
+        "the nut's lowest point is at {bottom} m"
+    );
+    assert!(
+        get::<Velocity>(&app, nut).0.length() < 0.01,
+        "the nut still moves"
+    );
+}
+
+#[test]
 fn with_the_soft_step_unusable_settings_fall_back_to_the_defaults_and_a_box_still_rests_within_1_cm()
  {
     let bad = SoftStepSettings {

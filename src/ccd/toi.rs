@@ -1,8 +1,8 @@
 //! The answer of a time-of-impact query, and the dispatch of a sweep against any [`Shape`].
 
 use super::{
-    SphereSweep, toi_sphere_capsule, toi_sphere_cuboid, toi_sphere_halfspace, toi_sphere_sphere,
-    toi_sphere_trimesh,
+    SphereSweep, toi_sphere_capsule, toi_sphere_convex, toi_sphere_cuboid, toi_sphere_halfspace,
+    toi_sphere_sphere, toi_sphere_trimesh,
 };
 use crate::bvh::QueryScratch;
 use crate::geometry::{Isometry, Shape};
@@ -43,6 +43,9 @@ pub fn toi_sphere_shape(
         Shape::Cuboid(c) => toi_sphere_cuboid(sweep, pose, c),
         Shape::HalfSpace(h) => toi_sphere_halfspace(sweep, pose, h),
         Shape::Capsule(c) => toi_sphere_capsule(sweep, pose, c),
+        Shape::Cylinder(_) | Shape::Ellipsoid(_) | Shape::ConvexHull(_) => {
+            toi_sphere_convex(sweep, shape, pose)
+        }
         Shape::TriMesh(m) => toi_sphere_trimesh(sweep, m.mesh(), m.bvh(), pose, scratch)
             .0
             .map(|hit| hit.toi),

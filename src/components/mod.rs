@@ -37,7 +37,8 @@ pub(crate) use sleeping::SleepTransitions;
 pub use sleeping::{SleepState, Sleeping, SleepingIslands};
 
 use crate::bounding::Aabb;
-use crate::geometry::{Isometry, MeshCollider, MeshColliderError, Shape, TriMesh};
+use crate::geometry::convex::HullFileError;
+use crate::geometry::{HullError, Isometry, MeshCollider, MeshColliderError, Shape, TriMesh};
 pub use crate::spatial::{LayerMask, Layers};
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
@@ -195,6 +196,36 @@ impl Collider {
         Self {
             shape: Shape::capsule(half_length, radius),
         }
+    }
+
+    /// A solid cylinder along the body's local z axis (standing when unrotated): caps
+    /// `half_height` from the centre, and `radius`. Wheels, barrels, pillars.
+    pub fn cylinder(half_height: f32, radius: f32) -> Self {
+        Self {
+            shape: Shape::cylinder(half_height, radius),
+        }
+    }
+
+    /// A solid ellipsoid of semi-axes `rx`, `ry`, `rz` along the body's local axes.
+    pub fn ellipsoid(rx: f32, ry: f32, rz: f32) -> Self {
+        Self {
+            shape: Shape::ellipsoid(Vec3::new(rx, ry, rz)),
+        }
+    }
+
+    /// The convex hull of `points` (in the body's frame), built once here by quickhull. Errors:
+    /// fewer than 4 points, non-finite or oversized ones, or all of them (nearly) coplanar.
+    pub fn convex_hull(points: &[Vec3]) -> Result<Self, HullError> {
+        Shape::convex_hull(points).map(|shape| Self { shape })
+    }
+
+    /// The convex hull of the vertices of an OBJ, STL or PLY file (chosen by extension): the
+    /// usual way to give a detailed prop a cheap dynamic collider.
+    pub fn convex_hull_from_file(path: impl AsRef<std::path::Path>) -> Result<Self, HullFileError> {
+        let hull = crate::geometry::convex::hull_from_file(path)?;
+        Ok(Self {
+            shape: Shape::ConvexHull(std::sync::Arc::new(hull)),
+        })
     }
 
     /// The solid below a plane through the body's position with outward `normal` (a ground).

@@ -6,6 +6,9 @@
 //!   split into two caps. About the axis `I_zz = m_c r²/2 + 2/5 m_b r²`; across it each cap is a
 //!   half ball whose centre sits `3r/8` beyond its flat face, moved to the capsule's centre by the
 //!   parallel-axis theorem, which sums to `I_xx = m_c (r²/4 + h²/3) + m_b (2/5 r² + h² + 3/4 h r)`.
+//! - **Cylinder** (along z) and **ellipsoid**: closed forms, `I_zz = m r²/2`,
+//!   `I_xx = m (3r² + L²)/12` and `I_xx = m (b² + c²)/5`. A **convex hull** is integrated as the
+//!   closed mesh of its faces (next item).
 //! - **Closed triangle meshes**: the volume integrals of Mirtich ("Fast and Accurate Computation
 //!   of Polyhedral Mass Properties", 1996) in the form of Eberly ("Polyhedral Mass Properties
 //!   (Revisited)", 2002): the divergence theorem turns the ten integrals of `1, x, y, z, x², y²,
@@ -29,7 +32,7 @@
 //! convention (off-diagonal entries are `−∫ρ xy`).
 
 use crate::bounding::symmetric_eigen::symmetric_eigen;
-use crate::geometry::{Isometry, Shape, TriMesh};
+use crate::geometry::{ConvexHull, Isometry, Shape, TriMesh};
 use glam::{DMat3, DQuat, DVec3, Mat3, Quat, Vec3};
 
 /// Mass, centre of mass and inertia tensor (about the centre of mass, in the shape's local axes).
@@ -123,6 +126,36 @@ impl MassProperties {
             cylinder * (r * r / 4.0 + h * h / 3.0) + ball * (0.4 * r * r + h * h + 0.75 * h * r);
         let tensor = DMat3::from_diagonal(DVec3::new(across, across, axial));
         Self::from_f64(cylinder + ball, DVec3::ZERO, tensor)
+    }
+
+    /// A solid cylinder along z of `half_height`, `radius` and `density` (kg/m³), centred on
+    /// the origin: `I_z = m r²/2`, `I_x = I_y = m (3r² + (2h)²)/12`.
+    pub fn cylinder(half_height: f32, radius: f32, density: f32) -> Self {
+        let (h, r) = (half_height as f64, radius as f64);
+        let mass = std::f64::consts::PI * r * r * 2.0 * h * density as f64;
+        let across = mass * (3.0 * r * r + 4.0 * h * h) / 12.0;
+        let tensor = DMat3::from_diagonal(DVec3::new(across, across, mass * r * r / 2.0));
+        Self::from_f64(mass, DVec3::ZERO, tensor)
+    }
+
+    /// A solid ellipsoid of semi-axes `radii` and `density` (kg/m³), centred on the origin:
+    /// `m = 4/3 π abc ρ`, `I_x = m (b² + c²)/5` and so on.
+    pub fn ellipsoid(radii: Vec3, density: f32) -> Self {
+        let r = radii.as_dvec3();
+        let mass = 4.0 / 3.0 * std::f64::consts::PI * r.x * r.y * r.z * density as f64;
+        let s = r * r;
+        let moments = DVec3::new(s.y + s.z, s.z + s.x, s.x + s.y) * (mass / 5.0);
+        Self::from_f64(mass, DVec3::ZERO, DMat3::from_diagonal(moments))
+    }
+
+    /// A solid convex hull at `density` (kg/m³): its faces fanned into a closed mesh and
+    /// integrated as one (Mirtich 1996, as [`trimesh`](Self::trimesh)).
+    pub fn convex_hull(hull: &ConvexHull, density: f32) -> Self {
+        match hull.to_trimesh() {
+            Ok(mesh) => Self::trimesh(&mesh, density),
+            // A built hull always has faces; keep the promise of no panic regardless.
+            Err(_) => Self::ZERO,
+        }
     }
 
     /// A triangle mesh at `density` (kg/m³): the enclosed solid if the mesh is closed and has
@@ -239,14 +272,17 @@ impl MassProperties {
 }
 
 impl Shape {
-    /// Mass properties at `density` (kg/m³): sphere, cuboid, capsule, half-space (infinite), triangle
-    /// mesh (solid if closed, else a thin shell: see [`MassProperties::trimesh`]).
+    /// Mass properties at `density` (kg/m³): sphere, cuboid, capsule, cylinder, ellipsoid,
+    /// convex hull, half-space (infinite), triangle mesh (solid if closed, else a thin shell: see [`MassProperties::trimesh`]).
     pub fn mass_properties(&self, density: f32) -> MassProperties {
         match self {
             Self::Sphere(s) => MassProperties::sphere(s.radius, density),
             Self::Cuboid(c) => MassProperties::cuboid(c.half_extents, density),
             Self::HalfSpace(_) => MassProperties::infinite(),
             Self::Capsule(c) => MassProperties::capsule(c.half_length, c.radius, density),
+            Self::Cylinder(c) => MassProperties::cylinder(c.half_height, c.radius, density),
+            Self::Ellipsoid(e) => MassProperties::ellipsoid(e.radii, density),
+            Self::ConvexHull(h) => MassProperties::convex_hull(h, density),
             Self::TriMesh(m) => MassProperties::trimesh(m.mesh(), density),
         }
     }

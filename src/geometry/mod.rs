@@ -4,6 +4,8 @@
 pub mod active_edges;
 mod contact;
 pub mod contacts;
+pub mod convex;
+mod convex_hull;
 mod isometry;
 mod mass_properties;
 mod mesh_collider;
@@ -17,6 +19,7 @@ mod trimesh;
 mod weld;
 
 pub use contact::{ContactManifold, ContactPoint, MAX_MANIFOLD_POINTS};
+pub use convex_hull::{ConvexHull, HullError, HullFace};
 pub use isometry::Isometry;
 pub use mass_properties::MassProperties;
 pub use mesh_collider::{MeshCollider, MeshColliderError};

@@ -1,14 +1,17 @@
 //! Collision shapes in their local frames: the slides' closed-form shapes (sphere, plane),
 //! the box that OBB tests and games both need, the capsule that game characters and limbs are
 //! made of (a sphere swept along a segment: every closed-form sphere test becomes a segment
-//! test), and triangle meshes with their hierarchy.
+//! test), the cylinder and ellipsoid of props and wheels, convex hulls, and triangle meshes with
+//! their hierarchy. Cylinders, ellipsoids and hulls collide through their support functions
+//! (GJK and EPA, [`crate::geometry::convex`]); the others keep their closed forms.
 //!
 //! A shape never stores its pose: the pose comes with every query (see [`Isometry`]).
 
 use crate::bounding::Aabb;
-use crate::geometry::{Isometry, MeshCollider};
+use crate::geometry::{ConvexHull, Isometry, MeshCollider};
 use glam::Vec3;
 use std::fmt;
+use std::sync::Arc;
 
 /// A ball of `radius` centred on the local origin.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -44,6 +47,24 @@ impl Capsule {
     }
 }
 
+/// A solid cylinder along the local **z** axis (as [`Capsule`]): its flat caps at
+/// `z = ±half_height`, its side at `radius` from the axis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cylinder {
+    /// Half the height, from the centre to each cap, `>= 0`.
+    pub half_height: f32,
+    /// Radius of the caps, `>= 0`.
+    pub radius: f32,
+}
+
+/// A solid ellipsoid centred on the local origin with semi-axes `radii` along the local axes:
+/// the slides' closed-form quadric `(x/a)² + (y/b)² + (z/c)² <= 1`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ellipsoid {
+    /// Semi-axes along local x, y, z; each `>= 0`.
+    pub radii: Vec3,
+}
+
 /// The solid half-space below a plane through the local origin: points `x` with `normal·x <= 0`.
 ///
 /// Used for grounds and walls: the body is unbounded, so it is always static and never enters the
@@ -65,6 +86,12 @@ pub enum Shape {
     HalfSpace(HalfSpace),
     /// See [`Capsule`].
     Capsule(Capsule),
+    /// See [`Cylinder`].
+    Cylinder(Cylinder),
+    /// See [`Ellipsoid`].
+    Ellipsoid(Ellipsoid),
+    /// A convex polyhedron; see [`ConvexHull`]. Cheap to clone (shared).
+    ConvexHull(Arc<ConvexHull>),
     /// A triangle mesh (a surface: open meshes are fine) with its hierarchy; see
     /// [`MeshCollider`]. Cheap to clone (shared).
     TriMesh(MeshCollider),
@@ -86,8 +113,10 @@ pub enum ShapeError {
     BadHalfExtents(Vec3),
     /// A plane normal that is zero, NaN or infinite.
     BadNormal(Vec3),
-    /// A capsule's half length that is negative, NaN or infinite.
+    /// A capsule's half length or a cylinder's half height that is negative, NaN or infinite.
     BadLength(f32),
+    /// Ellipsoid semi-axes with a negative, NaN or infinite component.
+    BadRadii(Vec3),
 }
 
 impl fmt::Display for ShapeError {
@@ -98,9 +127,11 @@ impl fmt::Display for ShapeError {
                 write!(f, "box half extents must be finite and >= 0, got {h}")
             }
             Self::BadNormal(n) => write!(f, "plane normal must be finite and non-zero, got {n}"),
-            Self::BadLength(l) => {
-                write!(f, "capsule half length must be finite and >= 0, got {l}")
-            }
+            Self::BadLength(l) => write!(
+                f,
+                "capsule half length and cylinder half height must be finite and >= 0, got {l}"
+            ),
+            Self::BadRadii(r) => write!(f, "ellipsoid radii must be finite and >= 0, got {r}"),
             Self::TooLarge(x) => write!(
                 f,
                 "shape size {x} m is above the largest supported, {MAX_SHAPE_EXTENT} m (use a \
@@ -132,6 +163,24 @@ impl Shape {
         })
     }
 
+    /// A cylinder along local z: `half_height` from its centre to each cap, and `radius`.
+    pub fn cylinder(half_height: f32, radius: f32) -> Self {
+        Self::Cylinder(Cylinder {
+            half_height,
+            radius,
+        })
+    }
+
+    /// An ellipsoid of semi-axes `radii` along the local axes.
+    pub fn ellipsoid(radii: Vec3) -> Self {
+        Self::Ellipsoid(Ellipsoid { radii })
+    }
+
+    /// The convex hull of `points` (see [`ConvexHull::from_points`] for what is refused).
+    pub fn convex_hull(points: &[Vec3]) -> Result<Self, crate::geometry::HullError> {
+        Ok(Self::ConvexHull(Arc::new(ConvexHull::from_points(points)?)))
+    }
+
     /// The half-space below the plane of outward `normal` (normalised here, after scaling by
     /// its largest component so that huge or tiny finite normals normalise too; a zero or
     /// non-finite normal is kept as is and refused by [`Shape::validate`]).
@@ -145,11 +194,13 @@ impl Shape {
         })
     }
 
-    /// Checks that the shape's numbers describe a real shape. Meshes are validated when their
-    /// [`MeshCollider`] is built, so they always pass.
+    /// Checks that the shape's numbers describe a real shape. Meshes and hulls are validated
+    /// when they are built, so they always pass.
     pub fn validate(&self) -> Result<(), ShapeError> {
         match self {
-            Self::Sphere(Sphere { radius }) | Self::Capsule(Capsule { radius, .. })
+            Self::Sphere(Sphere { radius })
+            | Self::Capsule(Capsule { radius, .. })
+            | Self::Cylinder(Cylinder { radius, .. })
                 if !(radius.is_finite() && *radius >= 0.0) =>
             {
                 Err(ShapeError::BadRadius(*radius))
@@ -159,6 +210,18 @@ impl Shape {
             }
             Self::Capsule(c) if c.half_length.max(c.radius) > MAX_SHAPE_EXTENT => {
                 Err(ShapeError::TooLarge(c.half_length.max(c.radius)))
+            }
+            Self::Cylinder(c) if !(c.half_height.is_finite() && c.half_height >= 0.0) => {
+                Err(ShapeError::BadLength(c.half_height))
+            }
+            Self::Cylinder(c) if c.half_height.max(c.radius) > MAX_SHAPE_EXTENT => {
+                Err(ShapeError::TooLarge(c.half_height.max(c.radius)))
+            }
+            Self::Ellipsoid(e) if !(e.radii.is_finite() && e.radii.cmpge(Vec3::ZERO).all()) => {
+                Err(ShapeError::BadRadii(e.radii))
+            }
+            Self::Ellipsoid(e) if e.radii.max_element() > MAX_SHAPE_EXTENT => {
+                Err(ShapeError::TooLarge(e.radii.max_element()))
             }
             Self::Cuboid(c)
                 if !(c.half_extents.is_finite() && c.half_extents.cmpge(Vec3::ZERO).all()) =>
@@ -197,6 +260,37 @@ impl Shape {
                 let (bottom, top) = c.segment(pose);
                 Aabb::new(bottom.min(top), bottom.max(top)).expanded(c.radius)
             }
+            Self::Cylinder(c) => {
+                // The caps' circles: along world axis i a circle of radius r around the axis `a`
+                // reaches r·sqrt(1 - a_i²).
+                let axis = pose.rotation * Vec3::Z;
+                let rim = (Vec3::ONE - axis * axis).max(Vec3::ZERO).sqrt() * c.radius;
+                let half = axis.abs() * c.half_height + rim;
+                Aabb::from_center_half_extents(pose.translation, half)
+            }
+            Self::Ellipsoid(e) => {
+                // Row i of R·diag(radii) has length sqrt(Σ_j (R_ij r_j)²): the support along
+                // world axis i.
+                let m = pose.rotation_matrix();
+                let scaled = [
+                    m.x_axis * e.radii.x,
+                    m.y_axis * e.radii.y,
+                    m.z_axis * e.radii.z,
+                ];
+                let half =
+                    (scaled[0] * scaled[0] + scaled[1] * scaled[1] + scaled[2] * scaled[2]).sqrt();
+                Aabb::from_center_half_extents(pose.translation, half)
+            }
+            Self::ConvexHull(h) => {
+                let m = pose.rotation_matrix();
+                let (lo, hi) = h
+                    .vertices()
+                    .iter()
+                    .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &v| {
+                        (lo.min(m * v), hi.max(m * v))
+                    });
+                Aabb::new(lo + pose.translation, hi + pose.translation)
+            }
             Self::TriMesh(m) => m.world_aabb(pose),
         }
     }
@@ -208,6 +302,9 @@ impl Shape {
             Self::Cuboid(c) => c.half_extents.length(),
             Self::HalfSpace(_) => f32::INFINITY,
             Self::Capsule(c) => c.half_length + c.radius,
+            Self::Cylinder(c) => c.half_height.hypot(c.radius),
+            Self::Ellipsoid(e) => e.radii.max_element(),
+            Self::ConvexHull(h) => h.bounding_radius(),
             Self::TriMesh(m) => m.bounding_radius(),
         }
     }

@@ -21,6 +21,7 @@ use super::cast::{CastHit, Ray, cast_at_plane};
 use crate::bvh::QueryScratch;
 use crate::ccd::{SphereSweep, toi_sphere_shape};
 use crate::geometry::contacts::closest_segment_box;
+use crate::geometry::convex::signed_distance;
 use crate::geometry::{Capsule, HalfSpace, Isometry, MeshCollider, Shape, Sphere};
 use glam::{Mat3, Vec3};
 use std::cell::Cell;
@@ -76,8 +77,40 @@ pub fn cast_box(
             against_plane(lowest, 0.0, motion, target, h)
         }
         Shape::Capsule(c) => against_capsule(cast, target, c),
+        Shape::Cylinder(_) | Shape::Ellipsoid(_) | Shape::ConvexHull(_) => {
+            let me = Shape::cuboid(cast.half_extents);
+            let motion = (cast.direction, cast.max_distance);
+            against_convex((&me, &cast.pose), motion, (shape, target))
+        }
         Shape::TriMesh(m) => against_mesh(cast, target, m, scratch),
     }
+}
+
+/// A convex caster (`shape` at `pose`, moving along the unit `direction` for at most `max`)
+/// against a convex target: conservative advancement on their GJK/EPA signed distance. A pair
+/// with no defined distance (two flat shapes in one plane) counts as touching where it is.
+pub(crate) fn against_convex(
+    (shape, pose): (&Shape, &Isometry),
+    (direction, max): (Vec3, f32),
+    (target, at): (&Shape, &Isometry),
+) -> Option<CastHit> {
+    let reach = shape.bounding_radius() + target.bounding_radius();
+    let tolerance = ADVANCE_TOLERANCE * (1.0 + reach);
+    advance(max, tolerance, |t| {
+        let moved = Isometry::new(pose.translation + direction * t, pose.rotation);
+        match signed_distance(target, at, shape, &moved) {
+            Some(d) => Gap {
+                distance: d.distance,
+                on_target: d.on_a,
+                normal: d.normal,
+            },
+            None => Gap {
+                distance: 0.0,
+                on_target: moved.translation,
+                normal: -direction,
+            },
+        }
+    })
 }
 
 fn box_corners(pose: &Isometry, h: Vec3) -> [Vec3; 8] {

@@ -13,7 +13,9 @@
 //! or overlapping hits at distance 0, the normal points out of the target towards the capsule,
 //! meshes are two-sided surfaces.
 
-use super::box_cast::{ADVANCE_TOLERANCE, Gap, advance, against_ball, against_plane};
+use super::box_cast::{
+    ADVANCE_TOLERANCE, Gap, advance, against_ball, against_convex, against_plane,
+};
 use super::cast::CastHit;
 use crate::bvh::QueryScratch;
 use crate::geometry::contacts::{
@@ -104,6 +106,11 @@ pub fn cast_capsule(
                 );
                 gap_from(on_other, on_axis, other.radius)
             })
+        }
+        Shape::Cylinder(_) | Shape::Ellipsoid(_) | Shape::ConvexHull(_) => {
+            let me = Shape::Capsule(cast.capsule);
+            let motion = (cast.direction, cast.max_distance);
+            against_convex((&me, &cast.pose), motion, (shape, target))
         }
         Shape::TriMesh(m) => advance(cast.max_distance, tolerance, |t| {
             let (a, b) = cast.segment_at(t);

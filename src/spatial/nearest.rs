@@ -6,6 +6,7 @@
 
 use crate::bvh::QueryScratch;
 use crate::geometry::contacts::closest_point_on_segment;
+use crate::geometry::convex::signed_distance;
 use crate::geometry::{Isometry, MeshCollider, Shape};
 use glam::Vec3;
 use std::cell::Cell;
@@ -78,6 +79,13 @@ pub fn nearest_point(
                 d <= c.radius,
                 on_axis + out * (c.radius / d.max(f32::MIN_POSITIVE)),
             )
+        }
+        Shape::Cylinder(_) | Shape::Ellipsoid(_) | Shape::ConvexHull(_) => {
+            let probe = Isometry::from_translation(local);
+            match signed_distance(shape, &Isometry::IDENTITY, &Shape::sphere(0.0), &probe) {
+                Some(d) => solid(d.distance <= 0.0, d.on_a),
+                None => solid(false, local),
+            }
         }
         Shape::TriMesh(m) => {
             let nearest = nearest_on_mesh(m, local, scratch);

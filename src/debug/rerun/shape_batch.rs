@@ -1,5 +1,6 @@
-//! Spheres, boxes, capsules and half-spaces of one group of bodies gathered into one batch per
-//! rerun archetype (`Ellipsoids3D`, `Boxes3D`, `Capsules3D`), so a step logs three entities
+//! Spheres, ellipsoids, boxes, capsules, cylinders, hulls and half-spaces of one group of bodies
+//! gathered into one batch per rerun archetype (`Ellipsoids3D`, `Boxes3D`, `Capsules3D`,
+//! `Cylinders3D`, and `LineStrips3D` for the hulls' face outlines), so a step logs five entities
 //! however many bodies it draws.
 
 use super::{arr, quat, report};
@@ -13,7 +14,8 @@ use rerun::RecordingStream;
 #[derive(Default)]
 pub(super) struct ShapeBatch {
     sphere_centers: Vec<[f32; 3]>,
-    sphere_radii: Vec<f32>,
+    sphere_half_sizes: Vec<[f32; 3]>,
+    sphere_rotations: Vec<rerun::Quaternion>,
     sphere_colors: Vec<rerun::Color>,
     sphere_labels: Vec<String>,
     box_centers: Vec<[f32; 3]>,
@@ -22,10 +24,14 @@ pub(super) struct ShapeBatch {
     box_colors: Vec<rerun::Color>,
     box_labels: Vec<String>,
     capsules: CapsuleBatch,
+    cylinders: CapsuleBatch,
+    hull_strips: Vec<Vec<[f32; 3]>>,
+    hull_colors: Vec<rerun::Color>,
     named: bool,
 }
 
-/// Capsules as rerun draws them: from the bottom cap's centre along the rotated +z.
+/// Capsules as rerun draws them (from the bottom cap's centre along the rotated +z), or
+/// cylinders (from their centres).
 #[derive(Default)]
 struct CapsuleBatch {
     bottoms: Vec<[f32; 3]>,
@@ -51,12 +57,8 @@ impl ShapeBatch {
         let label = label.map_or(String::new(), |n| n.as_str().to_owned());
         self.named |= !label.is_empty();
         match shape {
-            Shape::Sphere(s) => {
-                self.sphere_centers.push(arr(p));
-                self.sphere_radii.push(s.radius);
-                self.sphere_colors.push(color);
-                self.sphere_labels.push(label);
-            }
+            Shape::Sphere(s) => self.push_ellipsoid(p, Vec3::splat(s.radius), r, color, label),
+            Shape::Ellipsoid(e) => self.push_ellipsoid(p, e.radii, r, color, label),
             Shape::Cuboid(c) => self.push_box(p, c.half_extents, r, color, label),
             Shape::Capsule(c) => {
                 let batch = &mut self.capsules;
@@ -76,7 +78,35 @@ impl ShapeBatch {
             }
             // Meshes have their own entities (`record_meshes`).
             Shape::TriMesh(_) => {}
+            Shape::Cylinder(c) => {
+                let batch = &mut self.cylinders;
+                batch.bottoms.push(arr(p));
+                batch.lengths.push(2.0 * c.half_height);
+                batch.radii.push(c.radius);
+                batch.rotations.push(quat(r));
+                batch.colors.push(color);
+                batch.labels.push(label);
+            }
+            Shape::ConvexHull(h) => {
+                for face in 0..h.faces().len() {
+                    let mut strip: Vec<[f32; 3]> =
+                        h.face_polygon(face).map(|v| arr(p + r * v)).collect();
+                    if let Some(&first) = strip.first() {
+                        strip.push(first);
+                    }
+                    self.hull_strips.push(strip);
+                    self.hull_colors.push(color);
+                }
+            }
         }
+    }
+
+    fn push_ellipsoid(&mut self, p: Vec3, half: Vec3, r: Quat, color: rerun::Color, label: String) {
+        self.sphere_centers.push(arr(p));
+        self.sphere_half_sizes.push(arr(half));
+        self.sphere_rotations.push(quat(r));
+        self.sphere_colors.push(color);
+        self.sphere_labels.push(label);
     }
 
     fn push_box(&mut self, p: Vec3, half: Vec3, r: Quat, color: rerun::Color, label: String) {
@@ -88,10 +118,13 @@ impl ShapeBatch {
     }
 
     pub(super) fn log(self, rec: &RecordingStream, path: &str) {
-        let mut spheres =
-            rerun::Ellipsoids3D::from_centers_and_radii(self.sphere_centers, self.sphere_radii)
-                .with_colors(self.sphere_colors)
-                .with_fill_mode(rerun::FillMode::Solid);
+        let mut spheres = rerun::Ellipsoids3D::from_centers_and_half_sizes(
+            self.sphere_centers,
+            self.sphere_half_sizes,
+        )
+        .with_quaternions(self.sphere_rotations)
+        .with_colors(self.sphere_colors)
+        .with_fill_mode(rerun::FillMode::Solid);
         let mut boxes =
             rerun::Boxes3D::from_centers_and_half_sizes(self.box_centers, self.box_half_sizes)
                 .with_quaternions(self.box_rotations)
@@ -103,7 +136,15 @@ impl ShapeBatch {
             .with_quaternions(c.rotations)
             .with_colors(c.colors)
             .with_fill_mode(rerun::FillMode::Solid);
+        let y = self.cylinders;
+        let mut cylinders = rerun::Cylinders3D::from_lengths_and_radii(y.lengths, y.radii)
+            .with_centers(y.bottoms)
+            .with_quaternions(y.rotations)
+            .with_colors(y.colors)
+            .with_fill_mode(rerun::FillMode::Solid);
+        let hulls = rerun::LineStrips3D::new(self.hull_strips).with_colors(self.hull_colors);
         if self.named {
+            cylinders = cylinders.with_labels(y.labels).with_show_labels(true);
             spheres = spheres
                 .with_labels(self.sphere_labels)
                 .with_show_labels(true);
@@ -113,5 +154,7 @@ impl ShapeBatch {
         report(rec.log(format!("{path}/spheres"), &spheres));
         report(rec.log(format!("{path}/boxes"), &boxes));
         report(rec.log(format!("{path}/capsules"), &capsules));
+        report(rec.log(format!("{path}/cylinders"), &cylinders));
+        report(rec.log(format!("{path}/hulls"), &hulls));
     }
 }

@@ -13,6 +13,7 @@ const DT: f32 = 1.0 / 60.0;
 const MARGIN: f32 = 0.02;
 
 mod capsules;
+mod convex;
 mod ghost_edges;
 mod joints;
 

@@ -49,6 +49,7 @@ mod capsule_cuboid;
 mod capsule_halfspace;
 mod capsule_sphere;
 mod closest_segment_points;
+mod convex_convex;
 mod cuboid_cuboid;
 mod cuboid_halfspace;
 mod manifold_cache;
@@ -64,6 +65,7 @@ mod triangle_capsule;
 mod triangle_cuboid;
 mod triangle_distance;
 mod trimesh_capsule;
+mod trimesh_convex;
 mod trimesh_cuboid;
 mod trimesh_halfspace;
 mod trimesh_sphere;
@@ -77,6 +79,7 @@ pub use capsule_sphere::contact_capsule_sphere;
 pub(crate) use closest_segment_points::{
     Segment, closest_point_on_segment, closest_segment_points,
 };
+pub(crate) use convex_convex::{contact_convex_convex, contact_convex_halfspace};
 pub use cuboid_cuboid::contact_cuboid_cuboid;
 pub use cuboid_halfspace::contact_cuboid_halfspace;
 pub use manifold_cache::{MAX_SHIFT, ManifoldCache};
@@ -90,6 +93,7 @@ pub(crate) use triangle_capsule::segment_triangle_closest;
 pub use triangle_cuboid::{contact_triangle_cuboid, contact_triangle_cuboid_with_edges};
 pub use triangle_distance::closest_points_triangle_triangle;
 pub use trimesh_capsule::contact_trimesh_capsule;
+pub(crate) use trimesh_convex::contact_trimesh_convex;
 pub use trimesh_cuboid::contact_trimesh_cuboid;
 pub use trimesh_halfspace::contact_trimesh_halfspace;
 pub use trimesh_sphere::contact_trimesh_sphere;
@@ -141,7 +145,8 @@ pub fn contact(
     b: &Shape,
     pose_b: &Isometry,
 ) -> Option<ContactManifold> {
-    if matches!(a, Shape::TriMesh(_)) || matches!(b, Shape::TriMesh(_)) {
+    let needs_scratch = |s: &Shape| matches!(s, Shape::TriMesh(_)) || is_general_convex(s);
+    if needs_scratch(a) || needs_scratch(b) {
         contact_with_scratch(a, pose_a, b, pose_b, &mut ContactScratch::new())
     } else {
         primitive_contact(a, pose_a, b, pose_b)
@@ -158,6 +163,9 @@ pub fn contact_with_scratch(
     pose_b: &Isometry,
     scratch: &mut ContactScratch,
 ) -> Option<ContactManifold> {
+    if let Some(m) = general_convex_contact(a, pose_a, b, pose_b, 0.0, scratch) {
+        return m;
+    }
     use Shape::*;
     match (a, b) {
         (TriMesh(m), Sphere(s)) => {
@@ -205,6 +213,77 @@ fn primitive_contact(
             primitive_contact(b, pose_b, a, pose_a).map(ContactManifold::flipped)
         }
         (HalfSpace(_), HalfSpace(_)) | (TriMesh(_), _) | (_, TriMesh(_)) => None,
+        (Cylinder(_) | Ellipsoid(_) | ConvexHull(_), _)
+        | (_, Cylinder(_) | Ellipsoid(_) | ConvexHull(_)) => None,
+    }
+}
+
+/// Shapes that collide only through GJK/EPA (no closed form).
+pub(crate) fn is_general_convex(shape: &Shape) -> bool {
+    matches!(
+        shape,
+        Shape::Cylinder(_) | Shape::Ellipsoid(_) | Shape::ConvexHull(_)
+    )
+}
+
+/// The contact of a pair involving a cylinder, ellipsoid or hull, with a speculative `margin`
+/// (0: touching or overlapping only); `None` (the outer one) for the other pairs, which have
+/// closed forms. Two convex shapes are taken in a canonical order (kind, then pose), so that
+/// swapping the arguments flips the normal and keeps the depths bit for bit.
+pub(crate) fn general_convex_contact(
+    a: &Shape,
+    pose_a: &Isometry,
+    b: &Shape,
+    pose_b: &Isometry,
+    margin: f32,
+    scratch: &mut ContactScratch,
+) -> Option<Option<ContactManifold>> {
+    if !(is_general_convex(a) || is_general_convex(b)) {
+        return None;
+    }
+    Some(match (a, b) {
+        (Shape::TriMesh(m), _) => contact_trimesh_convex((pose_a, m), (pose_b, b), margin, scratch),
+        (_, Shape::TriMesh(m)) => {
+            let found = contact_trimesh_convex((pose_b, m), (pose_a, a), margin, scratch);
+            scratch.flip_hits();
+            found.map(ContactManifold::flipped)
+        }
+        (_, Shape::HalfSpace(h)) => {
+            scratch.begin_query();
+            contact_convex_halfspace(a, pose_a, h, pose_b, margin)
+        }
+        (Shape::HalfSpace(h), _) => {
+            scratch.begin_query();
+            contact_convex_halfspace(b, pose_b, h, pose_a, margin).map(ContactManifold::flipped)
+        }
+        _ => {
+            scratch.begin_query();
+            if canonical_swap(a, pose_a, b, pose_b) {
+                contact_convex_convex(b, pose_b, a, pose_a, margin).map(ContactManifold::flipped)
+            } else {
+                contact_convex_convex(a, pose_a, b, pose_b, margin)
+            }
+        }
+    })
+}
+
+/// True when `(b, a)` comes first in the canonical order of convex pairs: by kind, then by pose.
+fn canonical_swap(a: &Shape, pose_a: &Isometry, b: &Shape, pose_b: &Isometry) -> bool {
+    let rank = |s: &Shape| match s {
+        Shape::Sphere(_) => 0,
+        Shape::Capsule(_) => 1,
+        Shape::Cuboid(_) => 2,
+        Shape::Cylinder(_) => 3,
+        Shape::Ellipsoid(_) => 4,
+        _ => 5,
+    };
+    let key = |p: &Isometry| {
+        let (t, r) = (p.translation, p.rotation);
+        [t.x, t.y, t.z, r.x, r.y, r.z, r.w]
+    };
+    match rank(a).cmp(&rank(b)) {
+        std::cmp::Ordering::Equal => total_order(&key(pose_a), &key(pose_b)).is_gt(),
+        other => other.is_gt(),
     }
 }
 

@@ -13,7 +13,9 @@
 //! descended with boxes grown by the margin, and triangle pairs that do not cross report their
 //! exact gap (`trimesh_trimesh.rs`).
 
-use super::{ContactScratch, contact_trimesh_trimesh_within, contact_with_scratch};
+use super::{
+    ContactScratch, contact_trimesh_trimesh_within, contact_with_scratch, general_convex_contact,
+};
 use crate::geometry::{Capsule, ContactManifold, ContactPoint, Cuboid, Isometry, Shape, Sphere};
 
 /// The shape grown by `margin`, or `None` if it cannot be grown.
@@ -29,7 +31,11 @@ fn grown(shape: &Shape, margin: f32) -> Option<Shape> {
             radius: c.radius + margin,
             ..*c
         })),
-        Shape::HalfSpace(_) | Shape::TriMesh(_) => None,
+        Shape::HalfSpace(_)
+        | Shape::TriMesh(_)
+        | Shape::Cylinder(_)
+        | Shape::Ellipsoid(_)
+        | Shape::ConvexHull(_) => None,
     }
 }
 
@@ -88,6 +94,10 @@ pub fn speculative_contact_with_scratch(
     scratch: &mut ContactScratch,
 ) -> Option<ContactManifold> {
     if margin > 0.0 && margin.is_finite() {
+        // Cylinders, ellipsoids and hulls measure their gap directly (GJK): exact.
+        if let Some(m) = general_convex_contact(a, pose_a, b, pose_b, margin, scratch) {
+            return m;
+        }
         if let (Shape::TriMesh(ma), Shape::TriMesh(mb)) = (a, b) {
             return contact_trimesh_trimesh_within(pose_a, ma, pose_b, mb, margin, scratch);
         }

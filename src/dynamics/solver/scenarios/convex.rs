@@ -1,0 +1,234 @@
+//! Shapes that collide through GJK/EPA in the solver: a cylinder rolls down an incline at the
+//! rate its axial inertia predicts, stands still on its cap on the ground, a box and a mesh
+//! floor, and a cylinder rolling across a tessellated floor keeps its line; hull boxes stack; a
+//! hull gem dropped on the ground settles on a face; an ellipsoid rocks on the ground without
+//! leaving it. Two bounds here are measured limits, not goals (see the tests).
+
+use super::*;
+use crate::geometry::{MeshCollider, TriMesh};
+
+/// The body's local z axis in the world.
+fn axis(b: &Body) -> Vec3 {
+    b.orientation * Vec3::Z
+}
+
+#[test]
+fn a_cylinder_rolls_down_a_20_degree_incline_at_two_thirds_g_sin_theta_within_1_percent() {
+    let (half_height, radius) = (0.4, 0.3);
+    let theta = 20f32.to_radians();
+    let normal = Vec3::new(-theta.sin(), 0.0, theta.cos());
+    let downhill = -Vec3::new(theta.cos(), 0.0, theta.sin());
+    let mut scene = Scene::default();
+    let g = scene.ground(normal);
+    scene.bodies[g].friction = 1.0;
+    // Axis along world y, across the slope.
+    let lying = Quat::from_rotation_y(-theta) * Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
+    let c = scene.add(
+        Shape::cylinder(half_height, radius),
+        normal * radius,
+        lying,
+        2.0,
+    );
+    scene.bodies[c].friction = 1.0;
+    let start = scene.bodies[c].center;
+    let t = 1.5;
+    scene.run(t);
+    // Rolling without slipping, I = m r²/2: a = g sin θ / (1 + 1/2).
+    let expected = 0.5 * 9.81 * theta.sin() / 1.5 * t * t;
+    let travelled = (scene.bodies[c].center - start).dot(downhill);
+    assert!(
+        (travelled / expected - 1.0).abs() < 0.01,
+        "travelled {travelled} m, rolling predicts {expected} m"
+    );
+    assert!(axis(&scene.bodies[c]).dot(Vec3::Y).abs() > 0.999);
+}
+
+#[test]
+fn a_standing_cylinder_rests_on_ground_and_box_within_0_1_mm_and_on_a_mesh_within_0_5_mm_for_3_s() {
+    let (half_height, radius) = (0.5, 0.3);
+    let mut on_ground = Scene::default();
+    on_ground.ground(Vec3::Z);
+    let mut on_table = Scene::default();
+    on_table.add(
+        Shape::cuboid(Vec3::new(2.0, 2.0, 0.5)),
+        Vec3::ZERO,
+        Quat::IDENTITY,
+        0.0,
+    );
+    let mut on_mesh = Scene::default();
+    let floor = MeshCollider::new(TriMesh::grid_floor(6.0, 12).unwrap()).unwrap();
+    on_mesh.add(Shape::TriMesh(floor), Vec3::ZERO, Quat::IDENTITY, 0.0);
+    // On a mesh the cap's octagon is clipped triangle by triangle and the pieces merged
+    // (`mesh_manifold.rs`): the merged points are not symmetric about the axis (0.34 mm measured).
+    for (name, mut scene, top, bound) in [
+        ("ground", on_ground, 0.0, 1e-4),
+        ("box", on_table, 0.5, 1e-4),
+        ("mesh", on_mesh, 0.0, 5e-4),
+    ] {
+        let start = Vec3::new(0.3, -0.2, top + half_height + 0.001);
+        let c = scene.add(
+            Shape::cylinder(half_height, radius),
+            start,
+            Quat::from_rotation_z(0.4),
+            3.0,
+        );
+        scene.run(3.0);
+        let b = &scene.bodies[c];
+        let drift = (b.center - start).truncate().length();
+        let height = b.center.z - (top + half_height);
+        assert!(drift < bound, "{name}: drifted {drift} m");
+        assert!(height.abs() < 1e-4, "{name}: {height} m off its support");
+        assert!(
+            axis(b).z > 1.0 - 1e-6 && b.w.length() < 1e-3,
+            "{name}: tilting"
+        );
+    }
+}
+
+#[test]
+fn a_cylinder_rolling_across_a_tessellated_floor_keeps_its_line_within_2_mm_per_m_and_75_percent_of_its_speed()
+ {
+    let radius = 0.3;
+    let floor = MeshCollider::new(TriMesh::grid_floor(20.0, 40).unwrap()).unwrap();
+    let mut scene = Scene::default();
+    let f = scene.add(Shape::TriMesh(floor), Vec3::ZERO, Quat::IDENTITY, 0.0);
+    scene.bodies[f].friction = 1.0;
+    let lying = Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
+    let c = scene.add(
+        Shape::cylinder(0.4, radius),
+        Vec3::new(-6.0, 0.1, radius),
+        lying,
+        2.0,
+    );
+    scene.bodies[c].friction = 1.0;
+    scene.bodies[c].v = Vec3::new(3.0, 0.0, 0.0);
+    scene.bodies[c].w = Vec3::new(0.0, 3.0 / radius, 0.0);
+    scene.run(2.0);
+    let b = &scene.bodies[c];
+    let travelled = b.center.x + 6.0;
+    assert!(travelled > 5.0, "rolled only {travelled} m");
+    // Across the seams: no hop, no veer. The speed is not kept: 12 seams take 20% of it
+    // (measured 2.39 m/s of 3; on a half-space 2.997), a known limit the README states.
+    assert!((b.center.z - radius).abs() < 2e-3, "height {}", b.center.z);
+    assert!(
+        (b.center.y - 0.1).abs() < 2e-3 * travelled,
+        "veered to y = {}",
+        b.center.y
+    );
+    assert!(b.v.x > 0.75 * 3.0, "speed {}", b.v.x);
+}
+
+/// The hull of a box's corners and its face centres (coplanar extras the hull must merge).
+fn hull_box(half: Vec3) -> Shape {
+    let mut points = Vec::new();
+    for k in 0..8 {
+        let s = |bit: usize| if k & (1 << bit) != 0 { 1.0 } else { -1.0 };
+        points.push(half * Vec3::new(s(0), s(1), s(2)));
+    }
+    for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
+        points.push(half * axis);
+        points.push(-half * axis);
+    }
+    Shape::convex_hull(&points).unwrap()
+}
+
+#[test]
+fn a_stack_of_6_hull_boxes_stands_5_s_with_drift_under_1_cm() {
+    let half = Vec3::new(0.5, 0.4, 0.25);
+    let mut scene = Scene::default();
+    scene.ground(Vec3::Z);
+    let boxes: Vec<usize> = (0..6)
+        .map(|k| {
+            let at = Vec3::new(0.0, 0.0, half.z * (2 * k + 1) as f32 + 0.001 * k as f32);
+            scene.add(hull_box(half), at, Quat::IDENTITY, 1.0)
+        })
+        .collect();
+    scene.run(5.0);
+    for (k, &i) in boxes.iter().enumerate() {
+        let b = &scene.bodies[i];
+        let drift = b.center.truncate().length();
+        assert!(drift < 0.01, "box {k} drifted {drift} m");
+        assert!(axis(b).z > 0.999, "box {k} tilted");
+        assert!(
+            (b.center.z - half.z * (2 * k + 1) as f32).abs() < 0.01,
+            "box {k} sagged"
+        );
+    }
+}
+
+#[test]
+fn a_hull_gem_dropped_on_the_ground_settles_on_a_face_within_1_mm() {
+    // An irregular octahedron-like gem, symmetric about the origin so that its centre of mass
+    // is the local origin.
+    let mut points = Vec::new();
+    for p in [
+        Vec3::new(0.5, 0.1, 0.05),
+        Vec3::new(0.1, 0.4, -0.1),
+        Vec3::new(0.05, -0.1, 0.35),
+        Vec3::new(0.3, 0.3, 0.2),
+        Vec3::new(-0.2, 0.35, 0.25),
+    ] {
+        points.push(p);
+        points.push(-p);
+    }
+    let gem = Shape::convex_hull(&points).unwrap();
+    let Shape::ConvexHull(hull) = &gem else {
+        unreachable!()
+    };
+    let hull = hull.clone();
+    let mut scene = Scene::default();
+    scene.ground(Vec3::Z);
+    let g = scene.add(
+        gem,
+        Vec3::new(0.0, 0.0, 1.0),
+        Quat::from_rotation_x(0.3),
+        1.0,
+    );
+    scene.run(4.0);
+    let b = &scene.bodies[g];
+    assert!(b.v.length() < 1e-3 && b.w.length() < 1e-2, "still moving");
+    // Resting on a face: that face's normal points straight down, and the body's height is
+    // the face's offset.
+    let down = b.orientation.inverse() * -Vec3::Z;
+    let face = hull.faces()[hull.best_face(down)];
+    assert!(
+        face.normal.dot(down) > 0.999,
+        "not on a face: {}",
+        face.normal.dot(down)
+    );
+    assert!(
+        (b.center.z - face.offset).abs() < 1e-3,
+        "height {}",
+        b.center.z
+    );
+}
+
+#[test]
+fn an_ellipsoid_rocking_on_the_ground_stays_in_touch_within_3_mm_and_climbs_under_2_cm_in_6_s() {
+    // Rolling without slipping on one point conserves energy: it should rock on and on, never
+    // climbing above where it started. The solver keeps each contact point fixed on the body
+    // for a step's substeps while the true point runs over the curved surface, which feeds
+    // the rocking: 1.6 cm gained in 6 s (measured), a known limit the README states.
+    let radii = Vec3::new(0.5, 0.35, 0.2);
+    let shape = Shape::ellipsoid(radii);
+    let mut scene = Scene::default();
+    let ground = scene.ground(Vec3::Z);
+    scene.bodies[ground].friction = 1.0;
+    let tilt = Quat::from_rotation_x(0.3) * Quat::from_rotation_y(0.2);
+    let resting = |q: Quat| shape.world_aabb(&Isometry::new(Vec3::ZERO, q)).max.z;
+    let e = scene.add(shape.clone(), Vec3::new(0.0, 0.0, resting(tilt)), tilt, 1.0);
+    scene.bodies[e].friction = 1.0;
+    let start = scene.bodies[e].center.z;
+    let (mut highest, mut worst_gap) = (start, 0.0f32);
+    for _ in 0..(6.0 / DT) as usize {
+        scene.step();
+        let b = &scene.bodies[e];
+        highest = highest.max(b.center.z);
+        worst_gap = worst_gap.max((b.center.z - resting(b.orientation)).abs());
+    }
+    assert!(highest < start + 0.02, "climbed to {highest} from {start}");
+    assert!(
+        worst_gap < 3e-3,
+        "left or sank into the ground by {worst_gap} m"
+    );
+}

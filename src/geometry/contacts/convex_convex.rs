@@ -1,0 +1,256 @@
+//! Convex–convex contact for the shapes without a closed form (cylinders, ellipsoids, hulls, and
+//! anything paired with one): GJK/EPA give the normal and the deepest points
+//! ([`crate::geometry::convex`]), and the manifold is clipped from the two supporting features
+//! along that normal (Gregorius, "Robust contact creation for physics simulations", GDC 2015;
+//! Jolt's `ManifoldBetweenTwoFaces`): the better aligned face is the reference, the other
+//! feature is clipped to the reference's side planes, and each clipped point keeps its own depth
+//! to the reference plane, measured along the normal. The normal stays EPA's (for polytopes it
+//! is an exact face normal of `A − B` once EPA converges), so the deepest point's depth is EPA's.
+//!
+//! With a `margin`, pairs still apart by up to it report their gap as a negative depth (the
+//! speculative contacts of `speculative.rs`), exactly: GJK measures the gap directly.
+
+use super::manifold_reduction::spread_points;
+use super::polygon_clip::ClipPolygon;
+use crate::geometry::convex::SignedDistance;
+use crate::geometry::convex::core_distance;
+use crate::geometry::convex::support::{ConvexPart, Feature, MAX_FEATURE_POINTS};
+use crate::geometry::{ContactManifold, ContactPoint, HalfSpace, Isometry, Shape};
+use glam::Vec3;
+
+/// A face serves as the reference only when its normal is this close to the contact normal
+/// (cosine, ~11°): a steeper face would measure depths along a tilted plane.
+const REFERENCE_COSINE: f32 = 0.98;
+
+/// Two edges count as parallel (a line contact with two ends) when the sine of their angle is
+/// at most this.
+const PARALLEL_SINE: f32 = 0.05;
+
+/// Capacity of the clipped polygon: a feature clipped by as many side planes.
+const CLIP_CAPACITY: usize = 2 * MAX_FEATURE_POINTS;
+
+/// Contact between `a` at `pose_a` and `b` at `pose_b`, any convex shapes (see
+/// [`ConvexPart::of_shape`]), with a speculative `margin` (0: touching or overlapping only).
+/// Worked in A's frame, so the numbers stay near the pair. `None` when they are farther apart
+/// than the margin, or either is not convex.
+pub(crate) fn contact_convex_convex(
+    a: &Shape,
+    pose_a: &Isometry,
+    b: &Shape,
+    pose_b: &Isometry,
+    margin: f32,
+) -> Option<ContactManifold> {
+    let pa = ConvexPart::of_shape(a, Isometry::IDENTITY)?;
+    let pb = ConvexPart::of_shape(b, pose_a.inv_mul(pose_b))?;
+    let m = contact_parts(&pa, &pb, margin)?;
+    Some(placed(m, pose_a))
+}
+
+/// The manifold carried from a local frame to the world by `pose`.
+pub(crate) fn placed(m: ContactManifold, pose: &Isometry) -> ContactManifold {
+    let mut out = ContactManifold::new(pose.transform_vector(m.normal));
+    for p in m.points() {
+        out.push(ContactPoint {
+            point: pose.transform_point(p.point),
+            depth: p.depth,
+        });
+    }
+    out
+}
+
+/// Contact between two parts in one frame (module docs).
+pub(crate) fn contact_parts(
+    a: &ConvexPart,
+    b: &ConvexPart,
+    margin: f32,
+) -> Option<ContactManifold> {
+    let d = core_distance(a, b)?;
+    (d.distance <= margin).then(|| manifold(a, b, &d, margin))
+}
+
+/// The manifold of two parts whose signed distance along `d.normal` is `d`: clipped features, or
+/// the single deepest pair when no face lines up.
+pub(crate) fn manifold(
+    a: &ConvexPart,
+    b: &ConvexPart,
+    d: &SignedDistance,
+    margin: f32,
+) -> ContactManifold {
+    let n = d.normal;
+    let deepest = ContactPoint {
+        point: (d.on_a + d.on_b) * 0.5,
+        depth: -d.distance,
+    };
+    let (fa, fb) = (a.feature(n), b.feature(-n));
+    let mut points = [ContactPoint::default(); CLIP_CAPACITY];
+    let mut len = 0;
+    if fa.points().len() >= 2 && fb.points().len() >= 2 {
+        let radii = a.rounding + b.rounding;
+        let facing_a = fa
+            .normal
+            .map(|m| m.dot(n))
+            .filter(|&c| c >= REFERENCE_COSINE);
+        let facing_b = fb
+            .normal
+            .map(|m| -m.dot(n))
+            .filter(|&c| c >= REFERENCE_COSINE);
+        // A point can sink no deeper along n than the pair does (EPA's depth is the deepest
+        // along its own normal); a tilted reference plane would overstate a far corner.
+        let mut keep = |p: ContactPoint| {
+            if p.depth >= -margin && len < CLIP_CAPACITY {
+                points[len] = ContactPoint {
+                    depth: p.depth.min(deepest.depth),
+                    ..p
+                };
+                len += 1;
+            }
+        };
+        match (facing_a, facing_b) {
+            (Some(ca), Some(cb)) if ca >= cb => clip(&fa, &fb, n, radii, &mut keep),
+            (Some(_), None) => clip(&fa, &fb, n, radii, &mut keep),
+            (_, Some(_)) => clip(&fb, &fa, -n, radii, &mut keep),
+            (None, None) => parallel_lines(&fa, &fb, n, (a.rounding, b.rounding), &mut keep),
+        }
+    }
+    let found = &points[..len];
+    let best = found
+        .iter()
+        .map(|p| p.depth)
+        .fold(f32::NEG_INFINITY, f32::max);
+    let mut out = ContactManifold::new(n);
+    if best < deepest.depth - 1e-5 * (a.size() + b.size()) {
+        // The clip missed the deepest point (a rim or corner against an edge of the
+        // reference, a subsampled face): keep it first.
+        out.push(deepest);
+    }
+    if found.is_empty() {
+        out.push(deepest);
+        return out;
+    }
+    let (chosen, count) = spread_points(found, n);
+    for &i in &chosen[..count] {
+        out.push(found[i]);
+    }
+    out
+}
+
+/// Clips `incident` to the side planes of the face `reference`; `n` points from the reference's
+/// shape to the incident's. Each point inside gets its depth below the reference plane along
+/// `n` plus the incident's rounding (a face's own core is never rounded), and the midpoint
+/// between the surfaces.
+fn clip(
+    reference: &Feature,
+    incident: &Feature,
+    n: Vec3,
+    radii: f32,
+    keep: &mut impl FnMut(ContactPoint),
+) {
+    let Some(m) = reference.normal else { return };
+    let face = reference.points();
+    let centre = face.iter().sum::<Vec3>() / face.len() as f32;
+    let mut poly = ClipPolygon::<CLIP_CAPACITY>::from_corners(incident.points());
+    for (k, &r) in face.iter().enumerate() {
+        let edge = face[(k + 1) % face.len()] - r;
+        let mut side = edge.cross(m);
+        if side.dot(centre - r) > 0.0 {
+            side = -side;
+        }
+        poly = poly.clipped(side, side.dot(r));
+    }
+    let offset = m.dot(face[0]);
+    let along = m.dot(n);
+    for &p in poly.vertices() {
+        // The incident core point p lies `sunk` below the reference plane, along n; only the
+        // incident side is rounded (faces belong to unrounded cores).
+        let sunk = (offset - m.dot(p)) / along;
+        let on_reference = p + n * sunk;
+        keep(ContactPoint {
+            point: (on_reference + p - n * radii) * 0.5,
+            depth: radii + sunk,
+        });
+    }
+}
+
+/// Two edges (a capsule's axis, a cylinder's side, a box edge seen edge-on) lying parallel:
+/// the overlap of their spans, each end with its own gap.
+fn parallel_lines(
+    fa: &Feature,
+    fb: &Feature,
+    n: Vec3,
+    (ra, rb): (f32, f32),
+    keep: &mut impl FnMut(ContactPoint),
+) {
+    let ([a0, a1], [b0, b1]) = (first_two(fa), first_two(fb));
+    let (da, db) = (a1 - a0, b1 - b0);
+    let len2 = da.length_squared();
+    if len2 <= 0.0 || da.cross(db).length() > PARALLEL_SINE * da.length() * db.length() {
+        return;
+    }
+    let t = |p: Vec3| (p - a0).dot(da) / len2;
+    let (tb0, tb1) = (t(b0), t(b1));
+    if (tb1 - tb0).abs() <= f32::EPSILON {
+        return;
+    }
+    for ta in [tb0.min(tb1).max(0.0), tb0.max(tb1).min(1.0)] {
+        let on_a = a0 + da * ta;
+        let s = (ta - tb0) / (tb1 - tb0);
+        let on_b = b0 + db * s.clamp(0.0, 1.0);
+        let gap = (on_b - on_a).dot(n);
+        keep(ContactPoint {
+            point: (on_a + on_b + n * (ra - rb)) * 0.5,
+            depth: ra + rb - gap,
+        });
+    }
+}
+
+fn first_two(f: &Feature) -> [Vec3; 2] {
+    let p = f.points();
+    [p[0], p[p.len() - 1]]
+}
+
+/// A convex shape `a` at `pose_a` against the half-space `h` at `pose_h`, normal from the shape
+/// to the half-space: the shape's supporting feature below the raised plane, each point with its
+/// own depth (a standing cylinder rests on its cap's polygon, a lying one on its side line).
+pub(crate) fn contact_convex_halfspace(
+    a: &Shape,
+    pose_a: &Isometry,
+    h: &HalfSpace,
+    pose_h: &Isometry,
+    margin: f32,
+) -> Option<ContactManifold> {
+    let part = ConvexPart::of_shape(a, *pose_a)?;
+    let up = pose_h.transform_vector(h.normal);
+    let height = |p: Vec3| up.dot(p - pose_h.translation) - part.rounding;
+    let lowest = part.support(-up);
+    if height(lowest) > margin {
+        return None;
+    }
+    let normal = -up;
+    let mut points = [ContactPoint::default(); MAX_FEATURE_POINTS];
+    let mut len = 0;
+    for &p in part.feature(normal).points() {
+        let gap = height(p);
+        if gap <= margin {
+            let surface = p - up * part.rounding;
+            points[len] = ContactPoint {
+                point: surface - up * (0.5 * gap),
+                depth: -gap,
+            };
+            len += 1;
+        }
+    }
+    let mut out = ContactManifold::new(normal);
+    if len == 0 {
+        let gap = height(lowest);
+        out.push(ContactPoint {
+            point: lowest - up * (part.rounding + 0.5 * gap),
+            depth: -gap,
+        });
+        return Some(out);
+    }
+    let (chosen, count) = spread_points(&points[..len], normal);
+    for &i in &chosen[..count] {
+        out.push(points[i]);
+    }
+    Some(out)
+}

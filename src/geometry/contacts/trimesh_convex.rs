@@ -1,0 +1,85 @@
+//! Mesh–convex for the shapes without a closed form (cylinders, ellipsoids, hulls): the shape,
+//! carried into the mesh's frame, descends the mesh's OBB hierarchy inside its own oriented box
+//! (as mesh–box does), and every triangle reached is a convex part of its own for GJK/EPA and
+//! the feature clip of `convex_convex.rs`. A contact that touches a triangle only on its
+//! inactive edges takes the face normal ([`active_edges`](crate::geometry::active_edges)), so a
+//! cylinder rolling across a tessellated floor does not bump on the seams. The triangle contacts
+//! are merged into one manifold as `mesh_manifold.rs` explains.
+
+use super::convex_convex::manifold;
+use super::mesh_scratch::ContactScratch;
+use super::trimesh_cuboid::carried_box;
+use crate::bounding::{Bv, RelativePose};
+use crate::geometry::active_edges::face_normal_at_inactive_edge;
+use crate::geometry::convex::support::ConvexPart;
+use crate::geometry::convex::{SignedDistance, core_distance};
+use crate::geometry::{ContactManifold, Isometry, MeshCollider, Shape, Triangle};
+use glam::Vec3;
+
+/// Contact between a mesh at `pose_mesh` (shape A) and the convex `shape` at `pose_shape`
+/// (shape B), with a speculative `margin`; `None` when `shape` is not convex or nothing is
+/// within the margin.
+pub(crate) fn contact_trimesh_convex(
+    (pose_mesh, mesh): (&Isometry, &MeshCollider),
+    (pose_shape, shape): (&Isometry, &Shape),
+    margin: f32,
+    scratch: &mut ContactScratch,
+) -> Option<ContactManifold> {
+    let in_mesh = pose_mesh.inv_mul(pose_shape);
+    let part = ConvexPart::of_shape(shape, in_mesh)?;
+    let half = local_half_extents(shape) + Vec3::splat(margin.max(0.0));
+    let probe = carried_box(&in_mesh, half, mesh);
+    let same_frame = RelativePose::new(&Isometry::IDENTITY);
+    scratch.collect_triangle_contacts(
+        mesh,
+        |bv| bv.overlaps(&probe, &same_frame),
+        |t, tri| triangle_contact(tri, mesh.active_edges(t), &part, margin),
+    );
+    scratch.merge(pose_mesh)
+}
+
+/// Half extents of a box about the shape's origin that holds it.
+fn local_half_extents(shape: &Shape) -> Vec3 {
+    match shape {
+        Shape::Cylinder(c) => Vec3::new(c.radius, c.radius, c.half_height),
+        Shape::Ellipsoid(e) => e.radii,
+        Shape::ConvexHull(h) => {
+            let b = h.local_aabb();
+            b.min.abs().max(b.max.abs())
+        }
+        other => Vec3::splat(other.bounding_radius()),
+    }
+}
+
+/// One triangle (A) against the convex part (B), in the mesh's frame.
+fn triangle_contact(
+    tri: &Triangle,
+    active: u8,
+    part: &ConvexPart,
+    margin: f32,
+) -> Option<ContactManifold> {
+    let face = ConvexPart::triangle(tri);
+    let d = core_distance(&face, part)?;
+    if d.distance > margin {
+        return None;
+    }
+    let d = match face_normal_at_inactive_edge(tri, active, d.on_a, d.normal) {
+        Some(up) => along_face(tri, up, &d),
+        None => d,
+    };
+    (d.distance <= margin).then(|| manifold(&face, part, &d, margin))
+}
+
+/// The contact read along the face normal `up` (towards the part) when the surface continues
+/// flat past an inactive edge: the part's closest point to this triangle, `d.on_b`, keeps its
+/// place and its height above the triangle's plane becomes the distance. (The part's lowest
+/// point overall may lie over a neighbour: a cylinder lying across a seam is 7 mm above this
+/// triangle where it comes closest to it, and that, not the neighbour's contact, is this
+/// triangle's.)
+fn along_face(tri: &Triangle, up: Vec3, d: &SignedDistance) -> SignedDistance {
+    SignedDistance {
+        distance: up.dot(d.on_b - tri.a),
+        normal: up,
+        ..*d
+    }
+}

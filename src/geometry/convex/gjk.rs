@@ -1,0 +1,286 @@
+//! GJK (Gilbert, Johnson & Keerthi 1988): the distance between two convex cores, found as the
+//! distance from the origin to their Minkowski difference `A − B`, which GJK explores through
+//! support points `w = s_A(d) − s_B(−d)` and a simplex of at most four of them.
+//!
+//! Each iteration finds the simplex's point `v` closest to the origin (Ericson 2005, §5.1: the
+//! Voronoi regions of a triangle, and of a tetrahedron's faces), drops the vertices that do not
+//! support it, and adds the support point along `−v`. It stops with van den Bergen's (2003)
+//! relative test, `|v|² − v·w <= ε|v|²` (no support point gets meaningfully closer) or its
+//! absolute twin at f32's resolution, when `v` stops shrinking (rounding: the previous simplex
+//! is kept), or when the simplex encloses the origin or `v` is within a
+//! tolerance of it: the cores overlap, and EPA (`epa.rs`) takes the simplex.
+//!
+//! The support points come in f32, but the simplex arithmetic runs in f64: near a curved rim
+//! GJK bunches support points a few micrometres apart, and an f32 tetrahedron of them cannot
+//! tell inside from outside (a capsule 5 cm from a cylinder was reported 5 cm deep in it).
+
+use super::support::ConvexPart;
+use glam::{DVec3, Vec3};
+
+/// Iterations GJK may take; polytopes converge in a handful, smooth shapes in tens.
+const MAX_ITERATIONS: usize = 64;
+
+/// Relative convergence of van den Bergen's test (`ε` above).
+const RELATIVE_TOLERANCE: f64 = 1e-6;
+
+/// A tetrahedron whose six-fold volume is below this fraction of its longest edge cubed is flat.
+const FLAT_VOLUME_FRACTION: f64 = 1e-9;
+
+/// Absolute convergence: a support point closer than this fraction of the pair's size to
+/// improving the distance does not count (f32 support points are about this exact).
+const ABSOLUTE_FRACTION: f64 = 1e-6;
+
+/// The cores count as overlapping when `|v|` is below this fraction of the pair's size.
+const OVERLAP_FRACTION: f64 = 1e-6;
+
+/// A vertex of the Minkowski difference with the two support points that made it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct SupportPoint {
+    /// `a − b`.
+    pub w: DVec3,
+    /// The support point of A.
+    pub a: DVec3,
+    /// The support point of B.
+    pub b: DVec3,
+}
+
+/// The support point of `A − B` along `dir`.
+#[inline]
+pub(crate) fn support(a: &ConvexPart, b: &ConvexPart, dir: DVec3) -> SupportPoint {
+    let d = dir.as_vec3();
+    let (pa, pb) = (a.support(d).as_dvec3(), b.support(-d).as_dvec3());
+    SupportPoint {
+        w: pa - pb,
+        a: pa,
+        b: pb,
+    }
+}
+
+/// At most four support points, with the barycentric weights of the simplex's closest point.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Simplex {
+    pub points: [SupportPoint; 4],
+    pub weights: [f64; 4],
+    pub len: usize,
+}
+
+impl Simplex {
+    fn push(&mut self, p: SupportPoint) {
+        self.points[self.len] = p;
+        self.len += 1;
+    }
+
+    /// Keeps the listed vertices with these weights.
+    fn keep<const N: usize>(&mut self, ids: [usize; N], weights: [f64; N]) -> DVec3 {
+        let old = self.points;
+        let mut v = DVec3::ZERO;
+        for (k, (&i, &w)) in ids.iter().zip(&weights).enumerate() {
+            self.points[k] = old[i];
+            self.weights[k] = w;
+            v += old[i].w * w;
+        }
+        self.len = N;
+        v
+    }
+
+    /// The weighted sum of the vertices' A points and B points: the closest points' witnesses.
+    pub fn witnesses(&self) -> (DVec3, DVec3) {
+        let mut pa = DVec3::ZERO;
+        let mut pb = DVec3::ZERO;
+        for (p, &w) in self.points[..self.len].iter().zip(&self.weights) {
+            pa += p.a * w;
+            pb += p.b * w;
+        }
+        (pa, pb)
+    }
+
+    /// Reduces the simplex to the vertices supporting its point closest to the origin and
+    /// returns that point; `None` when a tetrahedron encloses the origin.
+    fn closest(&mut self) -> Option<DVec3> {
+        match self.len {
+            1 => Some(self.keep([0], [1.0])),
+            2 => Some(self.closest_on_segment(0, 1)),
+            3 => Some(self.closest_on_triangle(0, 1, 2)),
+            _ => self.closest_on_tetrahedron(),
+        }
+    }
+
+    fn closest_on_segment(&mut self, i: usize, j: usize) -> DVec3 {
+        let (a, b) = (self.points[i].w, self.points[j].w);
+        let ab = b - a;
+        let len2 = ab.length_squared();
+        let t = if len2 > 0.0 { -a.dot(ab) / len2 } else { 0.0 };
+        if t <= 0.0 {
+            self.keep([i], [1.0])
+        } else if t >= 1.0 {
+            self.keep([j], [1.0])
+        } else {
+            self.keep([i, j], [1.0 - t, t])
+        }
+    }
+
+    /// Ericson's `ClosestPtPointTriangle` for the origin, by Voronoi regions.
+    fn closest_on_triangle(&mut self, i: usize, j: usize, k: usize) -> DVec3 {
+        let (a, b, c) = (self.points[i].w, self.points[j].w, self.points[k].w);
+        let (ab, ac) = (b - a, c - a);
+        let (d1, d2) = (-ab.dot(a), -ac.dot(a));
+        if d1 <= 0.0 && d2 <= 0.0 {
+            return self.keep([i], [1.0]);
+        }
+        let (d3, d4) = (-ab.dot(b), -ac.dot(b));
+        if d3 >= 0.0 && d4 <= d3 {
+            return self.keep([j], [1.0]);
+        }
+        let vc = d1 * d4 - d3 * d2;
+        if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+            let t = d1 / (d1 - d3);
+            return self.keep([i, j], [1.0 - t, t]);
+        }
+        let (d5, d6) = (-ab.dot(c), -ac.dot(c));
+        if d6 >= 0.0 && d5 <= d6 {
+            return self.keep([k], [1.0]);
+        }
+        let vb = d5 * d2 - d1 * d6;
+        if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+            let t = d2 / (d2 - d6);
+            return self.keep([i, k], [1.0 - t, t]);
+        }
+        let va = d3 * d6 - d5 * d4;
+        if va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 {
+            let t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+            return self.keep([j, k], [1.0 - t, t]);
+        }
+        let sum = va + vb + vc;
+        if sum <= 0.0 || !sum.is_finite() {
+            // A degenerate (flat) triangle: its best edge.
+            return self.closest_on_segment(i, j);
+        }
+        let (v, w) = (vb / sum, vc / sum);
+        self.keep([i, j, k], [1.0 - v - w, v, w])
+    }
+
+    fn closest_on_tetrahedron(&mut self) -> Option<DVec3> {
+        const FACES: [[usize; 4]; 4] = [[0, 1, 2, 3], [0, 3, 1, 2], [0, 2, 3, 1], [1, 3, 2, 0]];
+        let w = self.points.map(|p| p.w);
+        // A nearly flat tetrahedron (three support points bunched on a curved rim) cannot tell
+        // inside from outside: it is searched face by face, as a flat one.
+        let longest = (1..4)
+            .map(|k| (w[k] - w[0]).length())
+            .fold(0.0f64, f64::max);
+        let volume6 = (w[1] - w[0]).cross(w[2] - w[0]).dot(w[3] - w[0]).abs();
+        let flat = volume6 <= FLAT_VOLUME_FRACTION * longest * longest * longest;
+        let mut best: Option<(f64, Simplex, DVec3)> = None;
+        let mut outside_any = false;
+        for [i, j, k, opposite] in FACES {
+            let n = (w[j] - w[i]).cross(w[k] - w[i]);
+            let origin_side = -n.dot(w[i]);
+            let other_side = n.dot(w[opposite] - w[i]);
+            // The origin is beyond this face when it is on the side away from the fourth
+            // vertex; a flat tetrahedron (both zero) is searched face by face.
+            if origin_side * other_side < 0.0 || other_side == 0.0 || flat {
+                outside_any = true;
+                let mut face = *self;
+                let v = face.closest_on_triangle(i, j, k);
+                if best.as_ref().is_none_or(|b| v.length_squared() < b.0) {
+                    best = Some((v.length_squared(), face, v));
+                }
+            }
+        }
+        if !outside_any {
+            return None;
+        }
+        let (_, face, v) = best?;
+        *self = face;
+        Some(v)
+    }
+}
+
+/// What GJK found. The simplex is carried by value: boxing it would allocate per query.
+#[derive(Clone, Copy, Debug)]
+#[allow(clippy::large_enum_variant)]
+pub(crate) enum Gjk {
+    /// The cores are apart: their closest points (on A's core, on B's core).
+    Separated { on_a: Vec3, on_b: Vec3 },
+    /// The cores overlap (or touch within the tolerance); the simplex goes to EPA.
+    Overlapping(Simplex),
+}
+
+/// Runs GJK on the cores of `a` and `b`.
+pub(crate) fn gjk(a: &ConvexPart, b: &ConvexPart) -> Gjk {
+    let scale = f64::from(a.size() + b.size() + a.center().distance(b.center()));
+    let overlap = (OVERLAP_FRACTION * scale).max(f64::MIN_POSITIVE);
+    let resolution = ABSOLUTE_FRACTION * scale;
+    let mut simplex = Simplex::default();
+    let mut v = (a.center() - b.center()).as_dvec3();
+    if v.length_squared() <= overlap * overlap {
+        v = DVec3::X;
+    }
+    let mut last = f64::INFINITY;
+    for _ in 0..MAX_ITERATIONS {
+        let w = support(a, b, -v);
+        let v2 = v.length_squared();
+        if simplex.len > 0 {
+            // How much closer to the origin the support plane along -v lies than v (times |v|):
+            // converged when that is below the relative or the absolute resolution.
+            let progress = v2 - v.dot(w.w);
+            let repeated = simplex.points[..simplex.len].iter().any(|p| p.w == w.w);
+            if repeated || progress <= (RELATIVE_TOLERANCE * v2).max(v2.sqrt() * resolution) {
+                break;
+            }
+        }
+        let before = simplex;
+        simplex.push(w);
+        let Some(closest) = simplex.closest() else {
+            return Gjk::Overlapping(simplex);
+        };
+        let v2 = closest.length_squared();
+        if !v2.is_finite() || v2 >= last {
+            // No progress (rounding in a nearly flat simplex): the previous answer stands.
+            simplex = before;
+            break;
+        }
+        v = closest;
+        if v2 <= overlap * overlap {
+            return Gjk::Overlapping(simplex);
+        }
+        last = v2;
+    }
+    let (on_a, on_b) = simplex.witnesses();
+    Gjk::Separated {
+        on_a: on_a.as_vec3(),
+        on_b: on_b.as_vec3(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::{Isometry, Shape};
+    use glam::Quat;
+
+    fn part(shape: &Shape, at: Vec3, turn: Quat) -> ConvexPart<'_> {
+        ConvexPart::of_shape(shape, Isometry::new(at, turn)).unwrap()
+    }
+
+    #[test]
+    fn box_distance_is_the_face_gap_within_1e_6() {
+        let cube = Shape::cuboid(Vec3::splat(0.5));
+        let a = part(&cube, Vec3::ZERO, Quat::IDENTITY);
+        let b = part(&cube, Vec3::new(0.3, 0.2, 1.75), Quat::IDENTITY);
+        let Gjk::Separated { on_a, on_b } = gjk(&a, &b) else {
+            panic!("apart")
+        };
+        assert!(((on_b - on_a).length() - 0.75).abs() < 1e-6);
+        assert!((on_b - on_a).normalize().dot(Vec3::Z) > 1.0 - 1e-6);
+    }
+
+    #[test]
+    fn overlapping_cores_are_reported_and_far_ones_are_not() {
+        let cyl = Shape::cylinder(0.5, 0.4);
+        let a = part(&cyl, Vec3::ZERO, Quat::IDENTITY);
+        let b = part(&cyl, Vec3::new(0.5, 0.1, 0.2), Quat::from_rotation_x(1.0));
+        assert!(matches!(gjk(&a, &b), Gjk::Overlapping(_)));
+        let c = part(&cyl, Vec3::new(3.0, 0.1, 0.2), Quat::from_rotation_x(1.0));
+        assert!(matches!(gjk(&a, &c), Gjk::Separated { .. }));
+    }
+}

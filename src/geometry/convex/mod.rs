@@ -1,0 +1,142 @@
+//! Convex shapes through their support functions: GJK for the distance between two convex
+//! cores (`gjk.rs`), EPA for their penetration when they overlap (`epa.rs`), and the supporting
+//! features the contact manifold is clipped from (`support.rs`). Cylinders, ellipsoids and hulls
+//! collide only this way; spheres, capsules and boxes take it when paired with one of them
+//! (their own pairs keep the closed forms, which are faster and exact).
+//!
+//! [`signed_distance`] is the public face: the signed distance between two convex
+//! shapes with the closest (or deepest) points, as parry's `query::distance` and
+//! `query::contact` report.
+
+mod epa;
+mod gjk;
+pub(crate) mod support;
+
+use crate::geometry::mesh_io::{self, MeshLoadError};
+use crate::geometry::{ConvexHull, HullError, Isometry, Shape};
+pub(crate) use epa::epa;
+pub(crate) use gjk::{Gjk, gjk};
+use glam::Vec3;
+use std::fmt;
+use support::ConvexPart;
+
+/// The signed distance between two convex shapes and where it is attained.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SignedDistance {
+    /// Distance between the surfaces; negative when they overlap (minus the penetration depth).
+    pub distance: f32,
+    /// Unit direction from A to B: moving B along it by `-distance` makes them touch.
+    pub normal: Vec3,
+    /// A's surface point nearest B (deepest in B when overlapping).
+    pub on_a: Vec3,
+    /// B's surface point nearest A (deepest in A when overlapping).
+    pub on_b: Vec3,
+}
+
+/// The signed distance between convex shapes `a` at `pose_a` and `b` at `pose_b` by GJK (apart)
+/// or EPA (overlapping), or `None` when either is not convex (a half-space, a mesh) or the pair
+/// has no defined direction (two flat shapes in one plane).
+pub fn signed_distance(
+    a: &Shape,
+    pose_a: &Isometry,
+    b: &Shape,
+    pose_b: &Isometry,
+) -> Option<SignedDistance> {
+    // In A's frame: the numbers stay near the pair, not near the world origin.
+    let pa = ConvexPart::of_shape(a, Isometry::IDENTITY)?;
+    let pb = ConvexPart::of_shape(b, pose_a.inv_mul(pose_b))?;
+    let d = core_distance(&pa, &pb)?;
+    Some(SignedDistance {
+        distance: d.distance,
+        normal: pose_a.transform_vector(d.normal),
+        on_a: pose_a.transform_point(d.on_a),
+        on_b: pose_a.transform_point(d.on_b),
+    })
+}
+
+/// [`SignedDistance`] of two parts in one frame, their roundings included.
+pub(crate) fn core_distance(a: &ConvexPart, b: &ConvexPart) -> Option<SignedDistance> {
+    let (core, on_a, on_b, normal) = match gjk(a, b) {
+        Gjk::Separated { on_a, on_b } => {
+            let gap = on_b - on_a;
+            let len = gap.length();
+            match gap.try_normalize() {
+                Some(n) => (len, on_a, on_b, n),
+                // Exactly touching cores without a GJK overlap: no direction; ask EPA.
+                None => return penetrating(a, b, &gjk_simplex_of(a, b)),
+            }
+        }
+        Gjk::Overlapping(s) => return penetrating(a, b, &s),
+    };
+    Some(rounded(a, b, core, on_a, on_b, normal))
+}
+
+fn gjk_simplex_of(a: &ConvexPart, b: &ConvexPart) -> gjk::Simplex {
+    let mut s = gjk::Simplex::default();
+    s.points[0] = gjk::support(a, b, glam::DVec3::Z);
+    s.weights[0] = 1.0;
+    s.len = 1;
+    s
+}
+
+fn penetrating(a: &ConvexPart, b: &ConvexPart, s: &gjk::Simplex) -> Option<SignedDistance> {
+    let p = epa(a, b, s)?;
+    Some(rounded(a, b, -p.depth, p.on_a, p.on_b, p.normal))
+}
+
+/// The surfaces' distance and points from the cores': each rounding moves its surface out
+/// along the normal.
+fn rounded(
+    a: &ConvexPart,
+    b: &ConvexPart,
+    core: f32,
+    on_a: Vec3,
+    on_b: Vec3,
+    normal: Vec3,
+) -> SignedDistance {
+    SignedDistance {
+        distance: core - a.rounding - b.rounding,
+        normal,
+        on_a: on_a + normal * a.rounding,
+        on_b: on_b - normal * b.rounding,
+    }
+}
+
+/// Why a convex hull could not be made from a mesh file.
+#[derive(Debug)]
+pub enum HullFileError {
+    /// The file could not be read or parsed (see [`MeshLoadError`]).
+    Load(MeshLoadError),
+    /// Its vertices make no hull (see [`HullError`]).
+    Hull(HullError),
+}
+
+impl fmt::Display for HullFileError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Load(e) => write!(f, "cannot load the hull's mesh: {e}"),
+            Self::Hull(e) => write!(f, "the mesh's vertices make no hull: {e}"),
+        }
+    }
+}
+
+impl std::error::Error for HullFileError {}
+
+impl From<MeshLoadError> for HullFileError {
+    fn from(e: MeshLoadError) -> Self {
+        Self::Load(e)
+    }
+}
+
+impl From<HullError> for HullFileError {
+    fn from(e: HullError) -> Self {
+        Self::Hull(e)
+    }
+}
+
+/// The convex hull of the vertices of an OBJ, STL or PLY file (by extension, as
+/// [`mesh_io::load`]).
+pub fn hull_from_file(path: impl AsRef<std::path::Path>) -> Result<ConvexHull, HullFileError> {
+    let mesh = mesh_io::load(path)?;
+    Ok(ConvexHull::from_points(mesh.vertices())?)
+}
