@@ -10,9 +10,9 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{Quat, Vec3};
 use std::hint::black_box;
 use urto::geometry::contacts::{
-    contact_cuboid_cuboid, contact_cuboid_halfspace, contact_sphere_cuboid,
+    contact, contact_cuboid_cuboid, contact_cuboid_halfspace, contact_sphere_cuboid,
 };
-use urto::geometry::{Cuboid, HalfSpace, Isometry, Sphere};
+use urto::geometry::{Cuboid, HalfSpace, Isometry, Shape, Sphere};
 
 /// Poses per benchmark iteration.
 const POSES: usize = 1024;
@@ -211,5 +211,77 @@ fn cuboid_halfspace(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, cuboid_cuboid, sphere_cuboid, cuboid_halfspace);
+/// Pairs without a closed form: a random hull of 16 points against another, and a cylinder
+/// against a box. urto builds the whole manifold (GJK/EPA, then the feature clip); parry's
+/// `query::contact` finds one point by GJK/EPA, so the comparison favours parry.
+fn convex_pairs(c: &mut Criterion) {
+    let mut r = Rng(4);
+    let mut hull = |r: &mut Rng| {
+        let half = r.vec(0.2, 1.0);
+        let points: Vec<Vec3> = (0..16).map(|_| r.vec(-1.0, 1.0) * half).collect();
+        Shape::convex_hull(&points).unwrap_or_else(|_| Shape::cuboid(half))
+    };
+    let hulls: Vec<_> = (0..POSES)
+        .map(|_| (hull(&mut r), r.pose(1.0), hull(&mut r), r.pose(1.0)))
+        .collect();
+    let cylinders: Vec<_> = (0..POSES)
+        .map(|_| {
+            let cyl = Shape::cylinder(0.1 + r.next(), 0.1 + r.next());
+            (
+                cyl,
+                r.pose(1.0),
+                Shape::cuboid(r.vec(0.1, 1.0)),
+                r.pose(1.0),
+            )
+        })
+        .collect();
+    let to_parry = |s: &Shape| -> Box<dyn parry3d::shape::Shape> {
+        match s {
+            Shape::ConvexHull(h) => {
+                let v: Vec<_> = h
+                    .vertices()
+                    .iter()
+                    .map(|p| parry3d::math::Vector::from_array(p.to_array()))
+                    .collect();
+                Box::new(parry3d::shape::ConvexPolyhedron::from_convex_hull(&v).unwrap())
+            }
+            Shape::Cylinder(c) => Box::new(parry3d::shape::Cylinder::new(c.half_height, c.radius)),
+            Shape::Cuboid(c) => Box::new(parry_cuboid(c)),
+            _ => unreachable!(),
+        }
+    };
+    let mut group = c.benchmark_group("convex");
+    for (name, pairs) in [("hull_hull", &hulls), ("cylinder_cuboid", &cylinders)] {
+        let parry: Vec<_> = pairs
+            .iter()
+            .map(|(a, pa, b, pb)| (to_parry(a), parry_pose(pa), to_parry(b), parry_pose(pb)))
+            .collect();
+        group.bench_function(format!("{name}: urto manifold (GJK/EPA + clip)"), |bench| {
+            bench.iter(|| {
+                for (a, pa, b, pb) in pairs {
+                    black_box(contact(a, pa, b, pb));
+                }
+            })
+        });
+        group.bench_function(
+            format!("{name}: parry query::contact (one point)"),
+            |bench| {
+                bench.iter(|| {
+                    for (a, pa, b, pb) in &parry {
+                        black_box(parry3d::query::contact(pa, &**a, pb, &**b, 0.0).ok());
+                    }
+                })
+            },
+        );
+    }
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    cuboid_cuboid,
+    sphere_cuboid,
+    cuboid_halfspace,
+    convex_pairs
+);
 criterion_main!(benches);

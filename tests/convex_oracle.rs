@@ -12,8 +12,10 @@
 //! - Ours is an upper bound of the true signed distance: GJK's `v` joins a point of A to a point
 //!   of B, and EPA's polytope lies inside `A − B`, so its depth never exceeds the true one.
 //!   Where parry's answer lies above ours by more than the tolerance, parry is provably off
-//!   (its GJK/EPA stop earlier on curved cylinders: up to 8e-3 on cylinder–box); those pairs are
-//!   counted (`parry_off`) and printed, not failed. Where it lies below ours, we fail.
+//!   (its GJK/EPA stop earlier on curved cylinders and capsules); those pairs are counted
+//!   (`parry_off`, at most a tenth of them) and printed, not failed. Where it lies below ours,
+//!   we fail. Our EPA depth is also checked against the least projection overlap over 66
+//!   directions, which no true depth exceeds.
 //! - Hull–ball pairs are checked against an exact brute force over the hull's triangles instead:
 //!   parry 0.31 strays up to 3e-3 on flat random hulls.
 
@@ -134,6 +136,26 @@ fn hull_sphere_brute_force(a: &Shape, pa: &Isometry, b: &Shape, pb: &Isometry) -
     Some(if outside { nearest } else { -nearest } - s.radius)
 }
 
+/// 64 unit directions spread over the sphere (a Fibonacci lattice).
+fn directions() -> impl Iterator<Item = Vec3> {
+    (0..64).map(|k| {
+        let z = 1.0 - (2 * k + 1) as f32 / 64.0;
+        let phi = k as f32 * 2.399_963;
+        let r = (1.0 - z * z).sqrt();
+        Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    })
+}
+
+/// parry's contact normal (from A to B) for an overlapping pair, or up.
+fn truth_normal(a: &Shape, pa: &Isometry, b: &Shape, pb: &Isometry) -> Vec3 {
+    let (sa, qa) = to_parry(a, pa);
+    let (sb, qb) = to_parry(b, pb);
+    parry3d::query::contact(&qa, &*sa, &qb, &*sb, 0.0)
+        .ok()
+        .flatten()
+        .map_or(Vec3::Z, |c| Vec3::from_array(c.normal1.to_array()))
+}
+
 /// How far the shape at `pose` reaches along the unit `d` (its support value).
 fn reach(shape: &Shape, pose: &Isometry, d: Vec3) -> f32 {
     let local = pose.inverse_transform_vector(d);
@@ -186,9 +208,14 @@ fn compare(kind_a: &str, kind_b: &str, seed: u64) -> Stats {
             eprintln!("{}: ours {}", context(), ours.distance);
         }
         if ours.distance < 0.0 {
-            // EPA's depth can be no more than the overlap of the shapes' projections on its own
-            // normal (computed here from vertices and radii, independently of GJK/EPA).
-            let overlap = reach(&a, &pa, ours.normal) + reach(&b, &pb, -ours.normal);
+            // The true depth is at most the overlap of the shapes' projections on any
+            // direction (computed here from vertices and radii, independently of GJK/EPA), and
+            // EPA's is at most the true one: below the least overlap over its own normal,
+            // parry's, and 64 fixed directions.
+            let overlap = directions()
+                .chain([ours.normal, truth_normal(&a, &pa, &b, &pb)])
+                .map(|d| reach(&a, &pa, d) + reach(&b, &pb, -d))
+                .fold(f32::INFINITY, f32::min);
             assert!(
                 -ours.distance <= overlap + 1e-4 * size,
                 "{}: EPA depth {} beyond the overlap {overlap} along its normal",
@@ -225,6 +252,7 @@ fn cylinder_pairs_agree_with_parry_within_1e_4_of_the_size_on_10000_pairs_each()
     for (k, other) in ["sphere", "box", "capsule", "cylinder"].iter().enumerate() {
         let s = compare("cylinder", other, 11 + k as u64);
         assert_eq!(s.beyond_tolerance, 0, "cylinder-{other}: {s:?}");
+        assert!(s.parry_off < SAMPLES / 10, "cylinder-{other}: {s:?}");
         assert!(
             s.overlapping > SAMPLES / 10 && s.apart > SAMPLES / 10,
             "{s:?}"
@@ -240,6 +268,7 @@ fn hull_pairs_agree_with_parry_within_1e_4_of_the_size_on_10000_pairs_each() {
     {
         let s = compare("hull", other, 21 + k as u64);
         assert_eq!(s.beyond_tolerance, 0, "hull-{other}: {s:?}");
+        assert!(s.parry_off < SAMPLES / 10, "hull-{other}: {s:?}");
         assert!(
             s.overlapping > SAMPLES / 10 && s.apart > SAMPLES / 10,
             "{s:?}"
@@ -306,24 +335,4 @@ fn ellipsoid_closest_pairs_meet_the_optimality_conditions_within_1e_4() {
         assert!(pb.transform_vector(normal_b).dot(d.normal) < -1.0 + 1e-4);
     }
     assert!(checked > SAMPLES / 4, "{checked}");
-}
-
-#[test]
-fn debug_1496() {
-    let mut rng = Rng::new(13);
-    for sample in 0..1497 {
-        let (a, b) = (
-            any_shape(&mut rng, "cylinder"),
-            any_shape(&mut rng, "capsule"),
-        );
-        let pa = rng.placement(0.2);
-        let pb = rng.placement(1.4);
-        if sample != 1496 {
-            continue;
-        }
-        eprintln!("ab {:?}", signed_distance(&a, &pa, &b, &pb));
-        eprintln!("ba {:?}", signed_distance(&b, &pb, &a, &pa));
-        eprintln!("c {:?}", contact(&a, &pa, &b, &pb));
-        eprintln!("{a:?} {pa:?} {b:?} {pb:?}");
-    }
 }

@@ -33,10 +33,17 @@ pub fn toi_sphere_convex(sweep: &SphereSweep, shape: &Shape, pose: &Isometry) ->
     let skip = t == 0.0
         && sweep.initial_overlap() == InitialOverlap::ApproachingOnly
         && sweep.displacement().dot(d.normal) >= 0.0;
+    // At an impact the surfaces meet (on_a is on both); a contact already at the start takes
+    // the midpoint between the surfaces, as the static tests do.
+    let point = if t > 0.0 {
+        d.on_a
+    } else {
+        (d.on_a + d.on_b) * 0.5
+    };
     (!skip).then_some(Toi {
         t,
         normal: d.normal,
-        point: d.on_a,
+        point,
     })
 }
 

@@ -2,31 +2,26 @@
 //!
 //! Quickhull (Barber, Dobkin & Huhdanpaa, "The quickhull algorithm for convex hulls", ACM TOMS
 //! 22(4), 1996) as Dirk Gregorius presents it ("Implementing Quickhull", GDC 2014): from a big
-//! tetrahedron, each point goes to the face it is farthest above (its *outside set*); while a
-//! face has one, its farthest point (the *eye*) joins the hull: the faces it sees give way to a
-//! cone of triangles from their boundary (the *horizon*) to the eye, which takes their points.
-//! About O(n log n). Coplanar triangles are merged into polygons at the end.
-//!
-//! Robustness, hazard by hazard:
+//! tetrahedron, each point goes to the face it is farthest above; while a face has points, the
+//! farthest (the *eye*) joins the hull: the faces it sees give way to a cone of triangles from
+//! their boundary (the *horizon*) to it, which takes their points. About O(n log n). Robustness:
 //! - **Tolerance** (Gregorius' rule): `eps = 3 · f32::EPSILON · (max|x| + max|y| + max|z|)` over
-//!   the points centred on their box and scaled by a power of two to a size near 1 (exact; no
-//!   product of tiny or huge coordinates under- or overflows). A point within `eps` of a face's
-//!   plane is on it, never an eye: duplicates and points on faces or edges never become vertices.
+//!   the points centred on their box and scaled by a power of two to a size near 1 (exact). A
+//!   point within `eps` of a plane is on it, never an eye: duplicates and points on faces or
+//!   edges do not become vertices.
 //! - **Degenerate clouds**: the first tetrahedron is the extremes along the axis of largest
 //!   spread, the point farthest from their line, then from their plane; a spread or distance of
 //!   at most `eps` is [`HullError::Degenerate`], caught before anything divides by it.
-//! - **Exact topology**: whether the eye sees a face is read from its plane distance beyond
-//!   `4 eps`, else from Shewchuk's exact `orient3d` on the input points: the hull so far is
-//!   exactly convex, the faces seen form a disk, and no cone folds over (with a tolerance alone,
-//!   near-coplanar eyes fold thin triangles over their neighbours and wreck later tests).
-//!   Normals are f64 cross products of the differences: even thin triangles' are f32-exact.
-//! - **Merging**: triangles are grouped, largest first, with neighbours whose corners are within
-//!   `eps` of the plane of the group's first; a group whose boundary is not one simple loop, or
-//!   has a dent deeper than `eps`, stays as triangles. Corners inside a group vanish; a corner on
-//!   only two faces (on an edge) is dropped from both unless one would keep fewer than 3.
-//! - **Planes**: a polygon's normal is Newell's (its area vector: no thin piece tilts it), its
-//!   offset the largest `normal · v` over its corners; they all lie within `2 eps` below it,
-//!   and every input point within `eps` above every plane (`eps` over the scale, in input units).
+//! - **Exact topology**: an eye sees a face if its plane distance is beyond `4 eps`, else by
+//!   Shewchuk's exact `orient3d` on the inputs: the hull stays exactly convex, the faces seen
+//!   form a disk, no cone folds over (as thin triangles do under near-coplanar eyes with a
+//!   tolerance alone). Normals are f64 cross products of differences: f32-exact even for slivers.
+//! - **Merging**: triangles join, largest first, groups whose corners are all within `eps` of
+//!   the first one's plane; a group whose boundary is not one simple loop or is dented deeper
+//!   than `eps` stays as triangles. Corners inside a group or on only two faces (on an edge)
+//!   vanish. Planes: Newell's normal (the area vector) and the largest `normal · v`; corners lie
+//!   within `2 eps` below, every input point within `eps` above (`eps` over the scale, in input
+//!   units).
 
 use super::predicates::orient3d;
 use super::shapes::MAX_SHAPE_EXTENT;
@@ -44,7 +39,9 @@ const TETRA_ADJ: [[usize; 3]; 4] = [[1, 2, 3], [3, 2, 0], [1, 3, 0], [2, 1, 0]];
 pub struct ConvexHull {
     vertices: Vec<Vec3>,
     faces: Vec<HullFace>,
+    /// Face `f`'s corners are `face_indices[face_start[f]..face_start[f + 1]]`.
     face_indices: Vec<u32>,
+    face_start: Vec<u32>,
     /// Per vertex, the vertices it shares an edge with.
     neighbours: Vec<Vec<u32>>,
 }
@@ -56,8 +53,6 @@ pub struct HullFace {
     pub normal: Vec3,
     /// Plane offset: `normal · x == offset` on the face, `<` inside the hull.
     pub offset: f32,
-    first: u32,
-    len: u32,
 }
 
 /// Why a hull cannot be built.
@@ -72,8 +67,7 @@ pub enum HullError {
         /// Its coordinates.
         position: Vec3,
     },
-    /// A coordinate magnitude above `MAX_SHAPE_EXTENT` (1e6 m), so that products of coordinates
-    /// stay finite. Also (carrying the count) more points than `u32` indices can address.
+    /// A coordinate magnitude above `MAX_SHAPE_EXTENT` (1e6 m): products would lose finiteness.
     TooLarge(f32),
     /// All points are (within tolerance) coincident, collinear or coplanar: no volume.
     Degenerate,
@@ -84,7 +78,7 @@ impl fmt::Display for HullError {
         let max = MAX_SHAPE_EXTENT;
         match self {
             Self::TooFewPoints(n) => write!(f, "{n} points: a hull needs 4 or more, not coplanar"),
-            Self::NonFinitePoint { index, position } => write!(f, "point {index} is {position}"),
+            Self::NonFinitePoint { index, .. } => write!(f, "point {index} is not finite: drop it"),
             Self::TooLarge(x) => write!(f, "{x} is beyond ±{max}: scale the points down"),
             Self::Degenerate => write!(f, "the points are flat (coplanar): give them thickness"),
         }
@@ -100,25 +94,20 @@ impl ConvexHull {
         if points.len() < 4 {
             return Err(HullError::TooFewPoints(points.len()));
         }
-        for (index, &position) in points.iter().enumerate() {
-            let size = position.abs().max_element();
-            if !position.is_finite() {
-                return Err(HullError::NonFinitePoint { index, position });
-            } else if size > MAX_SHAPE_EXTENT {
-                return Err(HullError::TooLarge(size));
-            }
+        if let Some(index) = points.iter().position(|p| !p.is_finite()) {
+            let position = points[index];
+            return Err(HullError::NonFinitePoint { index, position });
         }
-        if u32::try_from(points.len()).is_err() {
-            return Err(HullError::TooLarge(points.len() as f32));
+        let big = |p: &&Vec3| p.abs().max_element() > MAX_SHAPE_EXTENT;
+        if let Some(p) = points.iter().find(big) {
+            return Err(HullError::TooLarge(p.abs().max_element()));
         }
         let center = Aabb::from_points(points.iter().copied()).center();
         let size = points.iter().map(|&q| (q - center).abs().max_element());
         let size = size.fold(0.0, f32::max); // 0 (one point) scales by 2^120: degenerate
         let scale = 2f32.powi(-(size.log2().ceil() as i32).clamp(-120, 120));
         let p: Vec<Vec3> = points.iter().map(|&q| (q - center) * scale).collect();
-        let mut builder = Builder::new(&p, points)?;
-        builder.run();
-        Ok(builder.polygons())
+        Ok(Builder::new(&p, points)?.hull())
     }
 
     /// The hull's vertices: only its corners (no interior, mid-edge or mid-face points).
@@ -134,10 +123,9 @@ impl ConvexHull {
     /// Indices into [`vertices`](Self::vertices) of a face's corners, counter-clockwise seen from
     /// outside (the right-hand rule gives the outward normal); empty for a face out of range.
     pub fn face_vertices(&self, face: usize) -> &[u32] {
-        let (all, range) = (&self.face_indices, |f: &HullFace| {
-            f.first as usize..(f.first + f.len) as usize
-        });
-        self.faces.get(face).map_or(&[], |f| &all[range(f)])
+        let s = self.face_start.get(face..).unwrap_or(&[]);
+        let all = &self.face_indices;
+        s.get(1).map_or(&[], |&e| &all[s[0] as usize..e as usize])
     }
 
     /// A face's corners as points, in [`face_vertices`](Self::face_vertices) order.
@@ -146,20 +134,15 @@ impl ConvexHull {
         ids.map(|&i| self.vertices[i as usize])
     }
 
-    /// The vertex farthest along `dir` (any of them on a tie), GJK's support mapping. Hulls of up
-    /// to 16 vertices are scanned; larger ones are climbed from a vertex to its best neighbour
-    /// while that is better: on a convex polytope's vertex graph a local maximum of a linear
-    /// function is the global one, and strict improvement rules out cycling on ties.
+    /// The vertex farthest along `dir` (any on a tie), for GJK: the best of the first 16 vertices
+    /// (all of a small hull), then a better neighbour while there is one. On a convex polytope's
+    /// vertex graph a local maximum of a linear function is global; strict gains cannot cycle.
     pub fn support(&self, dir: Vec3) -> Vec3 {
         let v = &self.vertices;
         let mut best = argmax(v.len().min(16), |i| v[i].dot(dir));
-        while v.len() > 16 {
-            let near = &self.neighbours[best];
-            let next = near[argmax(near.len(), |k| v[near[k] as usize].dot(dir))] as usize;
-            if v[next].dot(dir) <= v[best].dot(dir) || dir.is_nan() {
-                break;
-            }
-            best = next;
+        let up = |b: usize, n: &&u32| v[**n as usize].dot(dir) > v[b].dot(dir);
+        while let Some(&n) = self.neighbours[best].iter().find(|n| up(best, n)) {
+            best = n as usize;
         }
         v[best]
     }
@@ -169,12 +152,11 @@ impl ConvexHull {
         argmax(self.faces.len(), |i| self.faces[i].normal.dot(dir))
     }
 
-    /// The surface as triangles (each face fanned from its first corner), outward winding, for
-    /// mass properties and drawing.
+    /// The surface as triangles (faces fanned), outward winding: for mass properties, drawing.
     pub fn to_trimesh(&self) -> Result<TriMesh, MeshError> {
         let mut triangles = Vec::with_capacity(self.face_indices.len());
         for ids in (0..self.faces.len()).map(|f| self.face_vertices(f)) {
-            triangles.extend(ids.windows(2).skip(1).map(|w| [ids[0], w[0], w[1]]));
+            triangles.extend((2..ids.len()).map(|i| [ids[0], ids[i - 1], ids[i]]));
         }
         TriMesh::new(self.vertices.clone(), triangles)
     }
@@ -202,19 +184,16 @@ fn tolerance(points: &[Vec3]) -> f32 {
     3.0 * f32::EPSILON * (m.x + m.y + m.z)
 }
 
-/// A triangle of the hull being built. Edge `k` is `v[k] → v[k + 1]`, shared with `adj[k]`.
+/// A triangle of the hull being built: edge `k` is `v[k] → v[k + 1]`, shared with `adj[k]`;
+/// `out` its outside set (points with positions), `mark` the stamp of the last eye seeing it.
 #[derive(Default)]
 struct Tri {
     v: [usize; 3],
     adj: [usize; 3],
     n: Vec3,
     d: f32,
-    /// The outside set (point, position): more than `eps` above the plane; and its farthest.
     out: Vec<(usize, Vec3)>,
-    far: usize,
-    far_d: f32,
     dead: bool,
-    /// Stamp of the last eye that sees it.
     mark: u32,
 }
 
@@ -225,7 +204,6 @@ struct Scratch {
     seen: Vec<usize>,
     cand: Vec<usize>,
     edges: Vec<[usize; 3]>,
-    order: Vec<usize>,
     cone: Vec<usize>,
     pool: Vec<(usize, Vec3)>,
 }
@@ -244,8 +222,7 @@ struct Builder<'a> {
 }
 
 impl<'a> Builder<'a> {
-    /// The first tetrahedron (extremes, farthest from their line, farthest from their plane),
-    /// with every other point in an outside set.
+    /// The first tetrahedron (see the module notes), with every other point in an outside set.
     fn new(p: &'a [Vec3], orig: &'a [Vec3]) -> Result<Self, HullError> {
         let (eps, count) = (tolerance(p), p.len());
         let m = p.iter().fold(Vec3::ZERO, |m, q| m.max(q.abs()));
@@ -265,9 +242,8 @@ impl<'a> Builder<'a> {
         let mut b = Self::default();
         (b.p, b.orig, b.eps, b.at) = (p, orig, eps, vec![(0, 0); count]);
         let tetra = [[i, j, k], [i, l, j], [j, l, k], [k, l, i]];
-        for (f, v) in tetra.into_iter().enumerate() {
-            b.add_tri(v);
-            b.tris[f].adj = TETRA_ADJ[f];
+        for (v, adj) in tetra.into_iter().zip(TETRA_ADJ) {
+            b.add_tri(v, adj);
         }
         for q in (0..count).filter(|q| ![i, j, k, l].contains(q)) {
             b.assign((q, p[q]), &[0, 1, 2, 3]);
@@ -275,8 +251,8 @@ impl<'a> Builder<'a> {
         Ok(b)
     }
 
-    /// A new triangle (its neighbours left to the caller), in a dead one's slot if any.
-    fn add_tri(&mut self, v: [usize; 3]) -> usize {
+    /// A new triangle, in a dead one's slot if any.
+    fn add_tri(&mut self, v: [usize; 3], adj: [usize; 3]) -> usize {
         let [a, b, c] = v.map(|i| self.p[i]);
         let n = (b.as_dvec3() - a.as_dvec3()).cross(c.as_dvec3() - a.as_dvec3());
         let n = n.normalize_or_zero().as_vec3();
@@ -285,7 +261,7 @@ impl<'a> Builder<'a> {
             self.tris.push(Tri::default());
         }
         let t = &mut self.tris[id]; // a dead triangle's outside set is empty
-        (t.v, t.n, t.d, t.dead) = (v, n, n.dot((a + b + c) / 3.0), false);
+        (t.v, t.adj, t.n, t.d, t.dead) = (v, adj, n, n.dot((a + b + c) / 3.0), false);
         id
     }
 
@@ -293,35 +269,24 @@ impl<'a> Builder<'a> {
     fn assign(&mut self, (q, at): (usize, Vec3), faces: &[usize]) {
         let dist = |f: usize| self.tris[f].n.dot(at) - self.tris[f].d;
         let best = faces[argmax(faces.len(), |k| dist(faces[k]))];
-        let (top, t) = (dist(best), &mut self.tris[best]);
-        if top > self.eps {
-            if t.out.is_empty() || top > t.far_d {
-                (t.far, t.far_d) = (q, top);
-            }
-            t.out.push((q, at));
-        }
-    }
-
-    fn run(&mut self) {
-        let mut w = Scratch::default();
-        w.stack.extend(0..4);
-        while let Some(f) = w.stack.pop() {
-            if !self.tris[f].dead && !self.tris[f].out.is_empty() {
-                self.add_point(f, &mut w);
-            }
+        if dist(best) > self.eps {
+            self.tris[best].out.push((q, at));
         }
     }
 
     /// Adds face `f`'s farthest point to the hull.
     fn add_point(&mut self, f: usize, w: &mut Scratch) {
-        let (p, orig, eps, eye) = (self.p, self.orig, self.eps, self.tris[f].far);
+        let (t, p, orig, eps) = (&self.tris[f], self.p, self.orig, self.eps);
+        let eye = t.out[argmax(t.out.len(), |k| t.n.dot(t.out[k].1))].0;
         let sees = |t: &Tri| {
             let d = t.n.dot(p[eye]) - t.d; // clear beyond 4 eps, else decided exactly
             let [a, b, c] = t.v.map(|i| orig[i]);
             d > 4.0 * eps || (d > -4.0 * eps && orient3d(a, b, c, orig[eye]) > 0.0)
         };
         self.stamp += 1;
-        (w.seen.clear(), w.edges.clear(), w.cand.push(f));
+        w.seen.clear();
+        w.edges.clear();
+        w.cand.push(f);
         while let Some(g) = w.cand.pop() {
             if self.tris[g].mark != self.stamp && sees(&self.tris[g]) {
                 self.tris[g].mark = self.stamp;
@@ -332,22 +297,17 @@ impl<'a> Builder<'a> {
         for &g in &w.seen {
             let (t, s) = (&self.tris[g], self.stamp);
             let horizon = (0..3).filter(|&k| self.tris[t.adj[k]].mark != s);
-            w.edges
-                .extend(horizon.map(|k| [t.v[k], t.v[(k + 1) % 3], t.adj[k]]));
+            let edge = |k: usize| [t.v[k], t.v[(k + 1) % 3], t.adj[k]];
+            w.edges.extend(horizon.map(edge));
         }
-        if !self.trace(&w.edges, &mut w.order) {
-            let pool = std::mem::take(&mut self.tris[f].out); // `f` does not see its eye: drop it
-            for q in pool.into_iter().filter(|q| q.0 != eye) {
-                self.assign(q, &[f]);
-            }
+        if !self.trace(&mut w.edges) {
+            self.tris[f].out.retain(|q| q.0 != eye); // `f` does not see its eye after all
             return w.stack.push(f);
         }
-        w.cone.clear();
-        for &k in &w.order {
-            let [a, b, o] = w.edges[k];
-            let c = self.add_tri([a, b, eye]);
+        for &[a, b, o] in &w.edges {
+            let c = self.add_tri([a, b, eye], [o, 0, 0]);
             let j = (0..3).find(|&j| self.tris[o].v[j] == b).unwrap_or(0);
-            (self.tris[c].adj[0], self.tris[o].adj[j]) = (o, c);
+            self.tris[o].adj[j] = c;
             w.cone.push(c);
         }
         let m = w.cone.len();
@@ -357,42 +317,43 @@ impl<'a> Builder<'a> {
         }
         for g in w.seen.drain(..) {
             self.tris[g].dead = true;
-            w.pool.extend(self.tris[g].out.drain(..));
+            w.pool.append(&mut self.tris[g].out); // keeps the face's capacity
             self.free.push(g);
         }
         for q in w.pool.drain(..).filter(|q| q.0 != eye) {
             self.assign(q, &w.cone);
         }
-        let with_points = w.cone.iter().filter(|&&c| !self.tris[c].out.is_empty());
+        let with_points = w.cone.drain(..).filter(|&c| !self.tris[c].out.is_empty());
         w.stack.extend(with_points);
     }
 
-    /// Orders `edges` into one closed loop, writing their indices to `order`; false if they are
-    /// not exactly one simple loop.
-    fn trace(&mut self, edges: &[[usize; 3]], order: &mut Vec<usize>) -> bool {
-        (order.clear(), self.stamp += 1);
-        let s = self.stamp;
+    /// Puts `edges` in order along their loop; false unless they are exactly one simple loop.
+    fn trace(&mut self, edges: &mut Vec<[usize; 3]>) -> bool {
+        self.stamp += 1;
         for (k, e) in edges.iter().enumerate() {
-            if self.at[e[0]].0 == s {
-                return false; // a pinch: two edges leave one vertex
-            }
-            self.at[e[0]] = (s, k);
+            self.at[e[0]] = (self.stamp, k);
         }
-        let first = edges.first().map_or(0, |e| e[0]);
+        let (first, mut ring) = (edges.first().map_or(0, |e| e[0]), vec![]);
         let mut v = first;
-        for _ in 0..edges.len() {
-            if self.at[v].0 != s {
-                return false;
-            }
+        while self.at[v].0 == self.stamp {
             let k = self.at[v].1;
             (self.at[v].0, v) = (0, edges[k][1]); // 0: visited
-            order.push(k);
+            ring.push(edges[k]);
         }
-        !edges.is_empty() && v == first
+        let closed = !edges.is_empty() && ring.len() == edges.len() && v == first;
+        *edges = ring;
+        closed
     }
 
-    /// Merges coplanar triangles into polygons, and builds the hull over the input points.
-    fn polygons(mut self) -> ConvexHull {
+    /// Runs quickhull, then merges coplanar triangles into the hull's polygons.
+    fn hull(mut self) -> ConvexHull {
+        let mut w = Scratch::default();
+        w.stack.extend(0..4);
+        while let Some(f) = w.stack.pop() {
+            if !self.tris[f].dead && !self.tris[f].out.is_empty() {
+                self.add_point(f, &mut w);
+            }
+        }
         let (p, eps, tris) = (self.p, self.eps, std::mem::take(&mut self.tris));
         let mut alive: Vec<usize> = (0..tris.len()).filter(|&t| !tris[t].dead).collect();
         alive.sort_by_cached_key(|&t| {
@@ -403,15 +364,13 @@ impl<'a> Builder<'a> {
         for &s in &alive {
             let (n, d) = (tris[s].n, tris[s].d);
             if group[s] == usize::MAX {
-                group[s] = s; // a group is named by its first, largest triangle
-                stack.push(s);
+                (group[s], stack) = (s, vec![s]); // a group is named by its first, largest triangle
             }
-            let g = group[s];
             while let Some(t) = stack.pop() {
                 for u in tris[t].adj {
                     let on_plane = |i: &usize| (n.dot(p[*i]) - d).abs() <= eps;
                     if group[u] == usize::MAX && tris[u].v.iter().all(on_plane) {
-                        group[u] = g;
+                        group[u] = s;
                         stack.push(u);
                     }
                 }
@@ -419,24 +378,23 @@ impl<'a> Builder<'a> {
         }
         alive.sort_by_key(|&t| group[t]); // stable: a group's first triangle leads it
         // Each face: its boundary loop `ring[start..end]`, and a normal if it is degenerate.
-        let (mut ring, mut loops, mut edges, mut order) =
-            (vec![], vec![], vec![[0; 3]; 0], vec![0; 0]);
+        let (mut ring, mut loops, mut edges) = (vec![], vec![], vec![[0; 3]; 0]);
         for members in alive.chunk_by(|&x, &y| group[x] == group[y]) {
-            let (g, many, seed) = (group[members[0]], members.len() > 1, tris[members[0]].n);
+            let (g, seed) = (group[members[0]], tris[members[0]].n);
             edges.clear();
-            for t in members.iter().map(|&t| &tris[t]).filter(|_| many) {
+            for t in members.iter().map(|&t| &tris[t]) {
                 let out = (0..3).filter(|&k| group[t.adj[k]] != g);
                 edges.extend(out.map(|k| [t.v[k], t.v[(k + 1) % 3], 0]));
             }
-            let traced = many && self.trace(&edges, &mut order);
+            let traced = self.trace(&mut edges);
             let dent = |i: usize| {
-                let ([u, v, _], w) = (edges[order[i]], edges[order[(i + 1) % order.len()]][1]);
+                let ([u, v, _], w) = (edges[i], edges[(i + 1) % edges.len()][1]);
                 let inward = seed.cross(p[w] - p[u]).normalize_or_zero();
                 inward.dot(p[v] - p[u])
             };
-            if traced && (0..order.len()).all(|i| dent(i) <= eps) {
-                ring.extend(order.iter().map(|&k| edges[k][0]));
-                loops.push((ring.len() - order.len(), ring.len(), seed));
+            if traced && (0..edges.len()).all(|i| dent(i) <= eps) {
+                ring.extend(edges.iter().map(|e| e[0]));
+                loops.push((ring.len() - edges.len(), ring.len(), seed));
             } else {
                 for t in members.iter().map(|&t| &tris[t]) {
                     ring.extend(t.v);
@@ -444,51 +402,43 @@ impl<'a> Builder<'a> {
                 }
             }
         }
-        let mut count = vec![0u32; p.len()]; // faces per point; 2: dropped
+        // Points on two faces only are dropped; a triangle left with two was between those faces.
+        let mut count = vec![0u32; p.len()];
         ring.iter().for_each(|&v| count[v] += 1);
-        for &(start, end, _) in &loops {
-            let mut kept = ring[start..end].iter().filter(|&&v| count[v] != 2).count();
-            for &v in &ring[start..end] {
-                if count[v] == 2 && kept < 3 {
-                    (count[v], kept) = (3, kept + 1);
-                }
-            }
-        }
-        let (mut vertices, mut faces, mut face_indices) = (vec![], vec![], vec![]);
-        let (mut remap, mut poly) = (vec![u32::MAX; p.len()], vec![]);
+        let (mut vertices, mut faces, mut face_indices, mut neighbours) =
+            (vec![], vec![], vec![], vec![]);
+        let (mut remap, mut face_start, mut kept) = (vec![u32::MAX; p.len()], vec![0], vec![]);
         for &(start, end, fallback) in &loops {
-            poly.clear();
-            for &v in ring[start..end].iter().filter(|&&v| count[v] != 2) {
+            kept.clear();
+            kept.extend(ring[start..end].iter().copied().filter(|&v| count[v] != 2));
+            if kept.len() < 3 {
+                continue;
+            }
+            let c = kept.iter().map(|&v| self.orig[v]).sum::<Vec3>() / kept.len() as f32;
+            let corner = |i: usize| self.orig[kept[i % kept.len()]] - c;
+            let normal = (0..kept.len()).map(|i| corner(i).cross(corner(i + 1)));
+            let normal = normal.sum::<Vec3>().try_normalize().unwrap_or(fallback);
+            let heights = kept.iter().map(|&v| normal.dot(self.orig[v]));
+            let offset = heights.fold(f32::MIN, f32::max);
+            for &v in &kept {
                 if remap[v] == u32::MAX {
                     remap[v] = vertices.len() as u32;
                     vertices.push(self.orig[v]);
+                    neighbours.push(vec![]);
                 }
-                (face_indices.push(remap[v]), poly.push(self.orig[v]));
             }
-            let c = poly.iter().sum::<Vec3>() / poly.len() as f32;
-            let area = |i: usize| (poly[i] - c).cross(poly[(i + 1) % poly.len()] - c);
-            let normal = (0..poly.len()).map(area).sum::<Vec3>().try_normalize();
-            let normal = normal.unwrap_or(fallback);
-            let offset = poly.iter().fold(f32::MIN, |m, c| m.max(normal.dot(*c)));
-            let (first, len) = ((face_indices.len() - poly.len()) as u32, poly.len() as u32);
-            faces.push(HullFace {
-                normal,
-                offset,
-                first,
-                len,
-            });
-        }
-        let mut neighbours = vec![Vec::new(); vertices.len()];
-        for f in &faces {
-            let ids = &face_indices[f.first as usize..(f.first + f.len) as usize];
-            for (i, &a) in ids.iter().enumerate() {
-                neighbours[a as usize].push(ids[(i + 1) % ids.len()]);
+            for (i, &v) in kept.iter().enumerate() {
+                face_indices.push(remap[v]);
+                neighbours[remap[v] as usize].push(remap[kept[(i + 1) % kept.len()]]);
             }
+            faces.push(HullFace { normal, offset });
+            face_start.push(face_indices.len() as u32);
         }
         ConvexHull {
             vertices,
             faces,
             face_indices,
+            face_start,
             neighbours,
         }
     }
@@ -496,63 +446,51 @@ impl<'a> Builder<'a> {
 
 #[cfg(test)]
 mod tests {
+    use super::HullError::*;
     use super::*;
     use glam::Vec3Swizzles;
     use std::collections::HashSet;
 
-    /// splitmix64, for deterministic clouds.
-    struct Rng(u64);
-
-    impl Rng {
-        /// Uniform in [-1, 1).
-        fn next(&mut self) -> f32 {
-            self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-            let z = (self.0 ^ (self.0 >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    /// `n` seeded (splitmix64) points scaled by `h`: 0 in a cube, 1 on a sphere, 2 in a ball, 3 in
+    /// a box, in turn on a face, on an edge, at a corner (so repeated) and inside; 4 in a cube
+    /// 1e3 wide, 3e3 off the origin; 5 in a flat box (1e-3 thick); 6 a needle; 7 in a 1e-3 ball.
+    fn cloud(mut seed: u64, n: usize, kind: usize, h: Vec3) -> Vec<Vec3> {
+        let mut next = || {
+            seed = seed.wrapping_add(0x9e37_79b9_7f4a_7c15);
+            let z = (seed ^ (seed >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
             let z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
             ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 23) as f32 - 1.0
-        }
-        fn vec(&mut self) -> Vec3 {
-            Vec3::new(self.next(), self.next(), self.next())
-        }
-        fn unit(&mut self) -> Vec3 {
-            let v = self.vec();
-            let inside = (0.01..1.0).contains(&v.length_squared());
-            if inside { v.normalize() } else { self.unit() }
-        }
-        fn cloud(&mut self, n: usize, scale: Vec3, at: Vec3) -> Vec<Vec3> {
-            (0..n).map(|_| self.vec() * scale + at).collect()
-        }
-        fn sphere(&mut self, n: usize) -> Vec<Vec3> {
-            (0..n).map(|_| self.unit()).collect()
-        }
-        /// In the box of half extents `h`, in turn: on a face, on an edge, a corner (repeated),
-        /// inside.
-        fn boxy(&mut self, n: usize, h: Vec3) -> Vec<Vec3> {
-            let snap = [Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::ONE, Vec3::ZERO];
-            let mut point = |i: usize| {
-                let (p, m) = (self.vec(), snap[i % 4]);
-                let m = [m, m.zxy(), m.yzx()][i / 4 % 3];
-                (p + (p.signum() - p) * m) * h
-            };
-            (0..n).map(&mut point).collect()
-        }
+        };
+        let snap = [Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::ONE, Vec3::ZERO];
+        let point = |i: usize| loop {
+            let (p, m) = (Vec3::new(next(), next(), next()), snap[i % 4]);
+            let m = [m, m.zxy(), m.yzx()][i / 4 % 3];
+            match (kind, p.length_squared()) {
+                (0, _) => return p * h,
+                (1, r) if (0.01..1.0).contains(&r) => return p.normalize() * h,
+                (2, r) if r < 1.0 => return p * h,
+                (3, _) => return (p + (p.signum() - p) * m) * h,
+                (4, _) => return (p + 3.0) * 1e3 * h,
+                (5, _) => return p * Vec3::new(1.0, 1.0, 5e-4) * h,
+                (6, _) => return p * Vec3::new(1.0, 1e-3, 1e-3) * h,
+                (7, r) if r < 1.0 => return p * 1e-3 * h,
+                _ => {}
+            }
+        };
+        (0..n).map(point).collect()
     }
 
-    /// Everything the hull promises, within the input's tolerance (every `step`-th point is
-    /// checked against every plane).
-    fn check(points: &[Vec3], h: &ConvexHull, step: usize) {
-        let tol = tolerance(points);
+    /// Builds the hull and checks all it promises, within the input's tolerance (every `step`-th
+    /// point against every plane).
+    fn check(points: &[Vec3], step: usize) -> ConvexHull {
+        let (h, tol) = (ConvexHull::from_points(points).unwrap(), tolerance(points));
         let bits = |p: &Vec3| p.to_array().map(f32::to_bits);
         let inputs: HashSet<_> = points.iter().map(bits).collect();
-        assert!(
-            h.vertices().iter().all(|v| inputs.contains(&bits(v))),
-            "a vertex not input"
-        );
+        assert!(h.vertices().iter().all(|v| inputs.contains(&bits(v))));
         let (mut edges, mut faces_at) = (HashSet::new(), vec![0; h.vertices().len()]);
         for (f, face) in h.faces().iter().enumerate() {
             let (ids, poly) = (h.face_vertices(f), h.face_polygon(f).collect::<Vec<_>>());
             let (m, n, mut turning) = (poly.len(), face.normal, 0.0);
-            assert!((n.length() - 1.0).abs() < 1e-5);
             for i in 0..m {
                 let (u, v, w) = (poly[(i + m - 1) % m], poly[i], poly[(i + 1) % m]);
                 assert!(edges.insert((ids[i], ids[(i + 1) % m])), "an edge twice");
@@ -564,115 +502,77 @@ mod tests {
             }
             let turns = turning / std::f32::consts::TAU;
             assert!((turns - 1.0).abs() < 1e-3, "face {f} turns {turns} times");
+            assert!((n.length() - 1.0).abs() < 1e-6, "face {f}: normal {n}");
             for &q in points.iter().step_by(step) {
                 let above = n.dot(q) - face.offset;
                 assert!(above <= tol, "{q} above face {f} by {above} > {tol}");
             }
         }
-        assert!(
-            edges.iter().all(|&(a, b)| edges.contains(&(b, a))),
-            "not closed"
-        );
-        assert!(faces_at.iter().all(|&n| n >= 3), "a vertex not a corner");
+        let closed = edges.iter().all(|&(a, b)| edges.contains(&(b, a)));
+        assert!(closed && faces_at.iter().all(|&n| n >= 3));
         let (v, e, f) = (h.vertices().len(), edges.len() / 2, h.faces().len());
         assert_eq!(v + f, e + 2, "Euler: V - E + F = 2");
+        h
     }
 
     #[test]
     fn random_clouds_are_convex_within_tolerance() {
-        let (mut rng, flat, needle) = (
-            Rng(1),
-            Vec3::new(1.0, 1.0, 5e-4),
-            Vec3::new(1.0, 1e-3, 1e-3),
-        );
-        for _ in 0..10 {
-            let clouds = [
-                rng.cloud(1000, Vec3::ONE, Vec3::ZERO),
-                rng.sphere(1000),
-                rng.boxy(1000, Vec3::new(1.0, 0.5, 0.25)), // coplanar, on edges, repeated
-                rng.cloud(1000, flat, Vec3::ZERO),
-                rng.cloud(1000, needle, Vec3::ZERO),
-                rng.cloud(1000, Vec3::splat(1e3), Vec3::new(3e3, 0.0, 0.0)),
-                rng.cloud(1000, Vec3::splat(1e-3), Vec3::ZERO),
-            ];
-            for points in clouds {
-                check(&points, &ConvexHull::from_points(&points).unwrap(), 1);
-            }
+        for (seed, kind) in (0..10).flat_map(|seed| (0..8).map(move |kind| (seed, kind))) {
+            check(&cloud(seed, 1000, kind, Vec3::new(1.0, 0.5, 0.25)), 1);
         }
-    }
-
-    #[test]
-    fn dense_sphere_of_200k_points_is_convex_within_tolerance() {
-        // Neighbours ~0.008 apart bulge ~1e-5: the hardest case for plane tests in f32.
-        let points = Rng(8).sphere(200_000);
-        check(&points, &ConvexHull::from_points(&points).unwrap(), 200);
+        check(&cloud(8, 200_000, 1, Vec3::ONE), 200); // dense: neighbours bulge by ~1e-5
     }
 
     #[test]
     fn cube_cloud_has_exactly_8_vertices_and_6_quads() {
-        let mut points = Rng(2).boxy(1000, Vec3::ONE);
-        let grid = (0..25).map(|i| Vec3::new(1.0, (i % 5) as f32 - 2.0, (i / 5) as f32 - 2.0));
-        let grid = grid.map(|g| g * Vec3::new(1.0, 0.5, 0.5));
-        points.extend(grid.flat_map(|g| [g, -g, g.zxy(), -g.zxy(), g.yzx(), -g.yzx()]));
-        let h = ConvexHull::from_points(&points).unwrap();
-        check(&points, &h, 1);
+        let mut points = cloud(2, 1000, 3, Vec3::ONE);
+        let grid = |i: usize| Vec3::new(2.0, (i % 5) as f32 - 2.0, (i / 5) as f32 - 2.0) / 2.0;
+        let faces = |g: Vec3| [g, -g, g.zxy(), -g.zxy(), g.yzx(), -g.yzx()];
+        points.extend((0..25).map(grid).flat_map(faces));
+        let h = check(&points, 1);
         assert_eq!((h.vertices().len(), h.faces().len()), (8, 6));
         assert!((0..6).all(|f| h.face_vertices(f).len() == 4 && h.faces()[f].offset == 1.0));
-        assert_eq!(
-            h.faces()[h.best_face(Vec3::new(0.1, -0.9, 0.2))].normal,
-            Vec3::NEG_Y
-        );
-        assert_eq!(h.local_aabb(), Aabb::new(Vec3::NEG_ONE, Vec3::ONE));
-        assert_eq!(h.bounding_radius(), 3f32.sqrt());
+        let down = h.faces()[h.best_face(Vec3::new(0.1, -0.9, 0.2))].normal;
+        assert_eq!(down, Vec3::NEG_Y);
+        assert_eq!(h.local_aabb(), Aabb::new(-Vec3::ONE, Vec3::ONE));
+        assert!(h.bounding_radius() == 3f32.sqrt() && h.face_vertices(6).is_empty());
     }
 
     #[test]
     fn too_few_flat_collinear_coincident_nan_and_huge_points_are_errors() {
-        let (mut rng, u, v) = (Rng(3), Vec3::new(1.0, 2.0, 3.0), Vec3::new(3.0, -1.0, 0.5));
+        let (u, v) = (Vec3::new(1.0, 2.0, 3.0), Vec3::new(3.0, -1.0, 0.5));
         let err = |p: &[Vec3]| ConvexHull::from_points(p).err();
-        let flat: Vec<Vec3> = (0..100).map(|_| rng.next() * u + rng.next() * v).collect();
-        let line: Vec<Vec3> = (0..100).map(|_| rng.next() * v + u).collect();
-        assert_eq!(err(&flat[..3]), Some(HullError::TooFewPoints(3)));
+        let flat = (0..100).map(|i| (i as f32).sin() * u + (i as f32).cos() * v);
+        let (flat, line): (Vec<_>, Vec<_>) = flat.map(|p| (p, p.x * v + u)).unzip();
+        assert_eq!(err(&flat[..3]), Some(TooFewPoints(3)));
         for degenerate in [&flat[..], &line, &[v; 10]] {
-            assert_eq!(err(degenerate), Some(HullError::Degenerate));
+            assert_eq!(err(degenerate), Some(Degenerate));
         }
-        let mut bad = rng.boxy(10, Vec3::ONE);
+        let mut bad = cloud(3, 10, 0, Vec3::ONE);
         bad[5].y = f32::NAN;
-        assert!(matches!(
-            err(&bad),
-            Some(HullError::NonFinitePoint { index: 5, .. })
-        ));
+        assert!(matches!(err(&bad), Some(NonFinitePoint { index: 5, .. })));
         bad[5].y = -2e6;
-        assert_eq!(err(&bad), Some(HullError::TooLarge(2e6)));
+        assert_eq!(err(&bad), Some(TooLarge(2e6)));
     }
 
     #[test]
     fn million_points_in_a_ball_build_in_under_2s_in_release() {
-        let mut rng = Rng(4);
-        let points: Vec<Vec3> = (0..1_000_000)
-            .map(|_| rng.unit() * rng.next().abs().cbrt())
-            .collect();
+        let points = cloud(4, 1_000_000, 2, Vec3::ONE);
         let start = std::time::Instant::now();
-        let h = ConvexHull::from_points(&points).unwrap();
+        let n = ConvexHull::from_points(&points).unwrap().vertices().len();
         let time = start.elapsed().as_secs_f32();
-        println!(
-            "1e6 points in a ball: {time} s, {} vertices",
-            h.vertices().len()
-        );
-        assert!(
-            h.vertices().len() > 100 && (cfg!(debug_assertions) || time < 2.0),
-            "{time} s"
-        );
-        check(&points, &h, 100);
+        println!("1e6 points in a ball: {time} s, {n} vertices");
+        assert!(n > 100 && (cfg!(debug_assertions) || time < 2.0));
+        check(&points, 100);
     }
 
     #[test]
     fn support_is_the_brute_force_max_for_1000_directions() {
-        let mut rng = Rng(6);
-        for points in [rng.sphere(300), rng.boxy(1000, Vec3::ONE)] {
-            let h = ConvexHull::from_points(&points).unwrap();
+        let dirs = cloud(6, 1000, 0, Vec3::ONE);
+        let (round, cube) = (cloud(5, 300, 1, Vec3::ONE), cloud(5, 1000, 3, Vec3::ONE));
+        for h in [check(&round, 1), check(&cube, 1)] {
             assert!(h.vertices().len() > 16 || h.vertices().len() == 8);
-            for dir in (0..1000).map(|_| rng.vec()) {
+            for &dir in &dirs {
                 let best = h.vertices().iter().fold(f32::MIN, |m, v| m.max(v.dot(dir)));
                 assert_eq!(h.support(dir).dot(dir), best, "along {dir}");
             }
@@ -681,29 +581,17 @@ mod tests {
 
     #[test]
     fn volume_matches_parry3d_within_1e_4_relative() {
-        let mut rng = Rng(7);
         let volume = |m: &TriMesh| {
             let v = |i: u32| m.vertices()[i as usize];
-            let six = m
-                .triangles()
-                .iter()
-                .map(|&[a, b, c]| v(a).dot(v(b).cross(v(c))));
-            six.sum::<f32>() / 6.0
+            let six = |&[a, b, c]: &[u32; 3]| v(a).dot(v(b).cross(v(c)));
+            m.triangles().iter().map(six).sum::<f32>() / 6.0
         };
-        for i in 0..20 {
-            let points = [rng.cloud(500, Vec3::ONE, Vec3::ZERO), rng.sphere(500)][i % 2].clone();
+        for seed in 0..20 {
+            let points = cloud(seed, 500, seed as usize % 2, Vec3::ONE);
             let (vertices, triangles) = parry3d::transformation::convex_hull(&points);
             let theirs = volume(&TriMesh::new(vertices, triangles).unwrap());
-            let ours = volume(
-                &ConvexHull::from_points(&points)
-                    .unwrap()
-                    .to_trimesh()
-                    .unwrap(),
-            );
-            assert!(
-                (ours - theirs).abs() <= 1e-4 * theirs,
-                "{ours} vs parry3d {theirs}"
-            );
+            let ours = volume(&check(&points, 1).to_trimesh().unwrap());
+            assert!((ours - theirs).abs() <= 1e-4 * theirs, "{ours} vs {theirs}");
         }
     }
 }

@@ -86,14 +86,15 @@ pub(crate) fn manifold(
     let mut len = 0;
     if fa.points().len() >= 2 && fb.points().len() >= 2 {
         let radii = a.rounding + b.rounding;
-        let facing_a = fa
-            .normal
-            .map(|m| m.dot(n))
-            .filter(|&c| c >= REFERENCE_COSINE);
-        let facing_b = fb
-            .normal
-            .map(|m| -m.dot(n))
-            .filter(|&c| c >= REFERENCE_COSINE);
+        // A face of no area (a zero-radius cylinder's cap, a flat box's face) has no side
+        // planes to clip with: it cannot be the reference.
+        let min_area = 1e-6 * (a.size() + b.size()).powi(2);
+        let facing = |f: &Feature, dir: Vec3| {
+            f.normal
+                .map(|m| m.dot(dir))
+                .filter(|&c| c >= REFERENCE_COSINE && polygon_area(f.points()) > min_area)
+        };
+        let (facing_a, facing_b) = (facing(&fa, n), facing(&fb, -n));
         // A point can sink no deeper along n than the pair does (EPA's depth is the deepest
         // along its own normal); a tilted reference plane would overstate a far corner.
         let mut keep = |p: ContactPoint| {
@@ -109,7 +110,10 @@ pub(crate) fn manifold(
             (Some(ca), Some(cb)) if ca >= cb => clip(&fa, &fb, n, radii, &mut keep),
             (Some(_), None) => clip(&fa, &fb, n, radii, &mut keep),
             (_, Some(_)) => clip(&fb, &fa, -n, radii, &mut keep),
-            (None, None) => parallel_lines(&fa, &fb, n, (a.rounding, b.rounding), &mut keep),
+            (None, None) if fa.normal.is_none() && fb.normal.is_none() => {
+                parallel_lines(&fa, &fb, n, (a.rounding, b.rounding), &mut keep)
+            }
+            (None, None) => {}
         }
     }
     let found = &points[..len];
@@ -171,8 +175,9 @@ fn clip(
     }
 }
 
-/// Two edges (a capsule's axis, a cylinder's side, a box edge seen edge-on) lying parallel:
-/// the overlap of their spans, each end with its own gap.
+/// Two edges (a capsule's axis, a cylinder's side line) lying parallel: the overlap of their
+/// spans, each end with its own gap. (`capsule_capsule.rs` has the same clip for two capsules'
+/// axes; here either segment may be rounded or not, and the gap is measured along `n`.)
 fn parallel_lines(
     fa: &Feature,
     fb: &Feature,
@@ -188,10 +193,11 @@ fn parallel_lines(
     }
     let t = |p: Vec3| (p - a0).dot(da) / len2;
     let (tb0, tb1) = (t(b0), t(b1));
-    if (tb1 - tb0).abs() <= f32::EPSILON {
-        return;
+    let (lo, hi) = (tb0.min(tb1).max(0.0), tb0.max(tb1).min(1.0));
+    if (tb1 - tb0).abs() <= f32::EPSILON || lo > hi {
+        return; // the spans do not overlap: the single deepest point stands
     }
-    for ta in [tb0.min(tb1).max(0.0), tb0.max(tb1).min(1.0)] {
+    for ta in [lo, hi] {
         let on_a = a0 + da * ta;
         let s = (ta - tb0) / (tb1 - tb0);
         let on_b = b0 + db * s.clamp(0.0, 1.0);
@@ -201,6 +207,15 @@ fn parallel_lines(
             depth: ra + rb - gap,
         });
     }
+}
+
+/// The area of a planar polygon (half the length of Newell's normal).
+fn polygon_area(p: &[Vec3]) -> f32 {
+    let mut twice = Vec3::ZERO;
+    for (k, &v) in p.iter().enumerate() {
+        twice += v.cross(p[(k + 1) % p.len()]);
+    }
+    0.5 * twice.length()
 }
 
 fn first_two(f: &Feature) -> [Vec3; 2] {

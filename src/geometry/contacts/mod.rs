@@ -16,6 +16,11 @@
 //! | **Capsule**   | [`contact_capsule_sphere`]    | [`contact_capsule_cuboid`]        | [`contact_capsule_halfspace`] | [`contact_capsule_capsule`]    | mesh–capsule, flipped         |
 //! | **TriMesh**   | [`contact_trimesh_sphere`]    | [`contact_trimesh_cuboid`]        | [`contact_trimesh_halfspace`] | [`contact_trimesh_capsule`]    | [`contact_trimesh_trimesh`]   |
 //!
+//! Any pair with a **cylinder, ellipsoid or convex hull** (no closed form) goes through GJK/EPA
+//! and a manifold clipped from the supporting features (`convex_convex.rs`), against a
+//! half-space through its supporting feature below the plane, and against a mesh triangle by
+//! triangle (`trimesh_convex.rs`); see `general_convex_contact`.
+//!
 //! "Flipped" means the test runs with the arguments swapped and the manifold is turned around
 //! with [`ContactManifold::flipped`] (normal negated, points unchanged). Box–box and mesh–mesh put
 //! their two shapes in a canonical order the same way, so for every pair `contact(a, b)` and
@@ -292,14 +297,25 @@ mod tests {
     use super::*;
     use glam::Quat;
 
-    fn shapes() -> [Shape; 5] {
+    fn shapes() -> [Shape; 8] {
         let ball = crate::geometry::TriMesh::uv_sphere(0.7, 24, 12).unwrap();
+        let gem = [
+            Vec3::new(0.6, 0.1, 0.0),
+            Vec3::new(-0.5, 0.2, 0.1),
+            Vec3::new(0.0, 0.6, -0.2),
+            Vec3::new(0.1, -0.5, 0.3),
+            Vec3::new(0.0, 0.0, 0.6),
+            Vec3::new(0.1, 0.1, -0.5),
+        ];
         [
             Shape::sphere(0.7),
             Shape::cuboid(Vec3::new(0.5, 0.8, 0.3)),
             Shape::half_space(Vec3::new(0.1, 0.2, 1.0)),
             Shape::capsule(0.4, 0.3),
             Shape::TriMesh(crate::geometry::MeshCollider::new(ball).unwrap()),
+            Shape::cylinder(0.4, 0.5),
+            Shape::ellipsoid(Vec3::new(0.6, 0.4, 0.3)),
+            Shape::convex_hull(&gem).unwrap(),
         ]
     }
 
@@ -339,14 +355,58 @@ mod tests {
                 Shape::half_space(Vec3::new(0.0, x, 1.0)),
                 Shape::capsule(x, 0.5),
                 Shape::capsule(0.5, x),
+                Shape::cylinder(x, 0.5),
+                Shape::cylinder(0.5, x),
+                Shape::ellipsoid(Vec3::new(0.5, x, 0.5)),
             ];
             for a in shapes().iter().chain(&bad_shapes) {
                 for b in shapes().iter().chain(&bad_shapes) {
                     for pose in &poses {
                         let _ = contact(a, pose, b, &good);
                         let _ = contact(a, &good, b, pose);
+                        let _ = speculative_contact(a, pose, b, &good, 0.05);
+                        let _ = crate::geometry::convex::signed_distance(a, pose, b, &good);
                     }
                     let _ = contact(a, &good, b, &good);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn zero_size_convex_shapes_give_finite_contacts_or_none() {
+        let degenerate = [
+            Shape::cylinder(0.0, 0.5),
+            Shape::cylinder(0.5, 0.0),
+            Shape::cylinder(0.0, 0.0),
+            Shape::ellipsoid(Vec3::new(0.5, 0.0, 0.5)),
+            Shape::ellipsoid(Vec3::ZERO),
+            Shape::cuboid(Vec3::new(0.5, 0.0, 0.5)),
+        ];
+        let poses = [
+            Isometry::IDENTITY,
+            Isometry::new(Vec3::new(0.1, 0.2, 0.3), Quat::from_rotation_x(0.4)),
+            Isometry::from_translation(Vec3::new(0.0, 0.0, 0.5)),
+        ];
+        for a in degenerate.iter().chain(&shapes()) {
+            for b in &degenerate {
+                for pa in &poses {
+                    for pb in &poses {
+                        for m in [contact(a, pa, b, pb), contact(b, pb, a, pa)]
+                            .into_iter()
+                            .flatten()
+                        {
+                            assert!(
+                                m.normal.is_finite() && m.normal.is_normalized(),
+                                "{a:?} {b:?}"
+                            );
+                            assert!(
+                                m.points()
+                                    .iter()
+                                    .all(|p| p.point.is_finite() && p.depth.is_finite())
+                            );
+                        }
+                    }
                 }
             }
         }
@@ -356,8 +416,21 @@ mod tests {
     fn far_apart_pairs_give_none() {
         let pa = Isometry::IDENTITY;
         let pb = Isometry::from_translation(Vec3::new(0.0, 0.0, 10.0));
-        let [sphere, cuboid, half_space, capsule, mesh] = shapes();
+        let [
+            sphere,
+            cuboid,
+            half_space,
+            capsule,
+            mesh,
+            cylinder,
+            ellipsoid,
+            hull,
+        ] = shapes();
         for (a, b) in [
+            (&cylinder, &hull),
+            (&hull, &ellipsoid),
+            (&mesh, &cylinder),
+            (&ellipsoid, &sphere),
             (&capsule, &capsule),
             (&capsule, &cuboid),
             (&sphere, &capsule),
@@ -379,5 +452,7 @@ mod tests {
         assert!(contact(&half_space, &pa, &mesh, &pb).is_none());
         assert!(contact(&half_space, &pa, &capsule, &pb).is_none());
         assert!(contact(&mesh, &pa, &half_space, &pb).is_some());
+        assert!(contact(&half_space, &pa, &hull, &pb).is_none());
+        assert!(contact(&cylinder, &pa, &half_space, &pb).is_some());
     }
 }

@@ -71,11 +71,13 @@ fn triangle_contact(
 }
 
 /// The contact read along the face normal `up` (towards the part) when the surface continues
-/// flat past an inactive edge: the part's closest point to this triangle, `d.on_b`, keeps its
-/// place and its height above the triangle's plane becomes the distance. (The part's lowest
+/// flat past an inactive edge: the closest pair `d` on this triangle keeps its points, and the
+/// part's point's height above the triangle's plane becomes the distance. (The part's lowest
 /// point overall may lie over a neighbour: a cylinder lying across a seam is 7 mm above this
 /// triangle where it comes closest to it, and that, not the neighbour's contact, is this
-/// triangle's.)
+/// triangle's. Moving the points under the part's lowest point instead, or under `d.on_b`,
+/// was measured worse: a standing cylinder drifted 8.5 mm in 3 s on a tessellated floor, a
+/// rolling one veered 10 cm.)
 fn along_face(tri: &Triangle, up: Vec3, d: &SignedDistance) -> SignedDistance {
     SignedDistance {
         distance: up.dot(d.on_b - tri.a),

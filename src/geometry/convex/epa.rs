@@ -100,9 +100,12 @@ impl Polytope {
         })
     }
 
+    /// A sliver (no normal) counts as seen: replacing it costs nothing, and its stand-in
+    /// normal would decide at random.
     fn sees(&self, f: usize, p: DVec3) -> bool {
         let face = &self.faces[f];
-        face.normal.dot(p - self.vertices[face.ids[0] as usize].w) > 0.0
+        !face.distance.is_finite()
+            || face.normal.dot(p - self.vertices[face.ids[0] as usize].w) > 0.0
     }
 
     /// Removes the faces the new vertex `new` sees, flooding out from `seed` (which sees it)

@@ -152,7 +152,8 @@ impl Simplex {
         }
         let sum = va + vb + vc;
         if sum <= 0.0 || !sum.is_finite() {
-            // A degenerate (flat) triangle: its best edge.
+            // A degenerate (flat) triangle: its first edge (GJK's next support point restores
+            // the rest).
             return self.closest_on_segment(i, j);
         }
         let (v, w) = (vb / sum, vc / sum);

@@ -134,7 +134,8 @@ impl<'a> ConvexPart<'a> {
         }
     }
 
-    /// A point inside the core (where GJK starts looking).
+    /// The part's origin (a triangle's centroid): where GJK starts looking. For a hull built
+    /// from points far from their origin it may lie outside the core; GJK only needs a start.
     pub fn center(&self) -> Vec3 {
         match self.core {
             Core::Triangle([a, b, c]) => (a + b + c) / 3.0,
@@ -142,7 +143,7 @@ impl<'a> ConvexPart<'a> {
         }
     }
 
-    /// Half the core's size plus its rounding: the scale its tolerances are relative to.
+    /// About the core's size plus its rounding: the scale its tolerances are relative to.
     pub fn size(&self) -> f32 {
         let core = match self.core {
             Core::Point => 0.0,
@@ -159,6 +160,10 @@ impl<'a> ConvexPart<'a> {
     /// The core's point farthest along `dir` (in the query's frame).
     #[inline]
     pub fn support(&self, dir: Vec3) -> Vec3 {
+        if !dir.is_finite() {
+            // Never walk a hull along a NaN direction; any point of the core answers.
+            return self.center();
+        }
         if let Core::Triangle(v) = self.core {
             return farthest(&v, dir);
         }
