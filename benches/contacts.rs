@@ -216,7 +216,7 @@ fn cuboid_halfspace(c: &mut Criterion) {
 /// `query::contact` finds one point by GJK/EPA, so the comparison favours parry.
 fn convex_pairs(c: &mut Criterion) {
     let mut r = Rng(4);
-    let mut hull = |r: &mut Rng| {
+    let hull = |r: &mut Rng| {
         let half = r.vec(0.2, 1.0);
         let points: Vec<Vec3> = (0..16).map(|_| r.vec(-1.0, 1.0) * half).collect();
         Shape::convex_hull(&points).unwrap_or_else(|_| Shape::cuboid(half))

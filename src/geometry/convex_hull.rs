@@ -26,7 +26,7 @@ use super::predicates::orient3d;
 use super::shapes::MAX_SHAPE_EXTENT;
 use super::{MeshError, TriMesh};
 use crate::bounding::Aabb;
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use std::fmt;
 
 /// A convex polyhedron built from a point cloud: its vertices, and its faces as planar convex
@@ -111,7 +111,7 @@ impl ConvexHull {
         &self.vertices
     }
 
-    /// The faces: convex polygons, no two neighbours coplanar (within tolerance).
+    /// The faces: convex polygons (coplanar triangles merged wherever the result stays convex).
     pub fn faces(&self) -> &[HullFace] {
         &self.faces
     }
@@ -409,10 +409,11 @@ impl<'a> Builder<'a> {
             if kept.len() < 3 {
                 continue;
             }
-            let c = kept.iter().map(|&v| self.orig[v]).sum::<Vec3>() / kept.len() as f32;
-            let corner = |i: usize| self.orig[kept[i % kept.len()]] - c;
-            let normal = (0..kept.len()).map(|i| corner(i).cross(corner(i + 1)));
-            let normal = normal.sum::<Vec3>().try_normalize().unwrap_or(fallback);
+            let k = kept.len();
+            let q = |i: usize| self.orig[kept[i % k]].as_dvec3(); // Newell's, in f64: thin faces too
+            let c = (0..k).map(q).sum::<DVec3>() / k as f64;
+            let area: DVec3 = (0..k).map(|i| (q(i) - c).cross(q(i + 1) - c)).sum();
+            let normal = area.try_normalize().map_or(fallback, |n| n.as_vec3());
             let heights = kept.iter().map(|&v| normal.dot(self.orig[v]));
             let offset = heights.fold(f32::MIN, f32::max);
             for &v in &kept {
@@ -424,7 +425,7 @@ impl<'a> Builder<'a> {
             }
             for (i, &v) in kept.iter().enumerate() {
                 face_indices.push(remap[v]);
-                neighbours[remap[v] as usize].push(remap[kept[(i + 1) % kept.len()]]);
+                neighbours[remap[v] as usize].push(remap[kept[(i + 1) % k]]);
             }
             faces.push(HullFace { normal, offset });
             face_start.push(face_indices.len() as u32);
@@ -593,46 +594,5 @@ mod tests {
             let ours = volume(&check(&points, 1).to_trimesh().unwrap());
             assert!((ours - theirs).abs() <= 1e-4 * theirs, "{ours} vs {theirs}");
         }
-    }
-
-    #[test]
-    fn zz_stress() {
-        let mut fails = 0;
-        for seed in 0..300u64 {
-            for kind in 0..8 {
-                for &n in &[4usize, 5, 6, 8, 12, 30, 100] {
-                    let pts = cloud(seed * 31 + n as u64, n, kind, Vec3::new(1.0, 0.5, 0.25));
-                    match std::panic::catch_unwind(|| { if let Ok(_) = ConvexHull::from_points(&pts) { check(&pts, 1); } }) {
-                        Ok(()) => {}
-                        Err(_) => { fails += 1; println!("FAIL seed {seed} kind {kind} n {n}"); }
-                    }
-                }
-            }
-        }
-        for m in 2..7usize {
-            let pts: Vec<Vec3> = (0..m*m*m).map(|i| Vec3::new((i % m) as f32, (i / m % m) as f32, (i / m / m) as f32)).collect();
-            let h = check(&pts, 1);
-            assert_eq!((h.vertices().len(), h.faces().len()), (8, 6));
-        }
-        let pts: Vec<Vec3> = (0..40).flat_map(|a| (0..40).map(move |b| { let (t, f) = (a as f32 * 0.08, b as f32 * 0.157); Vec3::new(t.sin() * f.cos(), t.sin() * f.sin(), t.cos()) })).collect();
-        check(&pts, 1);
-        let pts: Vec<Vec3> = (0..200).map(|i| { let a = i as f32 * 0.0314159; Vec3::new(a.cos(), a.sin(), if i % 2 == 0 { 1.0 } else { -1.0 }) }).collect();
-        let h = check(&pts, 1);
-        println!("cylinder: {} faces", h.faces().len());
-        for seed in 0..5 { let pts = cloud(100 + seed, 300_000, 1, Vec3::ONE); let t = std::time::Instant::now(); let h = ConvexHull::from_points(&pts).unwrap(); println!("300k sphere: {:?} {} verts", t.elapsed(), h.vertices().len()); check(&pts, 3000); }
-        let pts = cloud(77, 1_000_000, 1, Vec3::ONE); let t = std::time::Instant::now(); let h = ConvexHull::from_points(&pts).unwrap(); println!("1e6 sphere surface: {:?} {} verts", t.elapsed(), h.vertices().len());
-        let pts = cloud(78, 1_000_000, 0, Vec3::ONE); let t = std::time::Instant::now(); let h = ConvexHull::from_points(&pts).unwrap(); println!("1e6 cube: {:?} {} verts", t.elapsed(), h.vertices().len());
-        let pts = cloud(79, 1_000_000, 3, Vec3::ONE); let t = std::time::Instant::now(); let h = ConvexHull::from_points(&pts).unwrap(); println!("1e6 box features: {:?} {} verts {} faces", t.elapsed(), h.vertices().len(), h.faces().len());
-        for s in 0..3 { let pts = cloud(80 + s, 1_000_000, 2, Vec3::ONE); let t = std::time::Instant::now(); let h = ConvexHull::from_points(&pts).unwrap(); println!("1e6 ball: {:?} {} verts", t.elapsed(), h.vertices().len()); }
-        assert_eq!(fails, 0);
-    }
-
-    #[test]
-    fn zz_one() {
-        let pts = cloud(17 * 31 + 4, 4, 3, Vec3::new(1.0, 0.5, 0.25));
-        println!("{pts:?}");
-        let h = ConvexHull::from_points(&pts).unwrap();
-        for f in 0..h.faces().len() { println!("{:?} {:?}", h.faces()[f], h.face_polygon(f).collect::<Vec<_>>()); }
-        println!("tol {}", tolerance(&pts));
     }
 }
