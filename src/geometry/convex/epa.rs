@@ -21,7 +21,7 @@ const MAX_FACES: usize = 2 * MAX_VERTICES;
 /// Iterations EPA may take before answering with its best face.
 const MAX_ITERATIONS: usize = MAX_VERTICES - 4;
 /// Converged when a support point adds at most this fraction of the pair's size.
-const RELATIVE_TOLERANCE: f64 = 1e-5;
+const RELATIVE_TOLERANCE: f64 = 1e-6;
 
 /// EPA's answer.
 #[derive(Clone, Copy, Debug)]
