@@ -191,12 +191,10 @@ fn with_the_soft_step_a_tilted_dumbbell_compound_falls_onto_both_ends_within_1_c
     assert!((z - 0.25).abs() < 0.01, "the bar's centre is at {z} m");
 }
 
-#[test]
-fn a_stool_of_a_box_seat_and_four_capsule_legs_lands_upright_level_within_1_cm() {
-    let mut app = soft_step_app_on_ground();
-    // A seat with four capsule legs 0.7 m long (caps included) below it, parts of one body,
-    // dropped tilted: it lands on its legs, the seat level at 0.75 m.
-    let root = app
+/// A 4 kg box seat dropped tilted from 1.2 m with four `leg`s at its corners, centred `z`
+/// below it: parts of one body through `ChildOf`. Returns the seat.
+fn spawn_seat_on_legs(app: &mut App, leg: Collider, z: f32) -> Entity {
+    let seat = app
         .world_mut()
         .spawn((
             Collider::cuboid(0.3, 0.3, 0.04),
@@ -212,12 +210,18 @@ fn a_stool_of_a_box_seat_and_four_capsule_legs_lands_upright_level_within_1_cm()
         (-0.25, 0.25),
         (0.25, 0.25),
     ] {
-        app.world_mut().spawn((
-            Collider::capsule(0.3, 0.05),
-            Position::new(x, y, -0.4),
-            ChildOf(root),
-        ));
+        app.world_mut()
+            .spawn((leg.clone(), Position::new(x, y, z), ChildOf(seat)));
     }
+    seat
+}
+
+#[test]
+fn a_stool_of_a_box_seat_and_four_capsule_legs_lands_upright_level_within_1_cm() {
+    let mut app = soft_step_app_on_ground();
+    // A seat with four capsule legs 0.7 m long (caps included) below it, parts of one body,
+    // dropped tilted: it lands on its legs, the seat level at 0.75 m.
+    let root = spawn_seat_on_legs(&mut app, Collider::capsule(0.3, 0.05), -0.4);
     urto::step(app.world_mut(), 300).unwrap();
     let up = get::<Rotation>(&app, root).0 * Vec3::Z;
     let z = get::<Position>(&app, root).0.z;
@@ -229,28 +233,7 @@ fn a_stool_of_a_box_seat_and_four_capsule_legs_lands_upright_level_within_1_cm()
 fn a_chair_of_cylinder_legs_and_a_hull_from_a_mesh_file_land_and_rest_within_1_cm() {
     let mut app = soft_step_app_on_ground();
     // A box seat with four cylinder legs (0.7 m tall), parts of one body, dropped tilted.
-    let chair = app
-        .world_mut()
-        .spawn((
-            Collider::cuboid(0.3, 0.3, 0.04),
-            Position::new(0.0, 0.0, 1.2),
-            Rotation(Quat::from_rotation_x(0.2) * Quat::from_rotation_y(-0.15)),
-            Velocity::default(),
-            Mass(4.0),
-        ))
-        .id();
-    for (x, y) in [
-        (-0.25f32, -0.25f32),
-        (0.25, -0.25),
-        (-0.25, 0.25),
-        (0.25, 0.25),
-    ] {
-        app.world_mut().spawn((
-            Collider::cylinder(0.35, 0.04),
-            Position::new(x, y, -0.39),
-            ChildOf(chair),
-        ));
-    }
+    let chair = spawn_seat_on_legs(&mut app, Collider::cylinder(0.35, 0.04), -0.39);
     // The hull of a scanned nut's vertices (in millimetres, far from its origin: moved to its
     // box's centre and scaled to 0.3 m), dropped beside it.
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/nut.ply");

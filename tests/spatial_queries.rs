@@ -738,14 +738,38 @@ fn spatial_query_finds_the_nearest_collider_and_casts_a_box_with_a_filter() {
     );
 }
 
+/// parry3d's first hit of `caster` at `pose` moved along the unit `direction` for at most 12 m
+/// against `target` at `at`, stopping at penetration (as our casts do).
+fn parry_cast(
+    (caster, pose): (&dyn parry3d::shape::Shape, &Isometry),
+    direction: Vec3,
+    (target, at): (&dyn parry3d::shape::Shape, &Isometry),
+) -> Option<parry3d::query::ShapeCastHit> {
+    use parry3d::math::{Pose, Vector};
+    let pose_of = |p: &Isometry| Pose::from_parts(p.translation, p.rotation);
+    let options = parry3d::query::ShapeCastOptions {
+        max_time_of_impact: 12.0,
+        stop_at_penetration: true,
+        ..Default::default()
+    };
+    parry3d::query::cast_shapes(
+        &pose_of(pose),
+        Vector::from_array(direction.to_array()),
+        caster,
+        &pose_of(at),
+        Vector::ZERO,
+        target,
+        options,
+    )
+    .expect("supported")
+}
+
 #[test]
 fn box_casts_touch_within_1e_4_and_agree_with_parry3d_within_1e_3_on_2500_casts_at_five_shapes() {
-    use parry3d::math::{Pose, Vector};
     use urto::spatial::{BoxCast, cast_box};
     let mut rng = Rng::new(23);
     let shapes = shapes_with_parry_twins();
     let mut scratch = QueryScratch::new();
-    let pose_of = |p: &Isometry| Pose::from_parts(p.translation, p.rotation);
     for (shape, parry_shape, _) in &shapes {
         let (mut hits, mut misses, mut worst) = (0, 0, 0.0f32);
         for _ in 0..500 {
@@ -763,21 +787,11 @@ fn box_casts_touch_within_1e_4_and_agree_with_parry3d_within_1e_3_on_2500_casts_
             };
             let ours = cast_box(&cast, shape, &target, &mut scratch);
             let caster = parry3d::shape::Cuboid::new(cast.half_extents);
-            let options = parry3d::query::ShapeCastOptions {
-                max_time_of_impact: 12.0,
-                stop_at_penetration: true,
-                ..Default::default()
-            };
-            let theirs = parry3d::query::cast_shapes(
-                &pose_of(&cast.pose),
-                Vector::from_array(direction.to_array()),
-                &caster,
-                &pose_of(&target),
-                Vector::ZERO,
-                parry_shape.as_ref(),
-                options,
-            )
-            .expect("supported");
+            let theirs = parry_cast(
+                (&caster, &cast.pose),
+                direction,
+                (parry_shape.as_ref(), &target),
+            );
             let context = format!("{shape:?} {cast:?} {target:?}: {ours:?} vs {theirs:?}");
             match (ours, theirs) {
                 (Some(h), Some(t)) => {
@@ -831,12 +845,10 @@ fn box_casts_touch_within_1e_4_and_agree_with_parry3d_within_1e_3_on_2500_casts_
 /// so each of ours is also checked independently: touching within 1e-4, apart 1e-4 before.
 #[test]
 fn capsule_casts_touch_within_1e_4_and_agree_with_parry3d_within_1e_2_on_2500_casts() {
-    use parry3d::math::{Pose, Vector};
     use urto::geometry::Capsule;
     use urto::spatial::{CapsuleCast, cast_capsule};
     let mut rng = Rng::new(25);
     let mut scratch = QueryScratch::new();
-    let pose_of = |p: &Isometry| Pose::from_parts(p.translation, p.rotation);
     for (shape, parry_shape, _) in &shapes_with_parry_twins() {
         let (mut hits, mut misses, mut worst) = (0, 0, 0.0f32);
         for _ in 0..500 {
@@ -858,21 +870,11 @@ fn capsule_casts_touch_within_1e_4_and_agree_with_parry3d_within_1e_2_on_2500_ca
             };
             let ours = cast_capsule(&cast, shape, &target, &mut scratch);
             let caster = parry3d::shape::Capsule::new_z(capsule.half_length, capsule.radius);
-            let options = parry3d::query::ShapeCastOptions {
-                max_time_of_impact: 12.0,
-                stop_at_penetration: true,
-                ..Default::default()
-            };
-            let theirs = parry3d::query::cast_shapes(
-                &pose_of(&cast.pose),
-                Vector::from_array(direction.to_array()),
-                &caster,
-                &pose_of(&target),
-                Vector::ZERO,
-                parry_shape.as_ref(),
-                options,
-            )
-            .expect("supported");
+            let theirs = parry_cast(
+                (&caster, &cast.pose),
+                direction,
+                (parry_shape.as_ref(), &target),
+            );
             let context = format!("{shape:?} {cast:?} {target:?}: {ours:?} vs {theirs:?}");
             let capsule_at = |d: f32, grow: f32| {
                 let at = Isometry::new(cast.pose.translation + direction * d, cast.pose.rotation);

@@ -7,6 +7,7 @@
 //! between the two surfaces. A speculative contact (found with a margin, for a solver that
 //! detects once per step) also holds points still apart, with negative depth.
 
+use crate::geometry::Isometry;
 use glam::Vec3;
 
 /// Most points a manifold keeps: four span a face-face contact, enough for a box to rest flat.
@@ -85,6 +86,20 @@ impl ContactManifold {
     /// are all farther apart is not touching yet).
     pub fn touching(&self, tolerance: f32) -> bool {
         self.points().iter().any(|p| p.depth >= -tolerance)
+    }
+
+    /// The manifold of a local frame carried to the frame `pose` places it in (normal turned,
+    /// points moved, depths kept).
+    #[must_use]
+    pub fn transformed(&self, pose: &Isometry) -> Self {
+        let mut out = Self::new(pose.transform_vector(self.normal));
+        for p in self.points() {
+            out.push(ContactPoint {
+                point: pose.transform_point(p.point),
+                depth: p.depth,
+            });
+        }
+        out
     }
 
     /// The same contact seen from B: the normal flips, the points stay.

@@ -154,18 +154,8 @@ impl SpatialIndex {
     ) -> Result<Option<QueryHit>, QueryError> {
         let max = check_max_distance(cast.max_distance)?;
         let h = cast.half_extents;
-        if !cast.pose.is_finite() {
-            return Err(QueryError::NonFiniteOrigin(cast.pose.translation));
-        }
-        if Shape::cuboid(h).validate().is_err() {
-            return Err(QueryError::BadSize(h));
-        }
-        if !cast.direction.is_normalized() {
-            return Err(QueryError::BadDirection(cast.direction));
-        }
-        let ray = Ray::new(cast.pose.translation, cast.direction)?;
-        let radius = h.length();
-        let grow = radius + self.slack(&ray, radius, max);
+        let shape = Shape::cuboid(h);
+        let (ray, grow) = self.shape_cast_start((&shape, h), &cast.pose, cast.direction, max)?;
         Ok(self.first_hit(&ray, grow, max, accept, |id, mesh| {
             let (shape, pose) = colliders.collider(id)?;
             cast_box(cast, shape, &pose, mesh)
@@ -183,23 +173,36 @@ impl SpatialIndex {
     ) -> Result<Option<QueryHit>, QueryError> {
         let max = check_max_distance(cast.max_distance)?;
         let shape = Shape::Capsule(cast.capsule);
-        if !cast.pose.is_finite() {
-            return Err(QueryError::NonFiniteOrigin(cast.pose.translation));
-        }
-        if shape.validate().is_err() {
-            let c = cast.capsule;
-            return Err(QueryError::BadSize(Vec3::new(c.half_length, c.radius, 0.0)));
-        }
-        if !cast.direction.is_normalized() {
-            return Err(QueryError::BadDirection(cast.direction));
-        }
-        let ray = Ray::new(cast.pose.translation, cast.direction)?;
-        let radius = shape.bounding_radius();
-        let grow = radius + self.slack(&ray, radius, max);
+        let size = Vec3::new(cast.capsule.half_length, cast.capsule.radius, 0.0);
+        let (ray, grow) = self.shape_cast_start((&shape, size), &cast.pose, cast.direction, max)?;
         Ok(self.first_hit(&ray, grow, max, accept, |id, mesh| {
             let (shape, pose) = colliders.collider(id)?;
             cast_capsule(cast, shape, &pose, mesh)
         }))
+    }
+
+    /// The checks shared by the shape casts (a finite start, a usable `shape` — reported as
+    /// `size` when not — and a unit direction), then the ray its centre follows and how much
+    /// the tree's boxes grow to hold the shape along it.
+    fn shape_cast_start(
+        &self,
+        (shape, size): (&Shape, Vec3),
+        pose: &Isometry,
+        direction: Vec3,
+        max: f32,
+    ) -> Result<(Ray, f32), QueryError> {
+        if !pose.is_finite() {
+            return Err(QueryError::NonFiniteOrigin(pose.translation));
+        }
+        if shape.validate().is_err() {
+            return Err(QueryError::BadSize(size));
+        }
+        if !direction.is_normalized() {
+            return Err(QueryError::BadDirection(direction));
+        }
+        let ray = Ray::new(pose.translation, direction)?;
+        let radius = shape.bounding_radius();
+        Ok((ray, radius + self.slack(&ray, radius, max)))
     }
 
     /// The walk shared by the first-hit casts: every unbounded collider, then the tree's boxes

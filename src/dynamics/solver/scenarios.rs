@@ -150,7 +150,13 @@ impl Scene {
     }
 }
 
-/// A ground tilted by `degrees` about y (downhill along +x) and a body resting on it.
+/// The body's local z axis in the world (a capsule's or cylinder's axis).
+fn axis(b: &Body) -> Vec3 {
+    b.orientation * Vec3::Z
+}
+
+/// A ground tilted by `degrees` about y (downhill along +x) and a body resting on it; a capsule
+/// or cylinder lies on its side, its axis across the slope (along y), ready to roll.
 fn incline(degrees: f32, shape: Shape, friction: f32) -> (Scene, usize, Vec3) {
     let theta = degrees.to_radians();
     let normal = Vec3::new(-theta.sin(), 0.0, theta.cos());
@@ -159,12 +165,15 @@ fn incline(degrees: f32, shape: Shape, friction: f32) -> (Scene, usize, Vec3) {
     let mut scene = Scene::default();
     let g = scene.ground(normal);
     scene.bodies[g].friction = friction;
-    let height = match &shape {
-        Shape::Sphere(s) => s.radius,
-        Shape::Cuboid(c) => c.half_extents.z,
-        _ => 0.5,
+    let lying = Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
+    let (height, turn) = match &shape {
+        Shape::Sphere(s) => (s.radius, Quat::IDENTITY),
+        Shape::Cuboid(c) => (c.half_extents.z, Quat::IDENTITY),
+        Shape::Capsule(c) => (c.radius, lying),
+        Shape::Cylinder(c) => (c.radius, lying),
+        _ => (0.5, Quat::IDENTITY),
     };
-    let tilt = Quat::from_rotation_y(-theta);
+    let tilt = Quat::from_rotation_y(-theta) * turn;
     let b = scene.add(shape, normal * height, tilt, 1.0);
     scene.bodies[b].friction = friction;
     (scene, b, downhill)

@@ -68,7 +68,7 @@ pub fn contact_capsule_cuboid(
         };
         local.push(midway(x, depth.max(0.0)));
     }
-    Some(to_world(local, pose_b))
+    Some(local.transformed(pose_b))
 }
 
 /// Where the single point of a manifold comes from.
@@ -78,17 +78,6 @@ enum Feature {
     Closest(Vec3),
     /// An edge axis: the box edge along this local axis.
     Edge(usize),
-}
-
-fn to_world(local: ContactManifold, pose: &Isometry) -> ContactManifold {
-    let mut out = ContactManifold::new(pose.transform_vector(local.normal));
-    for p in local.points() {
-        out.push(ContactPoint {
-            point: pose.transform_point(p.point),
-            depth: p.depth,
-        });
-    }
-    out
 }
 
 /// The closest points `(on the segment, on the box [-h, h])` of the segment from `p0` to `p1`

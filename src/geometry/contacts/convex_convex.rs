@@ -43,19 +43,7 @@ pub(crate) fn contact_convex_convex(
     let pa = ConvexPart::of_shape(a, Isometry::IDENTITY)?;
     let pb = ConvexPart::of_shape(b, pose_a.inv_mul(pose_b))?;
     let m = contact_parts(&pa, &pb, margin)?;
-    Some(placed(m, pose_a))
-}
-
-/// The manifold carried from a local frame to the world by `pose`.
-pub(crate) fn placed(m: ContactManifold, pose: &Isometry) -> ContactManifold {
-    let mut out = ContactManifold::new(pose.transform_vector(m.normal));
-    for p in m.points() {
-        out.push(ContactPoint {
-            point: pose.transform_point(p.point),
-            depth: p.depth,
-        });
-    }
-    out
+    Some(m.transformed(pose_a))
 }
 
 /// Contact between two parts in one frame (module docs).

@@ -38,17 +38,11 @@ pub(crate) fn contact_trimesh_convex(
     scratch.merge(pose_mesh)
 }
 
-/// Half extents of a box about the shape's origin that holds it.
+/// Half extents of a box about the shape's origin that holds it (its local box, made
+/// symmetric: a hull's need not be centred on its origin).
 fn local_half_extents(shape: &Shape) -> Vec3 {
-    match shape {
-        Shape::Cylinder(c) => Vec3::new(c.radius, c.radius, c.half_height),
-        Shape::Ellipsoid(e) => e.radii,
-        Shape::ConvexHull(h) => {
-            let b = h.local_aabb();
-            b.min.abs().max(b.max.abs())
-        }
-        other => Vec3::splat(other.bounding_radius()),
-    }
+    let b = shape.world_aabb(&Isometry::IDENTITY);
+    b.min.abs().max(b.max.abs())
 }
 
 /// One triangle (A) against the convex part (B), in the mesh's frame.

@@ -57,6 +57,9 @@ pub(crate) struct ConvexPart<'a> {
     pub core: Core<'a>,
     pub rounding: f32,
     pub pose: Isometry,
+    /// [`ConvexPart::size`], found once: a hull's is a pass over its vertices, and every GJK,
+    /// EPA and clip of the query reads it.
+    size: f32,
 }
 
 /// The supporting feature of a core along a direction, in the query's frame: its points, and the
@@ -122,15 +125,18 @@ impl<'a> ConvexPart<'a> {
             core,
             rounding,
             pose,
+            size: core_size(core) + rounding,
         })
     }
 
     /// A mesh triangle, in the query's frame.
     pub fn triangle(tri: &Triangle) -> Self {
+        let core = Core::Triangle(tri.vertices());
         Self {
-            core: Core::Triangle(tri.vertices()),
+            core,
             rounding: 0.0,
             pose: Isometry::IDENTITY,
+            size: core_size(core),
         }
     }
 
@@ -145,16 +151,7 @@ impl<'a> ConvexPart<'a> {
 
     /// About the core's size plus its rounding: the scale its tolerances are relative to.
     pub fn size(&self) -> f32 {
-        let core = match self.core {
-            Core::Point => 0.0,
-            Core::Segment(h) => h,
-            Core::Cuboid(h) => h.max_element(),
-            Core::Cylinder(h, r) => h.max(r),
-            Core::Ellipsoid(r) => r.max_element(),
-            Core::Hull(h) => h.bounding_radius(),
-            Core::Triangle([a, b, c]) => (a - b).length().max((b - c).length()),
-        };
-        core + self.rounding
+        self.size
     }
 
     /// The core's point farthest along `dir` (in the query's frame).
@@ -231,6 +228,20 @@ impl<'a> ConvexPart<'a> {
             Core::Hull(hull) => hull_face(hull, d),
             _ => single(self.local_support(d)),
         }
+    }
+}
+
+/// About the size of a core (a half extent, a hull's bounding radius, a triangle's longer
+/// first edges).
+fn core_size(core: Core) -> f32 {
+    match core {
+        Core::Point => 0.0,
+        Core::Segment(h) => h,
+        Core::Cuboid(h) => h.max_element(),
+        Core::Cylinder(h, r) => h.max(r),
+        Core::Ellipsoid(r) => r.max_element(),
+        Core::Hull(h) => h.bounding_radius(),
+        Core::Triangle([a, b, c]) => (a - b).length().max((b - c).length()),
     }
 }
 

@@ -10,28 +10,12 @@ fn along_y() -> Quat {
     Quat::from_rotation_x(std::f32::consts::FRAC_PI_2)
 }
 
-/// The capsule's axis in the world.
-fn axis(b: &Body) -> Vec3 {
-    b.orientation * Vec3::Z
-}
-
 #[test]
 fn a_log_rolls_down_a_20_degree_incline_as_its_axial_inertia_predicts_within_1_percent() {
     let (half_length, radius) = (0.6, 0.3);
     let theta = 20f32.to_radians();
-    let normal = Vec3::new(-theta.sin(), 0.0, theta.cos());
-    let downhill = -Vec3::new(theta.cos(), 0.0, theta.sin());
-    let mut scene = Scene::default();
-    let g = scene.ground(normal);
-    scene.bodies[g].friction = 1.0;
-    let tilt = Quat::from_rotation_y(-theta);
-    let log = scene.add(
-        Shape::capsule(half_length, radius),
-        normal * radius,
-        tilt * along_y(),
-        2.0,
-    );
-    scene.bodies[log].friction = 1.0;
+    let shape = Shape::capsule(half_length, radius);
+    let (mut scene, log, downhill) = incline(20.0, shape, 1.0);
     let start = scene.bodies[log].center;
     let t = 1.5;
     scene.run(t);

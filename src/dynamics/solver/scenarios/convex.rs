@@ -7,29 +7,10 @@
 use super::*;
 use crate::geometry::{MeshCollider, TriMesh};
 
-/// The body's local z axis in the world.
-fn axis(b: &Body) -> Vec3 {
-    b.orientation * Vec3::Z
-}
-
 #[test]
 fn a_cylinder_rolls_down_a_20_degree_incline_at_two_thirds_g_sin_theta_within_1_percent() {
-    let (half_height, radius) = (0.4, 0.3);
     let theta = 20f32.to_radians();
-    let normal = Vec3::new(-theta.sin(), 0.0, theta.cos());
-    let downhill = -Vec3::new(theta.cos(), 0.0, theta.sin());
-    let mut scene = Scene::default();
-    let g = scene.ground(normal);
-    scene.bodies[g].friction = 1.0;
-    // Axis along world y, across the slope.
-    let lying = Quat::from_rotation_y(-theta) * Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
-    let c = scene.add(
-        Shape::cylinder(half_height, radius),
-        normal * radius,
-        lying,
-        2.0,
-    );
-    scene.bodies[c].friction = 1.0;
+    let (mut scene, c, downhill) = incline(20.0, Shape::cylinder(0.4, 0.3), 1.0);
     let start = scene.bodies[c].center;
     let t = 1.5;
     scene.run(t);
