@@ -107,6 +107,19 @@ fn bad_shapes_and_rotations_are_quarantined() {
     assert!(Collider::convex_hull(&[Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::NAN]).is_err());
     assert!(Collider::convex_hull(&[Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::X + Vec3::Y]).is_err());
     assert!(Collider::convex_hull_from_file("no/such/hull.obj").is_err());
+    // A readable mesh whose vertices are flat (one square) makes no hull: a hull error.
+    let flat = std::env::temp_dir().join(format!("urto-flat-hull-{}.obj", std::process::id()));
+    std::fs::write(
+        &flat,
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n",
+    )
+    .unwrap();
+    let refused = Collider::convex_hull_from_file(&flat);
+    let _ = std::fs::remove_file(&flat);
+    assert!(matches!(
+        refused,
+        Err(urto::geometry::convex::HullFileError::Hull(_))
+    ));
     // A good capsule next to the bad ones stays good.
     let good = app
         .world_mut()
