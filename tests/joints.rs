@@ -105,6 +105,39 @@ fn a_hinge_motor_spins_a_wheel_at_its_target_within_2_percent_and_holds_what_it_
 }
 
 #[test]
+fn a_position_motor_holding_an_arm_level_reports_its_torque_as_m_g_l_within_2_percent() {
+    // A 2 kg ball on a massless 1.5 m lever hinged about y at a static post: the motor holds
+    // the lever level, so at rest it applies m g L about the hinge (gravity pulls the ball
+    // down, turning it about +y: the motor's torque is the opposite, negative).
+    let mut app = app();
+    let (mass, lever) = (2.0f32, 1.5f32);
+    let post = app
+        .world_mut()
+        .spawn((Collider::sphere(0.05), Position::new(0.0, 0.0, 3.0), Static))
+        .id();
+    let arm = ball(&mut app, Vec3::new(lever, 0.0, 3.0), 0.1);
+    app.world_mut().entity_mut(arm).insert(Mass(mass));
+    let joint = app
+        .world_mut()
+        .spawn(
+            Joint::revolute(post, arm)
+                .with_axis(Vec3::Y)
+                .with_anchors(Vec3::ZERO, Vec3::new(-lever, 0.0, 0.0))
+                .with_motor(JointMotor::position(0.0, 4.0, 1.0, 500.0)),
+        )
+        .id();
+    urto::step(app.world_mut(), 240).unwrap();
+    let load = get::<JointLoad>(&app, joint);
+    let expected = mass * 9.81 * lever;
+    assert!(
+        (-load.motor / expected - 1.0).abs() < 0.02,
+        "{load:?} against {expected} N m"
+    );
+    let sag = 3.0 - get::<Position>(&app, arm).0.z;
+    assert!(sag.abs() < 0.05, "the arm sagged {sag} m");
+}
+
+#[test]
 fn a_joint_breaks_above_its_force_with_a_message_and_holds_below_it() {
     let mut app = app();
     let weak = ball(&mut app, Vec3::new(0.0, 0.0, 5.0), 0.2);

@@ -346,7 +346,7 @@ fn the_views_are_off_by_default_and_change_no_result() {
 }
 
 #[test]
-fn joints_are_drawn_at_their_anchors_with_their_axes_and_loads() {
+fn joints_are_drawn_at_their_anchors_with_their_axes_loads_and_motor_torques() {
     let (rec, storage) = rerun::RecordingStreamBuilder::new("urto_joint_views")
         .memory()
         .expect("memory sink");
@@ -368,7 +368,8 @@ fn joints_are_drawn_at_their_anchors_with_their_axes_and_loads() {
     app.world_mut().spawn(
         Joint::revolute(bob, JointEnd::World)
             .with_axis(Vec3::Y)
-            .with_anchors(Vec3::new(-1.0, 0.0, 0.0), pivot),
+            .with_anchors(Vec3::new(-1.0, 0.0, 0.0), pivot)
+            .with_motor(JointMotor::velocity(0.0, 0.5)),
     );
     urto::step(app.world_mut(), STEPS).unwrap();
     let store = common::recording::read_back(&rec, &storage);
@@ -381,11 +382,14 @@ fn joints_are_drawn_at_their_anchors_with_their_axes_and_loads() {
     ] {
         assert!(names.contains(path), "{path} missing from {names:?}");
     }
-    assert!(
-        names
-            .iter()
-            .any(|n| n.starts_with("/joints/") && n.ends_with("/force"))
-    );
+    for series in ["/force", "/torque", "/motor"] {
+        assert!(
+            names
+                .iter()
+                .any(|n| n.starts_with("/joints/") && n.ends_with(series)),
+            "{series} missing from {names:?}"
+        );
+    }
     // The last anchors drawn: the bob's anchor where the bob is now, and the pivot.
     let positions = rerun::Points3D::descriptor_positions().component;
     let mut last = Vec::new();

@@ -267,19 +267,28 @@ impl Joint {
         let (Some(limit), _) = self.kind.limit_and_motor() else {
             return swing;
         };
-        let coordinate = match self.kind {
+        let coordinate = self.coordinate(a, b);
+        (limit.min - coordinate)
+            .max(coordinate - limit.max)
+            .max(swing)
+            .max(0.0)
+    }
+
+    /// The joint's coordinate, what its limits bound and its motor drives, its frames in world
+    /// coordinates being `a` and `b` ([`world_frames`](Self::world_frames)): a hinge's angle or
+    /// a ball joint's twist about the axis (rad, in `(−π, π]`), a slider's travel along its axis
+    /// or the distance between the anchors (m); 0 for a fixed joint.
+    pub fn coordinate(&self, a: &Isometry, b: &Isometry) -> f32 {
+        match self.kind {
             JointKind::Revolute { .. } | JointKind::Spherical { .. } => {
                 twist_angle(a.rotation, b.rotation)
             }
             JointKind::Prismatic { .. } => {
                 (a.rotation * Vec3::X).dot(b.translation - a.translation)
             }
-            _ => a.translation.distance(b.translation),
-        };
-        (limit.min - coordinate)
-            .max(coordinate - limit.max)
-            .max(swing)
-            .max(0.0)
+            JointKind::Distance { .. } => a.translation.distance(b.translation),
+            JointKind::Fixed => 0.0,
+        }
     }
 
     /// Why the joint cannot be solved, if it cannot: non-finite or non-unit frames, a body
@@ -336,6 +345,9 @@ pub struct JointLoad {
     pub force: f32,
     /// Torque (N·m).
     pub torque: f32,
+    /// What the motor applied, signed along the joint's coordinate (N·m on a hinge, N on a
+    /// slider or a distance joint; 0 without a motor): the effort a game reads off its motor.
+    pub motor: f32,
 }
 
 #[cfg(test)]
@@ -362,6 +374,27 @@ mod tests {
         for joint in bad {
             assert!(joint.problem().is_some(), "{joint:?}");
         }
+    }
+
+    #[test]
+    fn the_coordinate_reads_a_hinge_angle_a_slider_travel_and_a_distance_within_1e_5() {
+        let (a, b) = (
+            Entity::from_raw_u32(1).unwrap(),
+            Entity::from_raw_u32(2).unwrap(),
+        );
+        let at = |x: f32, turn: Quat| Isometry::new(Vec3::new(x, 0.0, 0.0), turn);
+        // A hinge about −y, B's frame turned by 0.7 rad about −y (its x axis raised).
+        let hinge = Joint::revolute(a, b).with_axis(Vec3::NEG_Y);
+        let pose_b = at(0.0, Quat::from_rotation_y(-0.7));
+        let (fa, fb) = hinge.world_frames(Isometry::default(), Some(pose_b));
+        assert!((hinge.coordinate(&fa, &fb) - 0.7).abs() < 1e-5);
+        let slider = Joint::prismatic(a, b).with_axis(Vec3::X);
+        let (fa, fb) = slider.world_frames(at(1.0, Quat::IDENTITY), Some(at(1.25, Quat::IDENTITY)));
+        assert!((slider.coordinate(&fa, &fb) - 0.25).abs() < 1e-5);
+        let rope = Joint::rope(a, b, 2.0);
+        let (fa, fb) = rope.world_frames(at(0.0, Quat::IDENTITY), Some(at(-1.5, Quat::IDENTITY)));
+        assert!((rope.coordinate(&fa, &fb) - 1.5).abs() < 1e-5);
+        assert_eq!(Joint::fixed(a, b).coordinate(&fa, &fb), 0.0);
     }
 
     #[test]

@@ -17,7 +17,7 @@
 //! | `world/contacts` | contact points with their normals scaled by depth (magenta) | `Arrows3D` |
 //! | `broad_phase/pairs` | candidate pairs as segments between centres | `LineStrips3D` |
 //! | `world/joints/links`, `…/anchors`, `…/axes` | each joint's anchors, the segment between them (orange; red past a limit, grey disabled) and its axis at the first anchor | `LineStrips3D`, `Points3D`, `Arrows3D` |
-//! | `joints/<entity>/force`, `…/torque`, `joints/past_limit` | what the first 16 joints hold (N, N·m) and how far the worst joint is past its limit | `Scalars` |
+//! | `joints/<entity>/force`, `…/torque`, `…/motor`, `joints/past_limit` | what the first 16 joints hold (N, N·m), what their motors apply (signed), and how far the worst joint is past its limit | `Scalars` |
 //! | `broad_phase/grid_cells/occupied`, `…/empty` | the static grid's cells each moving body's volume touches (cyan: listing statics, dim blue: empty); only with [`RerunConfig::grid_cells`] | `Boxes3D` |
 //! | `broad_phase/candidates/listed`, `…/overlapping` | the statics those cells list, as the grid stores them (yellow: listed, red: their box also overlaps a moving body's, so the pair goes to the narrow phase) | `Boxes3D` |
 //! | `scene_graph/level_<k>` | the bounding volumes of depth `k` (root 0) of every body hierarchy (compound bodies), labelled with their [`Name`]; only with [`RerunConfig::scene_graph_levels`], each level in its own tab | `Boxes3D` |

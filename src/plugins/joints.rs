@@ -111,11 +111,16 @@ fn break_joints(
     mut broken: MessageWriter<JointBroken>,
     mut commands: Commands,
 ) {
-    for (e, force, torque) in solver.joint_loads() {
+    for (e, held) in solver.joint_loads() {
         let Ok((joint, load)) = joints.get_mut(e) else {
             continue;
         };
-        let now = JointLoad { force, torque };
+        let (force, torque) = (held.force, held.torque);
+        let now = JointLoad {
+            force,
+            torque,
+            motor: held.motor,
+        };
         match load {
             Some(mut load) => {
                 load.set_if_neq(now);

@@ -24,8 +24,8 @@ type JointView<'a> = (
     Has<Quarantined>,
 );
 
-/// Logs `world/joints` (anchors, segments, axes) and `joints/<entity>/{force,torque}` for the
-/// first joints, plus `joints/past_limit` (how far the worst joint is past its limit).
+/// Logs `world/joints` (anchors, segments, axes) and `joints/<entity>/{force,torque}` (and
+/// `motor` for a motorised joint) for the first joints, plus `joints/past_limit` (how far the worst joint is past its limit).
 pub(super) fn record_joints(
     rec: Res<RerunRecording>,
     joints: Query<JointView>,
@@ -64,6 +64,9 @@ pub(super) fn record_joints(
                 format!("{path}/torque"),
                 &rerun::Scalars::single(load.torque),
             ));
+            if joint.kind.limit_and_motor().1.is_some() {
+                report(stream.log(format!("{path}/motor"), &rerun::Scalars::single(load.motor)));
+            }
         }
     }
     let lines = rerun::LineStrips3D::new(segments).with_colors(colors);

@@ -310,9 +310,9 @@ impl JointConstraint {
         )
     }
 
-    /// The force (N) and torque (N·m) the joint applied over the last substep of the step:
-    /// its accumulated impulses over the substep `h`.
-    pub fn load(&self, h: f32) -> (f32, f32) {
+    /// What the joint applied over the last substep of the step: its accumulated impulses
+    /// over the substep `h`.
+    pub fn load(&self, h: f32) -> HeldLoad {
         let j = &self.impulses;
         let axial = j.motor + j.lower - j.upper;
         let mut force = j.point.length() + Vec3::new(j.across[0], j.across[1], 0.0).length();
@@ -321,8 +321,26 @@ impl JointConstraint {
             JointKind::Revolute { .. } | JointKind::Spherical { .. } => torque += axial.abs(),
             _ => force += axial.abs(),
         }
-        (force / h, torque / h)
+        HeldLoad {
+            force: force / h,
+            torque: torque / h,
+            motor: j.motor / h,
+        }
     }
+}
+
+/// What a joint applied over a substep, as forces (the impulses over the substep).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct HeldLoad {
+    /// Force (N): the point rows, a slider's rows across its axis, and a slider's or a
+    /// distance joint's motor and limits.
+    pub force: f32,
+    /// Torque (N·m): the angular rows, a ball joint's swing cone, and a hinge's or a ball
+    /// joint's motor and limits.
+    pub torque: f32,
+    /// The motor's share, signed along the joint's coordinate (N·m for a hinge, N for a slider
+    /// or a distance joint; 0 without a motor): what a game reads as the effort its motor makes.
+    pub motor: f32,
 }
 
 /// What one pass over a joint's rows needs besides the rows (borrowed apart from them, so the

@@ -60,7 +60,8 @@ pub use batch::ContactBatch;
 pub use body::{BodyInput, BodyParams, BodyState, SolverBodies};
 pub use contact::{ConstraintPoint, ContactConstraint, ContactInput, ContactPointInput};
 pub use joint::{
-    JointConstraint, JointFrame, JointImpulses, JointInput, JointKind, JointLimit, JointMotor,
+    HeldLoad, JointConstraint, JointFrame, JointImpulses, JointInput, JointKind, JointLimit,
+    JointMotor,
 };
 pub use rolling::RollingRows;
 pub use softness::Softness;

@@ -45,7 +45,7 @@ use crate::dynamics::forces::{
 };
 use crate::dynamics::solver::Solver;
 use crate::dynamics::solver::{
-    BodyInput, ContactInput, JointInput, SoftStepSettings, SolverBodies,
+    BodyInput, ContactInput, HeldLoad, JointInput, SoftStepSettings, SolverBodies,
 };
 use crate::plugins::forces::GatheredForces;
 use crate::plugins::narrow_phase::Contacts;
@@ -114,14 +114,13 @@ pub struct SoftStepSolver {
 }
 
 impl SoftStepSolver {
-    /// Each joint of the last step with the force (N) and torque (N·m) it held over the last
-    /// substep.
-    pub fn joint_loads(&self) -> impl Iterator<Item = (Entity, f32, f32)> + '_ {
+    /// Each joint of the last step with what it held over the last substep.
+    pub fn joint_loads(&self) -> impl Iterator<Item = (Entity, HeldLoad)> + '_ {
         let h = self.solver.substep();
-        self.solver.joints().iter().map(move |j| {
-            let (force, torque) = j.load(h);
-            (Entity::from_bits(j.input.key), force, torque)
-        })
+        self.solver
+            .joints()
+            .iter()
+            .map(move |j| (Entity::from_bits(j.input.key), j.load(h)))
     }
 
     /// A solver with these settings (unusable ones step with the defaults; see
