@@ -56,6 +56,23 @@ pub struct JointImpulses {
     pub swing: f32,
 }
 
+impl JointImpulses {
+    /// Every impulse times `factor`.
+    fn scale(&mut self, factor: f32) {
+        self.point *= factor;
+        self.angular *= factor;
+        self.across = self.across.map(|a| a * factor);
+        for x in [
+            &mut self.motor,
+            &mut self.lower,
+            &mut self.upper,
+            &mut self.swing,
+        ] {
+            *x *= factor;
+        }
+    }
+}
+
 /// A joint prepared for a step.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct JointConstraint {
@@ -254,8 +271,34 @@ impl JointConstraint {
 
     /// Applies the accumulated impulses.
     pub fn warm_start(&self, states: &mut [BodyState]) {
+        self.apply_impulses(states, self.slots());
+    }
+
+    /// Scales the impulses carried from the last step down so that applying them changes
+    /// neither body's velocity by more than `max_speed` nor its spin by more than `max_spin`,
+    /// and drops them if they are not finite. A joint fighting another one that holds the same
+    /// body somewhere else (two joints to static bodies at places the body cannot reach at
+    /// once) otherwise grows its rigid passes' impulses step after step until they overflow;
+    /// no impulse a sound joint carries comes near the bound.
+    pub fn bound_impulses(&mut self, max_speed: f32, max_spin: f32) {
+        let mut effect = [BodyState::default(); 2];
+        self.apply_impulses(&mut effect, (0, 1));
+        let over = effect
+            .iter()
+            .map(|s| {
+                (s.linear_velocity.length() / max_speed).max(s.angular_velocity.length() / max_spin)
+            })
+            .fold(0.0f32, f32::max);
+        if !over.is_finite() {
+            self.impulses = JointImpulses::default();
+        } else if over > 1.0 {
+            self.impulses.scale(1.0 / over);
+        }
+    }
+
+    /// Applies the accumulated impulses to the bodies in `states` at slots `ab`.
+    fn apply_impulses(&self, states: &mut [BodyState], ab: (usize, usize)) {
         let rows = &self.rows;
-        let ab = self.slots();
         let m = &self.masses;
         let j = &self.impulses;
         if self.holds_point() {

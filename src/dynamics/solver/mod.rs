@@ -104,6 +104,11 @@ pub struct SoftStepSettings {
     pub warm_start_distance: f32,
     /// Fastest turn per substep (rad): keeps a wildly spinning body's linearised rotation sane.
     pub max_rotation_per_substep: f32,
+    /// Fastest a body moves (m/s; Box2D v3's `maximumLinearSpeed`, 400 m/s, "faster than the
+    /// speed of sound"; Jolt's is 500). Valid but violent input (a joint spawned with its
+    /// anchors metres apart on a 10 g body, a stiff spring stretched far) would otherwise fling
+    /// a body at kilometres per second; this bounds it, and a game with faster bodies raises it.
+    pub max_linear_speed: f32,
     /// Stiffness with which joints close their position errors in the biased pass (Hz; 0:
     /// rigid). Box2D v3 takes twice its contact stiffness, 60 Hz.
     pub joint_hertz: f32,
@@ -123,6 +128,7 @@ impl Default for SoftStepSettings {
             restitution_threshold: 1.0,
             warm_start_distance: 0.05,
             max_rotation_per_substep: 0.25 * std::f32::consts::PI,
+            max_linear_speed: 400.0,
             joint_hertz: 60.0,
             joint_damping_ratio: 2.0,
         }
@@ -133,7 +139,7 @@ impl SoftStepSettings {
     /// The settings if every number is usable: `1..=MAX_SUBSTEPS` substeps,
     /// `1..=MAX_RELAX_ITERATIONS` relax passes, stiffnesses,
     /// damping ratio, restitution threshold and warm-start distance finite and `>= 0`, push-out
-    /// speed and rotation bound finite and `> 0`.
+    /// speed, rotation bound and speed bound finite and `> 0`.
     pub fn validated(self) -> Result<Self, SettingsError> {
         if !(1..=MAX_SUBSTEPS).contains(&self.substeps) {
             return Err(SettingsError::BadSubsteps(self.substeps));
@@ -156,6 +162,7 @@ impl SoftStepSettings {
         let above_zero = [
             ("max_push_out", self.max_push_out),
             ("max_rotation_per_substep", self.max_rotation_per_substep),
+            ("max_linear_speed", self.max_linear_speed),
         ];
         for (name, v) in at_least_zero {
             if !(v.is_finite() && v >= 0.0) {
@@ -247,6 +254,12 @@ impl Solver {
         self.substep = h;
         self.prepare(bodies, contacts, h);
         self.prepare_joints(bodies, joints);
+        for j in &mut self.joints {
+            j.bound_impulses(
+                2.0 * s.max_linear_speed,
+                2.0 * s.max_rotation_per_substep * inv_h,
+            );
+        }
         let joint_soft = Softness::new(s.joint_hertz, s.joint_damping_ratio, h);
         self.stabilise_springs(bodies, springs, h);
         let springs = std::mem::take(&mut self.stable_springs);
@@ -267,7 +280,7 @@ impl Solver {
             self.warm_start(bodies, flip);
             self.solve_joints(bodies, joint_soft, h, true);
             self.solve_contacts(bodies, inv_h, true, flip);
-            integrate_positions(bodies, h, s.max_rotation_per_substep);
+            integrate_positions(bodies, h, s.max_rotation_per_substep, s.max_linear_speed);
             for j in &mut self.joints {
                 j.refresh(&bodies.states);
             }
@@ -282,6 +295,16 @@ impl Solver {
         }
         for c in &mut self.constraints {
             c.restitute(&mut bodies.states, s.restitution_threshold);
+        }
+        // The relax passes and the bounces after the last move can still speed a body up: the
+        // step hands out no speed or spin above the bounds either (a spin above
+        // `max_rotation_per_substep / h` could not be followed by the next step anyway).
+        let max_spin = s.max_rotation_per_substep * inv_h;
+        for (state, p) in bodies.states.iter_mut().zip(&bodies.params) {
+            if p.dynamic {
+                state.linear_velocity = capped(state.linear_velocity, s.max_linear_speed);
+                state.angular_velocity = capped(state.angular_velocity, max_spin);
+            }
         }
         let orientations = &bodies.orientations;
         self.cache
@@ -479,12 +502,16 @@ fn integrate_velocities(bodies: &mut SolverBodies, h: f32) {
     }
 }
 
-/// Moves every body by its velocity for one substep: `dp += h v`, and `dq` turned by `h ω`
-/// (the linearised quaternion update, renormalised, as Box2D; at most `max_rotation` per
-/// substep). A gyroscopic body turning noticeably instead follows the free rigid body's exact
+/// Moves every body by its velocity for one substep: `dp += h v` (a dynamic body's `v` at most
+/// `max_speed`),
+/// and `dq` turned by `h ω` (the linearised quaternion update, renormalised, as Box2D; at most
+/// `max_rotation` per substep). A gyroscopic body turning noticeably instead follows the free rigid body's exact
 /// flow for `h` ([`FreeBody`]: McLachlan's splitting, momentum exact), which also updates `ω`.
-fn integrate_positions(bodies: &mut SolverBodies, h: f32, max_rotation: f32) {
+fn integrate_positions(bodies: &mut SolverBodies, h: f32, max_rotation: f32, max_speed: f32) {
     for (i, state) in bodies.states.iter_mut().enumerate() {
+        if bodies.params[i].dynamic {
+            state.linear_velocity = capped(state.linear_velocity, max_speed);
+        }
         state.delta_position += state.linear_velocity * h;
         let mut w = state.angular_velocity;
         if w == Vec3::ZERO {
@@ -508,6 +535,24 @@ fn integrate_positions(bodies: &mut SolverBodies, h: f32, max_rotation: f32) {
         }
         let spin = Quat::from_xyzw(w.x, w.y, w.z, 0.0) * dq;
         state.delta_rotation = (dq + spin * (0.5 * h)).normalize();
+    }
+}
+
+/// `v` shortened to `max` if it is longer (for dynamic bodies only: a kinematic body's speed is
+/// the game's to choose). Its length is taken after scaling by its largest component, so a
+/// vector near `f32::MAX` is shortened, not zeroed by an overflowing length; a non-finite one
+/// is left for the step's guard to quarantine.
+fn capped(v: Vec3, max: f32) -> Vec3 {
+    let largest = v.abs().max_element();
+    if largest <= max || !v.is_finite() {
+        return v;
+    }
+    let unit = v / largest;
+    let length = largest * unit.length();
+    if length > max {
+        unit * (max / unit.length())
+    } else {
+        v
     }
 }
 

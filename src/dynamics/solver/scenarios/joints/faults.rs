@@ -1,5 +1,6 @@
 //! Joints the solver cannot use: skipped, and the bodies they name left to fall freely; a NaN
-//! joint setting replaced by the defaults.
+//! joint setting replaced by the defaults. Joints that are valid but violent (spawned metres
+//! from their anchors, or fighting each other) held to the speed bound.
 
 use super::*;
 
@@ -59,4 +60,81 @@ fn an_unusable_joint_is_skipped_and_a_nan_joint_setting_steps_with_the_defaults(
     assert_eq!(scene.solver.settings, SoftStepSettings::default());
     let z = scene.bodies[bob].center.z;
     assert!((z + 1.0).abs() < 0.01, "the joint let go: z = {z}");
+}
+
+/// A 10 g ball tied by a ball joint to a 10 t block 20 m away (valid but violent: the joint
+/// closes the gap at once), stepped 30 times with `max_linear_speed`; the ball's top speed,
+/// as its velocity or as the distance it moved in a step over the step (the relax passes take
+/// the error-closing speed back out of the velocity a step hands out, not out of the motion).
+fn snap_from_20_m(max_linear_speed: f32) -> f32 {
+    let mut scene = Scene::default();
+    scene.solver.settings.max_linear_speed = max_linear_speed;
+    let block = scene.add(Shape::cuboid(Vec3::ONE), Vec3::ZERO, Quat::IDENTITY, 1e4);
+    let far = Vec3::new(20.0, 0.0, 0.0);
+    let ball = scene.add(Shape::sphere(0.05), far, Quat::IDENTITY, 0.01);
+    join(
+        &mut scene,
+        (block, ball),
+        (Vec3::ZERO, Vec3::ZERO),
+        Vec3::Y,
+        BALL,
+    );
+    let mut fastest = 0.0f32;
+    for _ in 0..30 {
+        let start = scene.bodies[ball].center;
+        scene.step();
+        let (v, moved) = (scene.bodies[ball].v, scene.bodies[ball].center - start);
+        assert!(v.is_finite() && moved.is_finite(), "{v}, {moved}");
+        fastest = fastest.max(v.length()).max(moved.length() / DT);
+    }
+    fastest
+}
+
+#[test]
+fn a_joint_spawned_20_m_apart_on_a_10_g_ball_snaps_it_no_faster_than_the_400_m_per_s_bound() {
+    let bound = SoftStepSettings::default().max_linear_speed;
+    let fastest = snap_from_20_m(bound);
+    assert!(fastest <= bound * (1.0 + 1e-6), "{fastest} m/s");
+    // It was the bound that held it: unbounded, the same snap is faster.
+    let unbounded = snap_from_20_m(1e9);
+    assert!(unbounded > bound, "{unbounded} m/s");
+}
+
+#[test]
+fn a_ball_welded_to_two_posts_it_cannot_reach_at_once_stays_finite_and_under_400_m_per_s_for_10_s()
+{
+    // Two rigid welds that disagree by metres, on a light ball with a small inertia, fight in
+    // every relax pass; carried from step to step unbounded, their impulses grew until the
+    // ball turned NaN (found by the scene fuzz).
+    let mut scene = Scene::default();
+    let posts = [Vec3::new(-2.0, 0.0, 0.0), Vec3::new(1.0, 2.0, 0.5)];
+    let post = posts.map(|at| anchor(&mut scene, at));
+    let ball = scene.add(Shape::sphere(0.02), Vec3::ZERO, Quat::IDENTITY, 0.01);
+    let offsets = [Vec3::new(0.5, 0.0, 0.0), Vec3::new(0.0, -0.7, 0.3)];
+    let axes = [Vec3::Y, Vec3::new(1.0, 0.0, 1.0)];
+    for ((p, offset), axis) in post.into_iter().zip(offsets).zip(axes) {
+        join(
+            &mut scene,
+            (p, ball),
+            (Vec3::ZERO, offset),
+            axis,
+            JointKind::Fixed,
+        );
+    }
+    let bound = SoftStepSettings::default().max_linear_speed;
+    for _ in 0..600 {
+        scene.step();
+        let b = &scene.bodies[ball];
+        assert!(
+            b.center.is_finite() && b.orientation.is_finite(),
+            "{}",
+            b.center
+        );
+        assert!(
+            b.v.length() <= bound * 1.001 && b.w.is_finite(),
+            "{} {}",
+            b.v,
+            b.w
+        );
+    }
 }

@@ -1,6 +1,10 @@
-//! Bad input is reported and set aside; it never panics and never poisons a neighbour.
+//! Bad input is reported and set aside; it never panics and never poisons a neighbour. And
+//! valid but extreme input ([`scene_fuzz`]: random scenes of every shape, joint and setting at
+//! the ends of their ranges) steps without a panic or a NaN.
 
+#[path = "../common/mod.rs"]
 mod common;
+mod scene_fuzz;
 
 use glam::Vec3;
 use urto::geometry::Shape;
@@ -133,14 +137,25 @@ fn bad_shapes_and_rotations_are_quarantined() {
 }
 
 #[test]
-fn an_overflowing_body_is_caught_before_it_spreads() {
+fn an_overflowing_kinematic_body_is_caught_and_a_dynamic_one_is_held_to_400_m_per_s() {
     let mut app = common::app();
+    // A kinematic body keeps the speed the game gave it, and overflows.
     let huge = app
         .world_mut()
         .spawn((
             Collider::sphere(0.5),
+            Mass::INFINITE,
             Velocity::new(f32::MAX, 0.0, 0.0),
             Position::new(f32::MAX * 0.99, 0.0, 0.0),
+        ))
+        .id();
+    // A dynamic one is held to the solver's speed bound.
+    let fast = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.5),
+            Velocity::new(f32::MAX, -f32::MAX, 0.0),
+            Position::new(0.0, 100.0, 0.0),
         ))
         .id();
     let neighbour = app
@@ -153,6 +168,11 @@ fn an_overflowing_body_is_caught_before_it_spreads() {
         app.world().get::<Position>(neighbour).unwrap().0,
         Vec3::ZERO
     );
+    let v = app.world().get::<Velocity>(fast).unwrap().0;
+    let bound = SoftStepSettings::default().max_linear_speed;
+    assert!(!quarantined(&app, fast));
+    assert!((v.length() / bound - 1.0).abs() < 1e-5, "{v}");
+    assert!((v.normalize() - Vec3::new(1.0, -1.0, 0.0).normalize()).length() < 1e-5);
 }
 
 #[test]
