@@ -271,6 +271,23 @@ fn a_chair_of_cylinder_legs_and_a_hull_from_a_mesh_file_land_and_rest_within_1_c
 }
 
 #[test]
+fn a_zero_negative_nan_or_infinite_speed_bound_is_refused_naming_it() {
+    for bad in [0.0, -1.0, f32::NAN, f32::INFINITY] {
+        let settings = SoftStepSettings {
+            max_linear_speed: bad,
+            ..Default::default()
+        };
+        let err = settings.validated().expect_err("an unusable speed bound");
+        assert!(format!("{err}").contains("max_linear_speed"), "{err}");
+    }
+    let fine = SoftStepSettings {
+        max_linear_speed: 2000.0,
+        ..Default::default()
+    };
+    assert!(fine.validated().is_ok());
+}
+
+#[test]
 fn with_the_soft_step_unusable_settings_fall_back_to_the_defaults_and_a_box_still_rests_within_1_cm()
  {
     let bad = SoftStepSettings {
