@@ -544,12 +544,12 @@ fn integrate_positions(bodies: &mut SolverBodies, h: f32, max_rotation: f32, max
 /// is left for the step's guard to quarantine.
 fn capped(v: Vec3, max: f32) -> Vec3 {
     let largest = v.abs().max_element();
-    if largest <= max || !v.is_finite() {
+    // The length is at most √3 times the largest component: most vectors need no root.
+    if largest * 1.732_051 <= max || !v.is_finite() {
         return v;
     }
     let unit = v / largest;
-    let length = largest * unit.length();
-    if length > max {
+    if largest * unit.length() > max {
         unit * (max / unit.length())
     } else {
         v
@@ -559,3 +559,31 @@ fn capped(v: Vec3, max: f32) -> Vec3 {
 /// Below this turn per substep (rad) the gyroscopic term changes `ω` by less than `turn²` of
 /// itself per substep, far below the contacts' own error: the linearised update is used.
 const GYROSCOPIC_MIN_TURN: f32 = 1e-4;
+
+#[cfg(test)]
+mod capped_tests {
+    use super::capped;
+    use glam::Vec3;
+
+    #[test]
+    fn capped_shortens_to_the_bound_within_1e_6_keeps_shorter_and_non_finite_vectors() {
+        for v in [
+            Vec3::new(283.0, 293.0, -6.0),
+            Vec3::new(f32::MAX, -f32::MAX, f32::MAX),
+            Vec3::new(1e30, 0.0, 0.0),
+        ] {
+            let c = capped(v, 400.0);
+            assert!((c.length() / 400.0 - 1.0).abs() < 1e-6, "{v} -> {c}");
+            assert!(
+                c.normalize()
+                    .dot(v / v.abs().max_element())
+                    .is_sign_positive()
+            );
+        }
+        for v in [Vec3::new(230.0, 230.0, 230.0), Vec3::ZERO, Vec3::X * 400.0] {
+            assert_eq!(capped(v, 400.0), v);
+        }
+        assert!(capped(Vec3::new(f32::NAN, 1.0, 0.0), 400.0).x.is_nan());
+        assert!(capped(Vec3::INFINITY, 400.0).x.is_infinite());
+    }
+}
