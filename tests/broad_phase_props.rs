@@ -1,7 +1,9 @@
 //! The broad phases against an independent model: random sequences of inserts, bulk inserts,
 //! moves (jitter and jumps on a coarse grid, so boxes touch and values repeat, `-0.0`
 //! included), removals, static bodies and bad calls; after every commit each broad phase's
-//! pairs, added and removed must equal the model's brute-force answer exactly.
+//! pairs, added and removed must equal the model's brute-force answer exactly. And the
+//! incremental SAP allocates nothing per step once its buffers have grown (a counting
+//! allocator, issue 12).
 
 use glam::Vec3;
 use proptest::prelude::*;
@@ -483,4 +485,89 @@ fn removing_and_reinserting_in_one_step_reports_only_net_changes() {
         assert_eq!(bp.pairs(), &[Pair { a: 1, b: 2 }], "{name}");
     }
     subjects.check_internals();
+}
+
+// ------------------------------------------- no allocation per step in steady state
+
+/// Counts the allocations each thread makes (tests run on threads of their own, so a test
+/// reads only its own count).
+struct CountingAllocator;
+
+thread_local! {
+    static ALLOCATIONS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
+fn count_allocation() {
+    // `try_with`: a thread being torn down still frees and may allocate.
+    let _ = ALLOCATIONS.try_with(|n| n.set(n.get() + 1));
+}
+
+// SAFETY: every call is forwarded unchanged to the system allocator; only a counter is added.
+unsafe impl std::alloc::GlobalAlloc for CountingAllocator {
+    unsafe fn alloc(&self, layout: std::alloc::Layout) -> *mut u8 {
+        count_allocation();
+        // SAFETY: the caller's contract for `alloc` is the system allocator's.
+        unsafe { std::alloc::System.alloc(layout) }
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: std::alloc::Layout) {
+        // SAFETY: `ptr` came from `alloc`/`realloc` above, i.e. from the system allocator.
+        unsafe { std::alloc::System.dealloc(ptr, layout) }
+    }
+
+    unsafe fn realloc(&self, ptr: *mut u8, layout: std::alloc::Layout, new_size: usize) -> *mut u8 {
+        count_allocation();
+        // SAFETY: as for `dealloc`, and `new_size` is the caller's.
+        unsafe { std::alloc::System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: CountingAllocator = CountingAllocator;
+
+fn allocations() -> u64 {
+    ALLOCATIONS.with(|n| n.get())
+}
+
+/// 2,000 unit boxes on a 1.5 m lattice, each swinging on its own phase by up to 0.8 m, so
+/// every step starts and ends overlaps; the motion repeats every `PERIOD` steps.
+fn swinging_box(i: u32, step: u32) -> Aabb {
+    const PERIOD: f32 = 60.0;
+    let cell = Vec3::new((i % 20) as f32, ((i / 20) % 10) as f32, (i / 200) as f32) * 1.5;
+    let phase = std::f32::consts::TAU * (step as f32 / PERIOD) + i as f32;
+    let swing = Vec3::new(phase.sin(), (1.3 * phase).cos(), (0.7 * phase).sin()) * 0.8;
+    Aabb::from_center_half_extents(cell + swing, Vec3::splat(0.5))
+}
+
+#[test]
+fn the_incremental_sap_makes_0_allocations_per_step_once_its_buffers_have_grown() {
+    let mut sap = IncrementalSap::<AxisTests>::new();
+    let bodies: Vec<(ProxyId, Aabb, BodyKind)> = (0..2000)
+        .map(|i| (i, swinging_box(i, 0), BodyKind::Dynamic))
+        .collect();
+    sap.insert_bulk(&bodies).expect("valid boxes");
+    sap.commit();
+    let mut step = |n: u32, sap: &mut IncrementalSap<AxisTests>| {
+        for i in 0..2000 {
+            sap.update(i, swinging_box(i, n)).expect("a known body");
+        }
+        sap.commit();
+    };
+    // Ten periods grow every buffer to what the motion needs (the motion repeats only up to
+    // rounding, so a buffer may still reach a new high in the first periods).
+    for n in 1..=600 {
+        step(n, &mut sap);
+    }
+    let before = allocations();
+    let mut churn = 0;
+    for n in 601..=720 {
+        step(n, &mut sap);
+        churn += sap.added().len() + sap.removed().len();
+    }
+    let made = allocations() - before;
+    assert!(
+        churn > 1000,
+        "the scene must start and end overlaps: {churn}"
+    );
+    assert_eq!(made, 0, "{made} allocations in 120 steady steps");
 }
