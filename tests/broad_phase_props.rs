@@ -547,7 +547,7 @@ fn the_incremental_sap_makes_0_allocations_per_step_once_its_buffers_have_grown(
         .collect();
     sap.insert_bulk(&bodies).expect("valid boxes");
     sap.commit();
-    let mut step = |n: u32, sap: &mut IncrementalSap<AxisTests>| {
+    let step = |n: u32, sap: &mut IncrementalSap<AxisTests>| {
         for i in 0..2000 {
             sap.update(i, swinging_box(i, n)).expect("a known body");
         }
