@@ -31,34 +31,24 @@ use urto::broad_phase::{BodyKind, BroadPhase, IncrementalSap};
 const WARM_UP: usize = 5;
 const STEPS: usize = 30;
 
-/// SplitMix64: the same boxes and motion for both engines, every run.
-struct Rng(u64);
+/// The tests' seeded generator (SplitMix64): the same boxes and motion for both engines, every
+/// run.
+#[allow(dead_code)]
+#[path = "../../tests/common/rng.rs"]
+mod rng;
+use rng::Rng;
 
-impl Rng {
-    fn next(&mut self) -> f32 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
-    }
-
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.next()
-    }
-
-    fn direction(&mut self) -> Vec3 {
-        loop {
-            let v = Vec3::new(
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-            );
-            if let Some(d) = v.try_normalize() {
-                return d;
-            }
-        }
-    }
+/// `n` points uniformly in the cube `[0, side]³`.
+fn in_cube(n: usize, side: f32, rng: &mut Rng) -> Vec<Vec3> {
+    (0..n)
+        .map(|_| {
+            Vec3::new(
+                rng.range(0.0, side),
+                rng.range(0.0, side),
+                rng.range(0.0, side),
+            )
+        })
+        .collect()
 }
 
 /// A scene: box centres, half extents, which boxes move and how, inside `bounds`.
@@ -75,16 +65,8 @@ impl Scene {
     /// `n` unit boxes in a cube sized for about two overlaps each, `moving` of them moving.
     fn cloud(n: usize, moving_fraction: f32, seed: u64) -> Self {
         let side = (4.0 * n as f32).cbrt();
-        let mut rng = Rng(seed);
-        let centers = (0..n)
-            .map(|_| {
-                Vec3::new(
-                    rng.range(0.0, side),
-                    rng.range(0.0, side),
-                    rng.range(0.0, side),
-                )
-            })
-            .collect();
+        let mut rng = Rng::new(seed);
+        let centers = in_cube(n, side, &mut rng);
         let name = if moving_fraction < 1.0 {
             format!("cloud {n}, {:.0} % moving", moving_fraction * 100.0)
         } else {
@@ -102,7 +84,7 @@ impl Scene {
 
     /// `n` unit boxes along x, 0.9 m apart (each overlaps its two neighbours), jittering.
     fn row(n: usize, seed: u64) -> Self {
-        let mut rng = Rng(seed);
+        let mut rng = Rng::new(seed);
         let centers = (0..n)
             .map(|i| Vec3::new(i as f32 * 0.9, rng.range(0.0, 0.1), rng.range(0.0, 0.1)))
             .collect();
@@ -119,7 +101,7 @@ impl Scene {
 
     /// `n` boxes of half extents 0.1–2 m, all moving.
     fn mixed(n: usize, seed: u64) -> Self {
-        let mut rng = Rng(seed);
+        let mut rng = Rng::new(seed);
         let halves: Vec<Vec3> = (0..n)
             .map(|_| {
                 Vec3::new(
@@ -131,15 +113,7 @@ impl Scene {
             .collect();
         let volume: f32 = halves.iter().map(|h| 8.0 * h.x * h.y * h.z).sum();
         let side = (2.0 * volume).cbrt();
-        let centers = (0..n)
-            .map(|_| {
-                Vec3::new(
-                    rng.range(0.0, side),
-                    rng.range(0.0, side),
-                    rng.range(0.0, side),
-                )
-            })
-            .collect();
+        let centers = in_cube(n, side, &mut rng);
         Self::finish(
             format!("{n} of mixed sizes, all moving"),
             centers,
@@ -164,7 +138,7 @@ impl Scene {
             |(lo, hi), &c: &Vec3| (lo.min(c), hi.max(c)),
         );
         let moving = (0..n as u32)
-            .filter(|_| rng.next() < moving_fraction)
+            .filter(|_| rng.unit() < moving_fraction)
             .collect();
         let velocities = (0..n).map(|_| rng.direction() * speed).collect();
         Self {
