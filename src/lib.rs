@@ -26,6 +26,10 @@
 //! assert!(z > 0.4 && z < 2.0);
 //! ```
 
+// Every public item says what it is (the public-surface audit of issue 11); clippy's
+// `-D warnings` in CI turns a missing doc into an error.
+#![warn(missing_docs)]
+
 pub mod bounding;
 pub mod broad_phase;
 pub mod bvh;

@@ -19,8 +19,11 @@ pub const LANES: usize = 4;
 /// A 3-vector per lane.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Vec3x4 {
+    /// The x components, one per lane.
     pub x: Lanes,
+    /// The y components, one per lane.
     pub y: Lanes,
+    /// The z components, one per lane.
     pub z: Lanes,
 }
 
