@@ -19,6 +19,7 @@
 //! - Hull–ball pairs are checked against an exact brute force over the hull's triangles instead:
 //!   parry 0.31 strays up to 3e-3 on flat random hulls.
 
+#[allow(dead_code)]
 #[path = "common/rng.rs"]
 mod rng;
 

@@ -6,7 +6,7 @@
 //! **Nothing about the arm is scripted but its motors' targets.** The turret's velocity motor
 //! turns it at a steady rate; the game reads how far it has turned, picks the reach for that
 //! point of the sweep, and a little inverse kinematics turns the reach into target angles for
-//! the shoulder's, elbow's and wrist's position motors (springs of a few hertz with a torque
+//! the shoulder's, elbow's and wrist's position motors (20 Hz springs with a torque
 //! limit, Box2D's and Avian's motors). The links are dynamic bodies: gravity pulls on them, the
 //! crates push back, and the motors' torques are what bats the crates away. A link that hits a
 //! heavy crate trails its target and catches up.
@@ -244,7 +244,7 @@ const GRIPPER_PARTS: Parts = &[
 const BASE: Vec3 = Vec3::new(0.15, 0.15, 0.1);
 const TURRET: (f32, f32) = (0.05, 0.18);
 
-/// A link: its root ball (`radius`) at `pivot`, turned by `rotation`, and its parts as
+/// A link: its root ball (`radius`, with the link's `mass`) placed at `pose`, and its parts as
 /// children; returns the link and how many colliders it has.
 fn spawn_link(
     world: &mut World,

@@ -26,6 +26,7 @@
 //!   that freed it).
 //! - Bad input is an error, never a panic, and a failed call changes nothing.
 
+mod adaptive;
 mod body_store;
 mod brute_force;
 mod endpoints;
@@ -39,6 +40,7 @@ mod positions;
 mod sap;
 mod sort_sweep;
 
+pub use adaptive::AdaptiveSweep;
 pub use brute_force::BruteForce;
 pub use grid::{GridError, GridQueryStats, StaticGrid, StaticGridConfig};
 pub use pair_tracking::{AxisBits, AxisTests, PairTracking};

@@ -350,6 +350,16 @@ pub struct JointLoad {
     pub motor: f32,
 }
 
+impl From<crate::dynamics::solver::HeldLoad> for JointLoad {
+    fn from(held: crate::dynamics::solver::HeldLoad) -> Self {
+        Self {
+            force: held.force,
+            torque: held.torque,
+            motor: held.motor,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

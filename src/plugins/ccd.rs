@@ -226,6 +226,9 @@ fn sweep_fast_bodies(
             continue;
         }
         let (mut at, mut velocity, mut motion) = (from, v.0, p.0 - from);
+        // The share of the step still to move: each impact uses up its sweep's `t` of what was
+        // left (a second impact at t = 0 is not handed a fresh step).
+        let mut remaining = 1.0f32;
         for _ in 0..settings.max_impacts {
             let Ok(sweep) = SphereSweep::new(at, radius, motion) else {
                 at += motion;
@@ -250,7 +253,8 @@ fn sweep_fast_bodies(
             };
             at = sweep.position_at(hit.t);
             velocity = reflect(velocity, hit.normal, e);
-            motion = velocity * dt * (1.0 - hit.t);
+            remaining *= 1.0 - hit.t;
+            motion = velocity * dt * remaining;
             impacts.contacts.push(ContactPair {
                 a: body,
                 b: root,

@@ -115,12 +115,8 @@ fn break_joints(
         let Ok((joint, load)) = joints.get_mut(e) else {
             continue;
         };
-        let (force, torque) = (held.force, held.torque);
-        let now = JointLoad {
-            force,
-            torque,
-            motor: held.motor,
-        };
+        let now = JointLoad::from(held);
+        let (force, torque) = (now.force, now.torque);
         match load {
             Some(mut load) => {
                 load.set_if_neq(now);

@@ -32,15 +32,6 @@ const SCENES: u64 = 24;
 /// Steps per scene.
 const STEPS: u32 = 90;
 
-/// `10^x` for `x` uniform in `[lo, hi)`: sizes and masses spread over decades.
-fn decades(rng: &mut Rng, lo: f32, hi: f32) -> f32 {
-    10f32.powf(rng.range(lo, hi))
-}
-
-fn chance(rng: &mut Rng, p: f32) -> bool {
-    rng.unit() < p
-}
-
 /// One convex or mesh shape about `size` across, thin in some directions.
 fn random_shape(rng: &mut Rng, size: f32) -> Collider {
     let mut side = || size * rng.range(0.05, 1.0);
@@ -68,7 +59,7 @@ fn random_shape(rng: &mut Rng, size: f32) -> Collider {
 /// A body: a shape (or a compound of two to four), placed anywhere in a 10 m ball, moving and
 /// spinning, with its material and options drawn at random.
 fn random_body(world: &mut World, rng: &mut Rng) -> Entity {
-    let size = decades(rng, -1.7, 1.3);
+    let size = rng.decades(-1.7, 1.3);
     let at = rng.in_ball(10.0) + Vec3::Z * 10.0;
     let mut body = world.spawn((
         random_shape(rng, size),
@@ -86,29 +77,29 @@ fn random_body(world: &mut World, rng: &mut Rng) -> Entity {
             body.insert((Mass::INFINITE, Velocity(v)));
         }
         _ => {
-            let v = rng.direction() * decades(rng, -1.0, 2.0);
+            let v = rng.direction() * rng.decades(-1.0, 2.0);
             let w = rng.direction() * rng.range(0.0, 30.0);
             body.insert((
-                Mass(decades(rng, -2.0, 4.0)),
+                Mass(rng.decades(-2.0, 4.0)),
                 Velocity(v),
                 AngularVelocity(w),
             ));
         }
     }
-    if chance(rng, 0.2) {
+    if rng.chance(0.2) {
         body.insert((
             LinearDrag(rng.range(0.0, 50.0)),
             AngularDrag(rng.range(0.0, 50.0)),
         ));
     }
-    if chance(rng, 0.1) {
+    if rng.chance(0.1) {
         body.insert(LockedAxes::ROTATION_LOCKED.lock_rotation_z());
     }
-    if chance(rng, 0.1) {
+    if rng.chance(0.1) {
         body.insert(RollingResistance(rng.range(0.0, 0.1)));
     }
     let id = body.id();
-    if chance(rng, 0.15) {
+    if rng.chance(0.15) {
         for _ in 0..1 + rng.below(3) {
             let part = random_shape(rng, size);
             let offset = rng.in_ball(size);
@@ -128,7 +119,8 @@ fn random_body(world: &mut World, rng: &mut Rng) -> Entity {
 fn random_joint(rng: &mut Rng, a: Entity, b: JointEnd, reach: f32) -> Joint {
     let (lo, hi) = (-rng.range(0.0, 3.0), rng.range(0.0, 3.0));
     let length = rng.range(0.1, reach);
-    let joint = match rng.below(7) {
+    let kind = rng.below(7);
+    let joint = match kind {
         0 => Joint::fixed(a, b),
         1 => Joint::spherical(a, b).with_swing_limit(rng.range(0.0, 3.0)),
         2 => Joint::revolute(a, b),
@@ -137,17 +129,29 @@ fn random_joint(rng: &mut Rng, a: Entity, b: JointEnd, reach: f32) -> Joint {
         5 => Joint::rod(a, b, length),
         _ => Joint::distance(a, b, 0.5 * length, length),
     };
-    let motor = if chance(rng, 0.5) {
-        JointMotor::velocity(rng.range(-10.0, 10.0), decades(rng, 0.0, 4.0))
+    // A distance joint keeps its constructor's bounds (a distance is never negative); its
+    // position motor pulls to a length within them.
+    let distance = kind >= 4;
+    let target = if distance {
+        rng.range(0.5 * length, length)
     } else {
-        JointMotor::position(rng.range(lo, hi), rng.range(0.1, 30.0), rng.unit(), 1e3)
+        rng.range(lo, hi)
+    };
+    let motor = if rng.chance(0.5) {
+        JointMotor::velocity(rng.range(-10.0, 10.0), rng.decades(0.0, 4.0))
+    } else {
+        JointMotor::position(target, rng.range(0.1, 30.0), rng.unit(), 1e3)
     };
     let joint = joint
         .with_axis(rng.direction())
         .with_anchors(rng.in_ball(reach), rng.in_ball(reach))
-        .with_limits(lo, hi)
         .with_motor(motor);
-    if chance(rng, 0.3) {
+    let joint = if distance {
+        joint
+    } else {
+        joint.with_limits(lo, hi)
+    };
+    if rng.chance(0.3) {
         joint.with_collisions()
     } else {
         joint
@@ -162,7 +166,7 @@ fn random_scene(seed: u64) -> (App, Vec<Entity>) {
     let gravity = rng.direction() * rng.range(0.0, 30.0);
     app.insert_resource(Gravity::new(gravity).expect("finite gravity"));
     let world = app.world_mut();
-    if chance(&mut rng, 0.8) {
+    if rng.chance(0.8) {
         let normal = (Vec3::Z + rng.in_ball(0.5)).normalize();
         world.spawn((Collider::half_space(normal), Static));
     }
@@ -185,8 +189,8 @@ fn random_scene(seed: u64) -> (App, Vec<Entity>) {
         world.entity_mut(a).insert(Spring {
             target,
             rest_length: rng.range(0.0, 5.0),
-            stiffness: decades(&mut rng, 0.0, 6.0),
-            damping: decades(&mut rng, -1.0, 3.0),
+            stiffness: rng.decades(0.0, 6.0),
+            damping: rng.decades(-1.0, 3.0),
         });
     }
     (app, bodies)
@@ -198,10 +202,11 @@ fn speed_bound() -> f32 {
     SoftStepSettings::default().max_linear_speed * 1.001
 }
 
-/// How much further than `speed_bound() · dt` a centre of mass may move in a step: a little,
-/// for what moves bodies besides the solver's velocities (measured: at most 1.045 in 300
-/// scenes, a jointed compound; everything else within the bound).
-const MOTION_SLACK: f32 = 1.25;
+/// How much further than `speed_bound() · dt` a centre of mass may move in a step. Measured
+/// at most 1.07 (2 of 600 scenes, both bodies at the speed bound); the cause is not found. (CCD
+/// used to hand a body a fresh step's motion after each impact; it now moves the share of the
+/// step left.)
+const MOTION_SLACK: f32 = 1.1;
 
 /// Where a body's centre of mass is (its origin swings about it as the body turns).
 fn center_of_mass(app: &App, e: Entity) -> Vec3 {
@@ -274,6 +279,13 @@ fn random_extreme_scenes_step_90_times_with_no_quarantine_no_nan_and_no_body_abo
                     failures.push(format!("seed {seed}, step {step}: {why}"));
                     break;
                 }
+            }
+        }
+        let world = app.world_mut();
+        let mut joints = world.query::<(Entity, &Joint, Option<&Quarantined>)>();
+        for (e, _, quarantined) in joints.iter(world) {
+            if let Some(q) = quarantined {
+                failures.push(format!("seed {seed}: joint {e} quarantined: {}", q.reason));
             }
         }
         println!(

@@ -28,6 +28,16 @@ impl Rng {
         lo + (hi - lo) * self.unit()
     }
 
+    /// `10^x` for `x` uniform in `[lo, hi)`: sizes and masses spread over decades.
+    pub fn decades(&mut self, lo: f32, hi: f32) -> f32 {
+        10f32.powf(self.range(lo, hi))
+    }
+
+    /// True with probability `p`.
+    pub fn chance(&mut self, p: f32) -> bool {
+        self.unit() < p
+    }
+
     pub fn below(&mut self, n: usize) -> usize {
         (self.next_u64() % n as u64) as usize
     }

@@ -278,21 +278,32 @@ impl JointConstraint {
     /// neither body's velocity by more than `max_speed` nor its spin by more than `max_spin`,
     /// and drops them if they are not finite. A joint fighting another one that holds the same
     /// body somewhere else (two joints to static bodies at places the body cannot reach at
-    /// once) otherwise grows its rigid passes' impulses step after step until they overflow;
-    /// no impulse a sound joint carries comes near the bound.
+    /// once) otherwise grows its rigid passes' impulses step after step until they overflow.
+    /// The bound is per joint: a sound joint can reach it too where a light, thin body carries
+    /// a heavy one (a 0.2 kg rod holding 10 kg 10 cm off its axis), and is then held to it.
     pub fn bound_impulses(&mut self, max_speed: f32, max_spin: f32) {
+        if self.impulses == JointImpulses::default() {
+            return;
+        }
         let mut effect = [BodyState::default(); 2];
         self.apply_impulses(&mut effect, (0, 1));
+        let finite = effect
+            .iter()
+            .all(|s| s.linear_velocity.is_finite() && s.angular_velocity.is_finite());
+        if !finite {
+            self.impulses = JointImpulses::default();
+            return;
+        }
         let over = effect
             .iter()
             .map(|s| {
-                (s.linear_velocity.length() / max_speed).max(s.angular_velocity.length() / max_spin)
+                let speed = s.linear_velocity.length_squared() / (max_speed * max_speed);
+                let spin = s.angular_velocity.length_squared() / (max_spin * max_spin);
+                speed.max(spin)
             })
             .fold(0.0f32, f32::max);
-        if !over.is_finite() {
-            self.impulses = JointImpulses::default();
-        } else if over > 1.0 {
-            self.impulses.scale(1.0 / over);
+        if over > 1.0 {
+            self.impulses.scale(1.0 / over.sqrt());
         }
     }
 

@@ -7,7 +7,9 @@
 //!
 //! 1. **prepare** — contact rows with lever arms ([`ContactConstraint::prepare`]), seeded with
 //!    last step's impulses ([`WarmStartCache`]), then packed up to four at a time into
-//!    [`ContactBatch`]es of contacts that share no moving body ([`ordered_batches`]);
+//!    [`ContactBatch`]es of contacts that share no moving body ([`ordered_batches`]); joints
+//!    seeded with theirs, held to what the speed and spin bounds allow
+//!    ([`JointConstraint::bound_impulses`]);
 //! 2. `substeps` times:
 //!    1. **integrate velocities** — springs, then gravity, forces, torques and damping, all
 //!       evaluated at the substep's starting state (so a stiff spring is as stable as the
@@ -15,10 +17,13 @@
 //!    2. **warm start** — apply the accumulated impulses (each contact's points are swept in
 //!       the opposite order from the last substep, so Gauss–Seidel favours none of them);
 //!    3. **solve** — one biased pass: penetration pushed out softly, speculative points closed;
-//!    4. **integrate positions** — each body's motion since the step's start (`dp`, `dq`);
+//!    4. **integrate positions** — each body's motion since the step's start (`dp`, `dq`),
+//!       a dynamic body's speed at most [`SoftStepSettings::max_linear_speed`] and every
+//!       body's turn at most [`SoftStepSettings::max_rotation_per_substep`];
 //!    5. **relax** — passes without bias, friction and rolling resistance included (two by default, see
 //!       [`SoftStepSettings::relax_iterations`]);
-//! 3. **restitution** — bounces from the approach speeds at the step's start;
+//! 3. **restitution** — bounces from the approach speeds at the step's start, then the speed
+//!    and spin bounds once more on what the step hands out;
 //! 4. **store impulses** — for the next step's warm start.
 //!
 //! Substeps share one collision detection: the separation of each contact point follows the
@@ -44,6 +49,7 @@
 pub mod batch;
 pub mod body;
 pub mod contact;
+mod integrate;
 pub mod joint;
 pub mod joint_input;
 pub mod joint_rows;
@@ -68,10 +74,15 @@ pub use softness::Softness;
 pub use warm_start::WarmStartCache;
 
 use crate::dynamics::forces::{ForceModel, Spring, SpringEnd};
-use crate::dynamics::free_rotation::FreeBody;
 use crate::settings::{MAX_SUBSTEPS, SettingsError};
-use glam::{Quat, Vec3};
+use glam::Vec3;
+use integrate::{capped, integrate_positions, integrate_velocities};
 use ordered_batches::OrderedBatches;
+
+/// How many times the speed and spin bounds a joint's carried impulses may change a body's
+/// velocity by: a sound joint's impulse reverses at most a body's whole velocity (from `+v` to
+/// `−v`, twice the bound), so anything above that is a fight between joints, not a load.
+const WARM_START_BOUND: f32 = 2.0;
 
 /// Most relax passes per substep a setting may ask for (more is a hang, not accuracy).
 pub const MAX_RELAX_ITERATIONS: u32 = 64;
@@ -103,6 +114,8 @@ pub struct SoftStepSettings {
     /// A contact point takes last step's impulses from the nearest old point within this (m).
     pub warm_start_distance: f32,
     /// Fastest turn per substep (rad): keeps a wildly spinning body's linearised rotation sane.
+    /// It also bounds the spin a dynamic body leaves the step with (`max / h`), and, with the
+    /// speed bound, the impulses a joint carries into a step.
     pub max_rotation_per_substep: f32,
     /// Fastest a body moves (m/s; Box2D v3's `maximumLinearSpeed`, 400 m/s, "faster than the
     /// speed of sound"; Jolt's is 500). Valid but violent input (a joint spawned with its
@@ -254,12 +267,7 @@ impl Solver {
         self.substep = h;
         self.prepare(bodies, contacts, h);
         self.prepare_joints(bodies, joints);
-        for j in &mut self.joints {
-            j.bound_impulses(
-                2.0 * s.max_linear_speed,
-                2.0 * s.max_rotation_per_substep * inv_h,
-            );
-        }
+        self.bound_joint_impulses(inv_h);
         let joint_soft = Softness::new(s.joint_hertz, s.joint_damping_ratio, h);
         self.stabilise_springs(bodies, springs, h);
         let springs = std::mem::take(&mut self.stable_springs);
@@ -296,16 +304,7 @@ impl Solver {
         for c in &mut self.constraints {
             c.restitute(&mut bodies.states, s.restitution_threshold);
         }
-        // The relax passes and the bounces after the last move can still speed a body up: the
-        // step hands out no speed or spin above the bounds either (a spin above
-        // `max_rotation_per_substep / h` could not be followed by the next step anyway).
-        let max_spin = s.max_rotation_per_substep * inv_h;
-        for (state, p) in bodies.states.iter_mut().zip(&bodies.params) {
-            if p.dynamic {
-                state.linear_velocity = capped(state.linear_velocity, s.max_linear_speed);
-                state.angular_velocity = capped(state.angular_velocity, max_spin);
-            }
-        }
+        self.cap_velocities(bodies, inv_h);
         let orientations = &bodies.orientations;
         self.cache
             .store(&self.constraints, |a| orientations[a as usize], h);
@@ -328,6 +327,32 @@ impl Solver {
                 c.impulses = self.joint_cache[i].1;
             }
             self.joints.push(c);
+        }
+    }
+
+    /// Holds the impulses each joint carries into the step to what could change a body's
+    /// velocity by [`WARM_START_BOUND`] times the speed and spin bounds (see
+    /// [`JointConstraint::bound_impulses`]).
+    fn bound_joint_impulses(&mut self, inv_h: f32) {
+        let s = &self.settings;
+        let max_speed = WARM_START_BOUND * s.max_linear_speed;
+        let max_spin = WARM_START_BOUND * s.max_rotation_per_substep * inv_h;
+        for j in &mut self.joints {
+            j.bound_impulses(max_speed, max_spin);
+        }
+    }
+
+    /// The relax passes and the bounces after the last move can still speed a dynamic body
+    /// up: the step hands out no speed or spin above the bounds either (a spin above
+    /// `max_rotation_per_substep / h` could not be followed by the next step anyway).
+    fn cap_velocities(&self, bodies: &mut SolverBodies, inv_h: f32) {
+        let s = &self.settings;
+        let max_spin = s.max_rotation_per_substep * inv_h;
+        for (state, p) in bodies.states.iter_mut().zip(&bodies.params) {
+            if p.dynamic {
+                state.linear_velocity = capped(state.linear_velocity, s.max_linear_speed);
+                state.angular_velocity = capped(state.angular_velocity, max_spin);
+            }
         }
     }
 
@@ -482,108 +507,5 @@ fn push(bodies: &mut SolverBodies, i: usize, impulse: Vec3) {
     let p = &bodies.params[i];
     if p.dynamic {
         bodies.states[i].linear_velocity += impulse * p.inverse_mass;
-    }
-}
-
-/// Gravity, forces and torques for one substep, then damping by the exact decay `e^{−h c}`
-/// (stable for any rate, and free drift decays as `e^{−c t}` whatever the substep; Box2D's
-/// `1/(1 + h c)` is its first-order approximation). Kinematic and static bodies keep their
-/// velocities.
-fn integrate_velocities(bodies: &mut SolverBodies, h: f32) {
-    let decay = |c: f32| if c > 0.0 { (-h * c).exp() } else { 1.0 };
-    for (state, p) in bodies.states.iter_mut().zip(&bodies.params) {
-        if !p.dynamic {
-            continue;
-        }
-        state.linear_velocity =
-            (state.linear_velocity + p.linear_acceleration * h) * decay(p.linear_damping);
-        state.angular_velocity =
-            (state.angular_velocity + p.angular_acceleration * h) * decay(p.angular_damping);
-    }
-}
-
-/// Moves every body by its velocity for one substep: `dp += h v` (a dynamic body's `v` at most
-/// `max_speed`),
-/// and `dq` turned by `h ω` (the linearised quaternion update, renormalised, as Box2D; at most
-/// `max_rotation` per substep). A gyroscopic body turning noticeably instead follows the free rigid body's exact
-/// flow for `h` ([`FreeBody`]: McLachlan's splitting, momentum exact), which also updates `ω`.
-fn integrate_positions(bodies: &mut SolverBodies, h: f32, max_rotation: f32, max_speed: f32) {
-    for (i, state) in bodies.states.iter_mut().enumerate() {
-        if bodies.params[i].dynamic {
-            state.linear_velocity = capped(state.linear_velocity, max_speed);
-        }
-        state.delta_position += state.linear_velocity * h;
-        let mut w = state.angular_velocity;
-        if w == Vec3::ZERO {
-            continue;
-        }
-        let turn = w.length() * h;
-        if turn > max_rotation {
-            w *= max_rotation / turn;
-            state.angular_velocity = w;
-        }
-        let dq = state.delta_rotation;
-        if let Some((frame, inverse_moments)) = bodies.params[i].gyroscopic
-            && turn > GYROSCOPIC_MIN_TURN
-        {
-            let start = bodies.orientations[i];
-            let mut free = FreeBody::new(dq * start, frame, inverse_moments, w);
-            free.drift(f64::from(h));
-            state.delta_rotation = (free.orientation(frame) * start.inverse()).normalize();
-            state.angular_velocity = free.angular_velocity();
-            continue;
-        }
-        let spin = Quat::from_xyzw(w.x, w.y, w.z, 0.0) * dq;
-        state.delta_rotation = (dq + spin * (0.5 * h)).normalize();
-    }
-}
-
-/// `v` shortened to `max` if it is longer (for dynamic bodies only: a kinematic body's speed is
-/// the game's to choose). Its length is taken after scaling by its largest component, so a
-/// vector near `f32::MAX` is shortened, not zeroed by an overflowing length; a non-finite one
-/// is left for the step's guard to quarantine.
-fn capped(v: Vec3, max: f32) -> Vec3 {
-    let largest = v.abs().max_element();
-    // The length is at most √3 times the largest component: most vectors need no root.
-    if largest * 1.732_051 <= max || !v.is_finite() {
-        return v;
-    }
-    let unit = v / largest;
-    if largest * unit.length() > max {
-        unit * (max / unit.length())
-    } else {
-        v
-    }
-}
-
-/// Below this turn per substep (rad) the gyroscopic term changes `ω` by less than `turn²` of
-/// itself per substep, far below the contacts' own error: the linearised update is used.
-const GYROSCOPIC_MIN_TURN: f32 = 1e-4;
-
-#[cfg(test)]
-mod capped_tests {
-    use super::capped;
-    use glam::Vec3;
-
-    #[test]
-    fn capped_shortens_to_the_bound_within_1e_6_keeps_shorter_and_non_finite_vectors() {
-        for v in [
-            Vec3::new(283.0, 293.0, -6.0),
-            Vec3::new(f32::MAX, -f32::MAX, f32::MAX),
-            Vec3::new(1e30, 0.0, 0.0),
-        ] {
-            let c = capped(v, 400.0);
-            assert!((c.length() / 400.0 - 1.0).abs() < 1e-6, "{v} -> {c}");
-            assert!(
-                c.normalize()
-                    .dot(v / v.abs().max_element())
-                    .is_sign_positive()
-            );
-        }
-        for v in [Vec3::new(230.0, 230.0, 230.0), Vec3::ZERO, Vec3::X * 400.0] {
-            assert_eq!(capped(v, 400.0), v);
-        }
-        assert!(capped(Vec3::new(f32::NAN, 1.0, 0.0), 400.0).x.is_nan());
-        assert!(capped(Vec3::INFINITY, 400.0).x.is_infinite());
     }
 }

@@ -138,3 +138,22 @@ fn a_ball_welded_to_two_posts_it_cannot_reach_at_once_stays_finite_and_under_400
         );
     }
 }
+
+#[test]
+fn a_nan_carried_impulse_is_dropped_and_a_huge_one_scaled_until_the_spin_is_at_its_bound() {
+    // A 1 kg ball of radius 0.1 (I = 0.004 kg m²) hung 1 m below a pivot.
+    let mut scene = Scene::default();
+    let bob = bob_below_pivot(&mut scene, Vec3::Z, BALL);
+    scene.step();
+    let mut joint = JointConstraint::prepare(&scene.joints[0], &scene.arrays);
+    joint.impulses.point = Vec3::new(f32::NAN, 0.0, 0.0);
+    joint.bound_impulses(800.0, 100.0);
+    assert_eq!(joint.impulses, JointImpulses::default());
+    // 1e6 N s at the anchor, 1 m from the centre: the spin bound binds first (100 rad/s needs
+    // only 100 · 0.004 / 1 = 0.4 N s), far before the speed bound (800 N s).
+    joint.impulses.point = Vec3::X * 1e6;
+    joint.bound_impulses(800.0, 100.0);
+    let j = joint.impulses.point.length();
+    assert!((j / 0.4 - 1.0).abs() < 1e-3, "{j} N s");
+    assert!(scene.bodies[bob].center.is_finite());
+}

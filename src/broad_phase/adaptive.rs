@@ -1,0 +1,317 @@
+//! Sweep and prune that falls back to sorting from scratch when insertion sort is losing
+//! (issue 12's adaptive sorting, at the level of the whole structure).
+//!
+//! The incremental SAP ([`IncrementalSap`]) costs `O(n + swaps)` a step, the sort and sweep
+//! from scratch ([`SortAndSweep`], on the axis where the centres spread most) `O(n log n +
+//! overlaps on that axis)` whatever the motion. Measured on the 10k cloud (`src/broad_phase/
+//! sap.rs`' table), one endpoint swap costs about a tenth of what one `n log₂ n` unit of the
+//! rebuild costs, so insertion sort loses once a step makes more than about ten swaps per `n
+//! log₂ n`: bodies moving far relative to their spacing, or bodies strung along one axis, whose
+//! intervals on the other two all overlap (a row of 10k boxes made 16M swaps a step).
+//!
+//! The rule: after each commit of the incremental SAP, a step with more than
+//! [`AdaptiveSweep::SWAPS_PER_SORT_UNIT`]` · n log₂ n` swaps is a strike; two strikes in a row
+//! move every body into a sort and sweep. Every [`AdaptiveSweep::PROBE_PERIOD`] commits the
+//! bodies go back to the SAP to see whether the motion has calmed (if not, two commits later
+//! they return). A switch costs one bulk insertion; it changes no pair, and the commit that
+//! switches reports the changes the old structure found.
+
+use super::{
+    BodyKind, BroadPhase, BroadPhaseError, IncrementalSap, Pair, ProxyId, SortAndSweep, StepStats,
+};
+use crate::bounding::Aabb;
+use std::mem::size_of;
+
+/// The structure in use.
+#[derive(Debug)]
+enum Engine {
+    Incremental(Box<IncrementalSap>),
+    FromScratch(Box<SortAndSweep>),
+}
+
+impl Engine {
+    fn get(&self) -> &dyn BroadPhase {
+        match self {
+            Self::Incremental(sap) => sap.as_ref(),
+            Self::FromScratch(sweep) => sweep.as_ref(),
+        }
+    }
+
+    fn get_mut(&mut self) -> &mut dyn BroadPhase {
+        match self {
+            Self::Incremental(sap) => sap.as_mut(),
+            Self::FromScratch(sweep) => sweep.as_mut(),
+        }
+    }
+}
+
+/// An incremental sweep and prune that switches to sorting from scratch while insertion sort
+/// loses (see the module doc).
+#[derive(Debug)]
+pub struct AdaptiveSweep {
+    engine: Engine,
+    /// Per id: its kind while present (a switch moves every present body).
+    kinds: Vec<Option<BodyKind>>,
+    /// Consecutive losing commits of the incremental SAP.
+    strikes: u32,
+    /// Commits since the last switch.
+    since_switch: u32,
+    /// Switches to sorting from scratch so far.
+    fallbacks: u64,
+    /// The changes of a commit that switched (the old structure's), reported until the next
+    /// commit.
+    switched: Option<(Vec<Pair>, Vec<Pair>)>,
+    /// Buffers for a switch.
+    moving: Vec<(ProxyId, Aabb, BodyKind)>,
+}
+
+impl Default for AdaptiveSweep {
+    fn default() -> Self {
+        Self {
+            engine: Engine::Incremental(Box::default()),
+            kinds: Vec::new(),
+            strikes: 0,
+            since_switch: 0,
+            fallbacks: 0,
+            switched: None,
+            moving: Vec::new(),
+        }
+    }
+}
+
+impl AdaptiveSweep {
+    /// Swaps per `n log₂ n` above which a commit counts as a strike against insertion sort.
+    pub const SWAPS_PER_SORT_UNIT: f64 = 10.0;
+    /// Losing commits in a row that trigger the fallback.
+    pub const STRIKES: u32 = 2;
+    /// Commits after which sorting from scratch hands the bodies back to the SAP to try again.
+    pub const PROBE_PERIOD: u32 = 120;
+
+    /// An empty broad phase (it starts incremental).
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Whether the bodies are in the sort and sweep from scratch now.
+    pub fn is_sorting_from_scratch(&self) -> bool {
+        matches!(self.engine, Engine::FromScratch(_))
+    }
+
+    /// How many times insertion sort was found losing and the bodies moved to the sort from
+    /// scratch.
+    pub fn fallbacks(&self) -> u64 {
+        self.fallbacks
+    }
+
+    /// The switch the last commit's work calls for, if any.
+    fn next_engine(&mut self) -> Option<Engine> {
+        self.since_switch += 1;
+        match &self.engine {
+            Engine::Incremental(sap) => {
+                let n = sap.len().max(2) as f64;
+                let budget = Self::SWAPS_PER_SORT_UNIT * n * n.log2();
+                let losing = sap.stats().endpoint_swaps as f64 > budget;
+                self.strikes = if losing { self.strikes + 1 } else { 0 };
+                (self.strikes >= Self::STRIKES).then(|| Engine::FromScratch(Box::default()))
+            }
+            Engine::FromScratch(_) => (self.since_switch >= Self::PROBE_PERIOD)
+                .then(|| Engine::Incremental(Box::default())),
+        }
+    }
+
+    /// Moves every body into `next`, keeping this commit's changes to report.
+    fn switch_to(&mut self, mut next: Engine) {
+        let old = self.engine.get();
+        self.moving.clear();
+        for (id, kind) in self.kinds.iter().enumerate() {
+            if let (Some(kind), Some(aabb)) = (kind, old.aabb(id as ProxyId)) {
+                self.moving.push((id as ProxyId, aabb, *kind));
+            }
+        }
+        let changes = (old.added().to_vec(), old.removed().to_vec());
+        let new = next.get_mut();
+        // The boxes were accepted once: a bulk insertion of them cannot fail.
+        if new.insert_bulk(&self.moving).is_ok() {
+            new.commit();
+            if matches!(next, Engine::FromScratch(_)) {
+                self.fallbacks += 1;
+            }
+            self.engine = next;
+            self.switched = Some(changes);
+        }
+        self.strikes = 0;
+        self.since_switch = 0;
+    }
+}
+
+impl BroadPhase for AdaptiveSweep {
+    fn insert(&mut self, id: ProxyId, aabb: Aabb, kind: BodyKind) -> Result<(), BroadPhaseError> {
+        self.engine.get_mut().insert(id, aabb, kind)?;
+        let slot = id as usize;
+        if self.kinds.len() <= slot {
+            self.kinds.resize(slot + 1, None);
+        }
+        self.kinds[slot] = Some(kind);
+        Ok(())
+    }
+
+    fn insert_bulk(&mut self, bodies: &[(ProxyId, Aabb, BodyKind)]) -> Result<(), BroadPhaseError> {
+        self.engine.get_mut().insert_bulk(bodies)?;
+        let top = bodies.iter().map(|b| b.0 as usize + 1).max().unwrap_or(0);
+        if self.kinds.len() < top {
+            self.kinds.resize(top, None);
+        }
+        for &(id, _, kind) in bodies {
+            self.kinds[id as usize] = Some(kind);
+        }
+        Ok(())
+    }
+
+    fn update(&mut self, id: ProxyId, aabb: Aabb) -> Result<(), BroadPhaseError> {
+        self.engine.get_mut().update(id, aabb)
+    }
+
+    fn remove(&mut self, id: ProxyId) -> Result<(), BroadPhaseError> {
+        self.engine.get_mut().remove(id)?;
+        if let Some(kind) = self.kinds.get_mut(id as usize) {
+            *kind = None;
+        }
+        Ok(())
+    }
+
+    fn commit(&mut self) {
+        self.switched = None;
+        self.engine.get_mut().commit();
+        if let Some(next) = self.next_engine() {
+            self.switch_to(next);
+        }
+    }
+
+    fn pairs(&self) -> &[Pair] {
+        self.engine.get().pairs()
+    }
+
+    fn added(&self) -> &[Pair] {
+        match &self.switched {
+            Some((added, _)) => added,
+            None => self.engine.get().added(),
+        }
+    }
+
+    fn removed(&self) -> &[Pair] {
+        match &self.switched {
+            Some((_, removed)) => removed,
+            None => self.engine.get().removed(),
+        }
+    }
+
+    fn stats(&self) -> StepStats {
+        self.engine.get().stats()
+    }
+
+    fn memory_bytes(&self) -> usize {
+        self.engine.get().memory_bytes()
+            + self.kinds.capacity() * size_of::<Option<BodyKind>>()
+            + self.moving.capacity() * size_of::<(ProxyId, Aabb, BodyKind)>()
+    }
+
+    fn len(&self) -> usize {
+        self.engine.get().len()
+    }
+
+    fn contains(&self, id: ProxyId) -> bool {
+        self.engine.get().contains(id)
+    }
+
+    fn aabb(&self, id: ProxyId) -> Option<Aabb> {
+        self.engine.get().aabb(id)
+    }
+}
+
+/// The pairs of `a` and `b` as sorted sets are equal (a test helper: the structures list
+/// pairs in different orders).
+#[cfg(test)]
+fn same_pairs(a: &[Pair], b: &[Pair]) -> bool {
+    use super::pair_diff::diff_sorted;
+    let (mut a, mut b) = (a.to_vec(), b.to_vec());
+    a.sort_unstable();
+    b.sort_unstable();
+    let (mut added, mut removed) = (Vec::new(), Vec::new());
+    diff_sorted(&a, &b, &mut added, &mut removed);
+    added.is_empty() && removed.is_empty()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::broad_phase::BruteForce;
+    use glam::Vec3;
+
+    /// Box `i` of a row along x (each overlapping its neighbours), jittering with `step`.
+    fn row_box(i: u32, step: u32) -> Aabb {
+        let wobble = ((i * 7 + step * 13) % 17) as f32 * 0.004;
+        let c = Vec3::new(i as f32 * 0.9, wobble, 0.05 - wobble);
+        Aabb::from_center_half_extents(c, Vec3::splat(0.5))
+    }
+
+    #[test]
+    fn a_jittering_row_of_2000_falls_back_and_keeps_the_brute_force_pairs_and_changes() {
+        let mut adaptive = AdaptiveSweep::new();
+        let mut brute = BruteForce::new();
+        let bodies: Vec<_> = (0..2000)
+            .map(|i| (i, row_box(i, 0), BodyKind::Dynamic))
+            .collect();
+        adaptive.insert_bulk(&bodies).unwrap();
+        brute.insert_bulk(&bodies).unwrap();
+        let mut was_from_scratch = false;
+        for step in 1..=(AdaptiveSweep::PROBE_PERIOD + 10) {
+            // Body 5 leaves every seventh step and comes back the next, so the changes are
+            // never all empty.
+            let (leaves, returns) = (step % 7 == 0, step % 7 == 1 && step > 1);
+            for i in (0..2000).filter(|&i| i != 5 || !(leaves || returns)) {
+                adaptive.update(i, row_box(i, step)).unwrap();
+                brute.update(i, row_box(i, step)).unwrap();
+            }
+            if leaves {
+                adaptive.remove(5).unwrap();
+                brute.remove(5).unwrap();
+            } else if returns {
+                adaptive
+                    .insert(5, row_box(5, step), BodyKind::Dynamic)
+                    .unwrap();
+                brute
+                    .insert(5, row_box(5, step), BodyKind::Dynamic)
+                    .unwrap();
+            }
+            adaptive.commit();
+            brute.commit();
+            assert!(same_pairs(adaptive.pairs(), brute.pairs()), "step {step}");
+            assert_eq!(adaptive.added(), brute.added(), "step {step}");
+            assert_eq!(adaptive.removed(), brute.removed(), "step {step}");
+            was_from_scratch |= adaptive.is_sorting_from_scratch();
+        }
+        assert!(was_from_scratch && adaptive.fallbacks() >= 1);
+    }
+
+    #[test]
+    fn a_calm_cloud_stays_incremental() {
+        let mut adaptive = AdaptiveSweep::new();
+        let at = |i: u32, step: u32| {
+            let c = Vec3::new((i % 30) as f32, (i / 30 % 30) as f32, (i / 900) as f32) * 1.2;
+            let c = c + Vec3::X * 0.001 * ((i + step) % 5) as f32;
+            Aabb::from_center_half_extents(c, Vec3::splat(0.5))
+        };
+        let bodies: Vec<_> = (0..2700)
+            .map(|i| (i, at(i, 0), BodyKind::Dynamic))
+            .collect();
+        adaptive.insert_bulk(&bodies).unwrap();
+        for step in 1..60 {
+            for i in 0..2700 {
+                adaptive.update(i, at(i, step)).unwrap();
+            }
+            adaptive.commit();
+        }
+        assert_eq!(adaptive.fallbacks(), 0);
+        assert!(!adaptive.is_sorting_from_scratch());
+    }
+}
