@@ -10,8 +10,8 @@ use proptest::prelude::*;
 use std::collections::{BTreeMap, BTreeSet};
 use urto::bounding::Aabb;
 use urto::broad_phase::{
-    AxisBits, AxisTests, BodyKind, BroadPhase, BroadPhaseError, BruteForce, IncrementalSap,
-    MAX_PROXY_ID, Pair, ProxyId, SortAndSweep,
+    AdaptiveSweep, AxisBits, AxisTests, BodyKind, BroadPhase, BroadPhaseError, BruteForce,
+    IncrementalSap, MAX_PROXY_ID, Pair, ProxyId, SortAndSweep,
 };
 
 // ---------------------------------------------------------------- the subjects
@@ -24,6 +24,8 @@ struct Subjects {
     tests: [IncrementalSap<AxisTests>; 3],
     /// Default, always whole-array insertion sort.
     bits: [IncrementalSap<AxisBits>; 2],
+    /// The SAP that falls back to sorting from scratch.
+    adaptive: AdaptiveSweep,
 }
 
 impl Subjects {
@@ -40,6 +42,7 @@ impl Subjects {
                 IncrementalSap::new(),
                 IncrementalSap::new().with_full_sort_fraction(0.0),
             ],
+            adaptive: AdaptiveSweep::new(),
         }
     }
 
@@ -54,6 +57,7 @@ impl Subjects {
             ("sap-tests-per-body", t2),
             ("sap-bits", b0),
             ("sap-bits-full-sort", b1),
+            ("adaptive", &mut self.adaptive),
         ]
     }
 

@@ -1,5 +1,7 @@
-//! Broad-phase peer benchmark (issue 12): urto's incremental sweep and prune against parry3d's
-//! `Bvh` (the tree rapier3d's broad phase is built on) on the same scenes, in one process.
+//! Broad-phase peer benchmark (issue 12): urto's incremental sweep and prune, and its adaptive
+//! variant (which falls back to sorting from scratch while insertion sort loses), against
+//! parry3d's `Bvh` (the tree rapier3d's broad phase is built on) on the same scenes, in one
+//! process.
 //!
 //! Scenes of unit boxes (about two overlaps each unless said): a cloud of 1k, 10k and 100k
 //! boxes all moving 0.05 m a step in random directions (bouncing inside the cloud's cube); 100k
@@ -26,7 +28,7 @@ use rapier3d::parry::bounding_volume::Aabb as ParryAabb;
 use rapier3d::parry::partitioning::{Bvh, BvhBuildStrategy, BvhWorkspace};
 use std::time::{Duration, Instant};
 use urto::bounding::Aabb;
-use urto::broad_phase::{BodyKind, BroadPhase, IncrementalSap};
+use urto::broad_phase::{AdaptiveSweep, BodyKind, BroadPhase, IncrementalSap};
 
 const WARM_UP: usize = 5;
 const STEPS: usize = 30;
@@ -214,22 +216,23 @@ impl ParryBroadPhase {
     }
 }
 
-fn urto_sap(scene: &Scene) -> IncrementalSap {
-    let mut sap = IncrementalSap::new();
+/// An urto broad phase holding the scene's boxes.
+fn urto_filled<B: BroadPhase + Default>(scene: &Scene) -> B {
+    let mut bp = B::default();
     let bodies: Vec<_> = (0..scene.centers.len())
         .map(|i| (i as u32, scene.aabb(i), BodyKind::Dynamic))
         .collect();
-    sap.insert_bulk(&bodies).expect("finite boxes");
-    sap.commit();
-    sap
+    bp.insert_bulk(&bodies).expect("finite boxes");
+    bp.commit();
+    bp
 }
 
-fn urto_step(sap: &mut IncrementalSap, scene: &Scene) -> usize {
+fn urto_step(bp: &mut impl BroadPhase, scene: &Scene) -> usize {
     for &i in &scene.moving {
-        sap.update(i, scene.aabb(i as usize)).expect("a known box");
+        bp.update(i, scene.aabb(i as usize)).expect("a known box");
     }
-    sap.commit();
-    sap.pairs().len()
+    bp.commit();
+    bp.pairs().len()
 }
 
 fn median(mut times: Vec<Duration>) -> Duration {
@@ -241,44 +244,63 @@ fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3
 }
 
-/// Steps both engines on `scene`, interleaved, and prints its table row.
+/// `a` against `b` as "urto … faster/slower".
+fn ratio(urto: Duration, peer: Duration) -> String {
+    if urto <= peer {
+        format!("{:.2}× faster", ms(peer) / ms(urto))
+    } else {
+        format!("**{:.2}× slower**", ms(urto) / ms(peer))
+    }
+}
+
+/// Steps the three broad phases on `scene`, interleaved, and prints its table row.
 fn run(mut scene: Scene) {
-    let mut sap = urto_sap(&scene);
+    let mut sap: IncrementalSap = urto_filled(&scene);
+    let mut adaptive: AdaptiveSweep = urto_filled(&scene);
     let mut parry = ParryBroadPhase::new(&scene);
-    let (mut urto_times, mut parry_times) = (Vec::new(), Vec::new());
-    let mut urto_pairs = 0;
+    let mut times = [Vec::new(), Vec::new(), Vec::new()];
+    let (mut sap_pairs, mut adaptive_pairs) = (0, 0);
     for step in 0..WARM_UP + STEPS {
         scene.advance();
         let start = Instant::now();
-        urto_pairs = urto_step(&mut sap, &scene);
-        let urto_time = start.elapsed();
+        sap_pairs = urto_step(&mut sap, &scene);
+        let t0 = start.elapsed();
+        let start = Instant::now();
+        adaptive_pairs = urto_step(&mut adaptive, &scene);
+        let t1 = start.elapsed();
         let start = Instant::now();
         parry.step(&scene);
-        let parry_time = start.elapsed();
+        let t2 = start.elapsed();
         if step >= WARM_UP {
-            urto_times.push(urto_time);
-            parry_times.push(parry_time);
+            for (list, t) in times.iter_mut().zip([t0, t1, t2]) {
+                list.push(t);
+            }
         }
     }
-    let (u, p) = (median(urto_times), median(parry_times));
-    let ratio = if u <= p {
-        format!("urto {:.2}× faster", ms(p) / ms(u))
-    } else {
-        format!("**urto {:.2}× slower**", ms(u) / ms(p))
-    };
+    let [s, a, p] = times.map(median);
     println!(
-        "| {} | {:.3} ms | {:.3} ms | {ratio} | {urto_pairs} / {} |",
+        "| {} | {:.3} ms | {:.3} ms ({}) | {:.3} ms | SAP {}, adaptive {} | {sap_pairs} / {adaptive_pairs} / {} |",
         scene.name,
-        ms(u),
+        ms(s),
+        ms(a),
+        if adaptive.is_sorting_from_scratch() {
+            "sorting from scratch"
+        } else {
+            "incremental"
+        },
         ms(p),
+        ratio(s, p),
+        ratio(a, p),
         parry.pairs.len()
     );
 }
 
 fn main() {
     let quick = std::env::var("PEERS_BROAD_PHASE_QUICK").is_ok();
-    println!("| scene | urto SAP | parry3d Bvh | ratio | pairs (urto / parry) |");
-    println!("| --- | ---: | ---: | --- | ---: |");
+    println!(
+        "| scene | urto SAP | urto adaptive (mode at the end) | parry3d Bvh | urto vs parry | pairs (SAP / adaptive / parry) |"
+    );
+    println!("| --- | ---: | ---: | ---: | --- | ---: |");
     run(Scene::cloud(1_000, 1.0, 1));
     run(Scene::cloud(10_000, 1.0, 2));
     if !quick {

@@ -51,6 +51,7 @@ impl BroadPhase for BruteForce {
         }
         let n = ids.len() as u64;
         self.stats = StepStats {
+            rebuilt: true,
             endpoint_swaps: 0,
             pair_tests: n * n.saturating_sub(1) / 2,
         };

@@ -149,6 +149,9 @@ pub struct StepStats {
     /// that flip an axis overlap (each a cross-axis test, or a table update with
     /// [`AxisBits`]) plus the candidate pairs of the sweep after an insertion.
     pub pair_tests: u64,
+    /// The pairs were found again from scratch (the rebuilders; [`AdaptiveSweep`] while it
+    /// has fallen back to sorting), not kept up incrementally.
+    pub rebuilt: bool,
 }
 
 /// The common interface of every broad phase.

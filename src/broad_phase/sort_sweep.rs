@@ -155,6 +155,7 @@ impl BroadPhase for SortAndSweep {
         let tests = sweep(&self.arrays, self.history.begin());
         self.history.finish();
         self.stats = StepStats {
+            rebuilt: true,
             endpoint_swaps: 0,
             pair_tests: tests,
         };

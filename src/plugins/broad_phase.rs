@@ -19,7 +19,7 @@
 
 use crate::bounding::Aabb;
 use crate::broad_phase::{
-    AxisTests, BodyKind, BroadPhase, IncrementalSap, ProxyId, StaticGrid, StaticGridConfig,
+    AdaptiveSweep, BodyKind, BroadPhase, ProxyId, StaticGrid, StaticGridConfig,
 };
 use crate::components::*;
 use crate::plugins::core::PrepareIndex;
@@ -40,7 +40,8 @@ pub type BroadPhaseFactory = fn() -> Box<dyn BroadPhase + Send + Sync>;
 /// Keeps bounding volumes and the broad-phase structures fresh and finds candidate pairs.
 #[derive(Debug, Clone)]
 pub struct BroadPhasePlugin {
-    /// The moving-body algorithm (default: incremental sweep and prune).
+    /// The moving-body algorithm (default: incremental sweep and prune that falls back to
+    /// sorting from scratch while insertion sort loses, [`AdaptiveSweep`]).
     pub moving: BroadPhaseFactory,
     /// The static grid's settings (default: cell size chosen from the statics' sizes).
     pub grid: StaticGridConfig,
@@ -49,7 +50,7 @@ pub struct BroadPhasePlugin {
 impl Default for BroadPhasePlugin {
     fn default() -> Self {
         Self {
-            moving: || Box::new(IncrementalSap::<AxisTests>::new()),
+            moving: || Box::new(AdaptiveSweep::new()),
             grid: StaticGridConfig::default(),
         }
     }
@@ -228,6 +229,10 @@ fn sync_broad_phase(
     index.proxies.end_step();
     let steps = index.moving.stats();
     stats.set_counter("broad_phase/sap_swaps", steps.endpoint_swaps as f64);
+    stats.set_counter(
+        "broad_phase/rebuilt_from_scratch",
+        f64::from(u8::from(steps.rebuilt)),
+    );
     stats.set_counter("broad_phase/moving_bodies", index.moving.len() as f64);
     stats.set_counter("broad_phase/static_bodies", index.grid.len() as f64);
     stats.add_time(Stage::BroadPhase, start.elapsed());
