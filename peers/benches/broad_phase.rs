@@ -23,7 +23,6 @@
 //! 100k scenes.
 
 use glam::Vec3;
-use rapier3d::math::Vector;
 use rapier3d::parry::bounding_volume::Aabb as ParryAabb;
 use rapier3d::parry::partitioning::{Bvh, BvhBuildStrategy, BvhWorkspace};
 use std::time::{Duration, Instant};
@@ -35,6 +34,11 @@ const STEPS: usize = 30;
 
 /// The tests' seeded generator (SplitMix64): the same boxes and motion for both engines, every
 /// run.
+#[allow(dead_code)]
+#[path = "common/rapier_world.rs"]
+mod rapier_world;
+use rapier_world::rv;
+
 #[allow(dead_code)]
 #[path = "../../tests/common/rng.rs"]
 mod rng;
@@ -177,7 +181,7 @@ impl Scene {
     fn parry_aabb(&self, i: usize) -> ParryAabb {
         let (c, h) = (self.centers[i], self.halves[i]);
         let (lo, hi) = (c - h, c + h);
-        ParryAabb::new(Vector::new(lo.x, lo.y, lo.z), Vector::new(hi.x, hi.y, hi.z))
+        ParryAabb::new(rv(lo), rv(hi))
     }
 }
 

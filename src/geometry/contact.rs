@@ -92,10 +92,25 @@ impl ContactManifold {
     /// points moved, depths kept).
     #[must_use]
     pub fn transformed(&self, pose: &Isometry) -> Self {
-        let mut out = Self::new(pose.transform_vector(self.normal));
+        self.mapped(|n| pose.transform_vector(n), |p| pose.transform_point(p))
+    }
+
+    /// The manifold of the frame `pose` places in world carried back into that frame (the
+    /// inverse of [`transformed`](Self::transformed)).
+    #[must_use]
+    pub fn to_local(&self, pose: &Isometry) -> Self {
+        self.mapped(
+            |n| pose.inverse_transform_vector(n),
+            |p| pose.inverse_transform_point(p),
+        )
+    }
+
+    /// The normal and the points mapped, depths kept.
+    fn mapped(&self, normal: impl Fn(Vec3) -> Vec3, point: impl Fn(Vec3) -> Vec3) -> Self {
+        let mut out = Self::new(normal(self.normal));
         for p in self.points() {
             out.push(ContactPoint {
-                point: pose.transform_point(p.point),
+                point: point(p.point),
                 depth: p.depth,
             });
         }

@@ -96,16 +96,7 @@ impl ManifoldCache {
         manifold: Option<&ContactManifold>,
         hits: &[[u32; 2]],
     ) {
-        let to_local = |m: &ContactManifold| {
-            let mut local = ContactManifold::new(pose_a.inverse_transform_vector(m.normal));
-            for p in m.points() {
-                local.push(ContactPoint {
-                    point: pose_a.inverse_transform_point(p.point),
-                    depth: p.depth,
-                });
-            }
-            local
-        };
+        let to_local = |m: &ContactManifold| m.to_local(pose_a);
         let entry = Entry {
             b_in_a: pose_a.inv_mul(pose_b),
             manifold: manifold.map(to_local),
