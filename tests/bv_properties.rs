@@ -13,7 +13,9 @@ mod common;
 use common::rng::Rng;
 use glam::Vec3;
 use proptest::prelude::*;
-use urto::bounding::{Aabb, BoundingSphere, Bv, Kdop14, Kdop18, Kdop26, Obb};
+use urto::bounding::{
+    Aabb, BoundingSphere, Bv, Kdop14, Kdop18, Kdop26, Obb, SurfaceMoments, TriangleSet,
+};
 use urto::geometry::Isometry;
 
 /// A point set of one of several shapes, from a seed.
@@ -47,9 +49,12 @@ fn check_containment<B: Bv>(a: &[Vec3], b: &[Vec3]) -> Result<(), TestCaseError>
     for p in a {
         prop_assert!(bv.contains_point(*p, 0.0), "{bv:?} misses {p}");
     }
-    let tris = triangles_of(a);
-    let all: Vec<u32> = (0..tris.len() as u32).collect();
-    let from_tris = B::fit_triangles(a, &tris, &all);
+    let corners: Vec<[Vec3; 3]> = triangles_of(a)
+        .iter()
+        .map(|t| t.map(|i| a[i as usize]))
+        .collect();
+    let surface = SurfaceMoments::of_triangles(&corners);
+    let from_tris = B::fit_triangles(&TriangleSet::new(&corners, &surface));
     for p in a {
         prop_assert!(
             from_tris.contains_point(*p, 0.0),

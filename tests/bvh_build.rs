@@ -121,6 +121,42 @@ fn procedural_and_scanned_meshes_build_valid_trees() {
     check_all_kinds(&ply("ant.ply"));
 }
 
+/// The build splits and fits large meshes on several threads; the tree must not depend on how
+/// many (12,800 triangles, past the size below which it stays on one thread; a soup of random
+/// triangles, and the same torus scaled to 1e-3 and moved 1e4 away, where the summed moments'
+/// cancellation is worst).
+#[test]
+fn any_thread_count_builds_the_same_tree_bit_for_bit() {
+    let mut rng = Rng::new(5);
+    let big_torus = torus(2.0, 0.5, 160, 40);
+    let far_small = Mesh {
+        vertices: big_torus
+            .vertices
+            .iter()
+            .map(|v| *v * 1e-3 + Vec3::new(1e4, -1e4, 5e3))
+            .collect(),
+        triangles: big_torus.triangles.clone(),
+    };
+    let meshes = [big_torus, far_small, soup(9000, 10.0, 0.3, &mut rng)];
+    for mesh in &meshes {
+        assert!(mesh.triangles.len() > 8192);
+        for rule in [BuildRule::Median, BuildRule::BinnedSah] {
+            let with = |threads| BuildOptions {
+                threads,
+                ..BuildOptions::with_rule(rule)
+            };
+            let one = Bvh::<Obb>::build(&mesh.vertices, &mesh.triangles, &with(1)).unwrap();
+            check_structure(&one, mesh, 4);
+            for threads in [0, 2, 3, 8] {
+                let many = Bvh::<Obb>::build(&mesh.vertices, &mesh.triangles, &with(threads));
+                assert!(many.unwrap() == one, "{threads} threads, {rule:?}");
+            }
+            let aabb = Bvh::<Aabb>::build(&mesh.vertices, &mesh.triangles, &with(4)).unwrap();
+            check_structure(&aabb, mesh, 4);
+        }
+    }
+}
+
 #[test]
 fn degenerate_meshes_build_valid_trees() {
     let p = Vec3::new(3.0, -1.0, 2.0);

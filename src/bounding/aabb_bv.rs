@@ -8,7 +8,7 @@
 //! three-interval comparison.
 
 use super::box_sat::face_axes;
-use super::{Aabb, Bv, RelativePose, overlap_ratio, rounding_pad};
+use super::{Aabb, Bv, RelativePose, TriangleSet, overlap_ratio, rounding_pad};
 use crate::geometry::Isometry;
 use glam::{Vec3, Vec3A};
 
@@ -72,6 +72,16 @@ impl Bv for Aabb {
             b.padded()
         } else {
             Aabb::new(Vec3::ZERO, Vec3::ZERO)
+        }
+    }
+
+    /// The box of the corners is already in the summed moments.
+    fn fit_triangles(set: &TriangleSet) -> Self {
+        let b = set.surface().bounds();
+        if b.is_valid() {
+            b.padded()
+        } else {
+            Self::fit_points(set.points())
         }
     }
 

@@ -2,22 +2,18 @@
 //! (Gottschalk, Lin and Manocha 1996, "OBBTree", §3).
 //!
 //! The point covariance depends on how densely the mesh is sampled: a cluster of small triangles
-//! pulls the axes towards itself. The paper's remedy, used by [`triangles_covariance`], integrates
+//! pulls the axes towards itself. The paper's remedy integrates
 //! over the *surface*: each triangle weighs by its area, with its exact second moment
-//! `A/12 · (9 m mᵀ + p pᵀ + q qᵀ + r rᵀ)` (m its centroid, p, q, r its corners).
+//! `A/12 · (9 m mᵀ + p pᵀ + q qᵀ + r rᵀ)` (m its centroid, p, q, r its corners); those sums are
+//! [`SurfaceMoments`](super::SurfaceMoments), summed once per hierarchy, and this file keeps the
+//! point covariance, the fallback for surfaces without area.
 //!
 //! Sums run in f64 about a reference point near the data, so large coordinates (a mesh far from
 //! its origin) do not cancel away the spread.
 
 use glam::{DMat3, DVec3, Vec3};
 
-/// Total area below which a surface counts as degenerate (relative to its squared extent); the
-/// corners' point covariance is used instead.
-const DEGENERATE_AREA: f64 = 1e-12;
-
-fn outer(a: DVec3, b: DVec3) -> DMat3 {
-    DMat3::from_cols(a * b.x, a * b.y, a * b.z)
-}
+use super::surface::outer;
 
 /// Covariance matrix of the points (zero for fewer than two distinct points).
 pub(crate) fn points_covariance<I: Iterator<Item = Vec3> + Clone>(points: I) -> DMat3 {
@@ -33,45 +29,11 @@ pub(crate) fn points_covariance<I: Iterator<Item = Vec3> + Clone>(points: I) -> 
     sum_sq * (1.0 / n) - outer(mean, mean)
 }
 
-/// Area-weighted covariance of the triangles' surface, or `None` when their total area is
-/// negligible (the caller then falls back to [`points_covariance`]).
-pub(crate) fn triangles_covariance<I>(triangles: I) -> Option<DMat3>
-where
-    I: Iterator<Item = [Vec3; 3]> + Clone,
-{
-    let reference = triangles.clone().next()?[0].as_dvec3();
-    let mut area_sum = 0.0;
-    let mut first_moment = DVec3::ZERO;
-    let mut second_moment = DMat3::ZERO;
-    let mut extent_sq: f64 = 0.0;
-    for [p, q, r] in triangles {
-        let (p, q, r) = (
-            p.as_dvec3() - reference,
-            q.as_dvec3() - reference,
-            r.as_dvec3() - reference,
-        );
-        extent_sq = extent_sq.max(
-            p.length_squared()
-                .max(q.length_squared())
-                .max(r.length_squared()),
-        );
-        let area = 0.5 * (q - p).cross(r - p).length();
-        let m = (p + q + r) / 3.0;
-        area_sum += area;
-        first_moment += m * area;
-        second_moment +=
-            (outer(m, m) * 9.0 + outer(p, p) + outer(q, q) + outer(r, r)) * (area / 12.0);
-    }
-    if area_sum.is_nan() || area_sum <= DEGENERATE_AREA * extent_sq {
-        return None;
-    }
-    let mean = first_moment / area_sum;
-    Some(second_moment * (1.0 / area_sum) - outer(mean, mean))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bounding::SurfaceMoments;
+    use glam::DVec3;
 
     /// A unit square in the xy plane split into two triangles, and the same square far from the
     /// origin: the surface covariance of a uniform unit square is diag(1/12, 1/12, 0).
@@ -86,7 +48,7 @@ mod tests {
             ]
             .map(|v| v + offset);
             let tris = [[a, b, c], [a, c, d]];
-            let cov = triangles_covariance(tris.iter().copied()).unwrap();
+            let cov = SurfaceMoments::of_triangles(&tris).covariance().unwrap();
             let expected = DMat3::from_diagonal(DVec3::new(1.0 / 12.0, 1.0 / 12.0, 0.0));
             assert!(
                 (cov - expected)
@@ -102,8 +64,12 @@ mod tests {
     #[test]
     fn degenerate_surfaces_are_refused_and_points_still_work() {
         let p = Vec3::new(1.0, 2.0, 3.0);
-        assert!(triangles_covariance([[p, p, p]].into_iter()).is_none());
-        assert!(triangles_covariance(std::iter::empty()).is_none());
+        assert!(
+            SurfaceMoments::of_triangles(&[[p, p, p]])
+                .covariance()
+                .is_none()
+        );
+        assert!(SurfaceMoments::of_triangles(&[]).covariance().is_none());
         assert_eq!(points_covariance([p, p].into_iter()), DMat3::ZERO);
         let c = points_covariance([Vec3::ZERO, Vec3::X * 2.0].into_iter());
         assert!((c.x_axis.x - 1.0).abs() < 1e-12 && c.y_axis.y == 0.0);

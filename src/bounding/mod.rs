@@ -21,6 +21,7 @@ mod kdop;
 mod obb;
 mod relative_pose;
 mod sphere;
+mod surface;
 pub(crate) mod symmetric_eigen;
 
 pub use aabb::Aabb;
@@ -28,6 +29,7 @@ pub use kdop::{Kdop, Kdop14, Kdop18, Kdop26, KdopRelative};
 pub use obb::Obb;
 pub use relative_pose::{ABS_ROTATION_EPSILON, RELATIVE_SLACK, RelativePose};
 pub use sphere::BoundingSphere;
+pub use surface::{SurfaceMoments, TriangleSet};
 
 use crate::geometry::Isometry;
 use glam::Vec3;
@@ -52,17 +54,12 @@ pub trait Bv: Copy + Debug + PartialEq + Send + Sync + 'static {
     where
         I: Iterator<Item = Vec3> + Clone;
 
-    /// A BV holding the triangles `triangles[t]` for each `t` in `subset`, whose corners index
-    /// `vertices`. Indices must be in range (the hierarchy checks them once, at build time).
+    /// A BV holding the triangles of `set`.
     ///
     /// The default fits the corners; kinds that use the surface itself (the OBB's area-weighted
-    /// covariance) override it.
-    fn fit_triangles(vertices: &[Vec3], triangles: &[[u32; 3]], subset: &[u32]) -> Self {
-        Self::fit_points(
-            subset
-                .iter()
-                .flat_map(|&t| triangles[t as usize].map(|i| vertices[i as usize])),
-        )
+    /// covariance, the AABB's box of corners) take it from the set's summed moments.
+    fn fit_triangles(set: &TriangleSet) -> Self {
+        Self::fit_points(set.points())
     }
 
     /// A BV holding both, for refitting a hierarchy bottom-up.

@@ -2,7 +2,7 @@
 //! an optimal frame"), after Gottschalk, Lin and Manocha (1996, "OBBTree").
 //!
 //! Fit: the axes are the eigenvectors of the covariance of the surface (area-weighted over the
-//! triangles, see `covariance.rs`; of the points when there is no surface), the extents the
+//! triangles, summed once per hierarchy: `surface.rs`; of the points when there is no surface), the extents the
 //! points' projections on them. Degenerate sets still get a stable basis: the Jacobi
 //! decomposition returns orthonormal vectors for repeated or zero eigenvalues, the axes are sorted
 //! by decreasing variance with a fixed sign convention, and the third is the cross product of the
@@ -12,9 +12,9 @@
 //! products of their edges) with ε added to the absolute rotation matrix.
 
 use super::box_sat::all_axes;
-use super::covariance::{points_covariance, triangles_covariance};
-use super::symmetric_eigen::symmetric_eigen;
-use super::{Aabb, Bv, RelativePose, rounding_pad};
+use super::covariance::points_covariance;
+use super::symmetric_eigen::symmetric_eigen_within;
+use super::{Aabb, Bv, RelativePose, TriangleSet, rounding_pad};
 use crate::geometry::Isometry;
 use glam::{DMat3, Mat3, Mat3A, Vec3, Vec3A};
 
@@ -31,13 +31,34 @@ pub struct Obb {
 
 impl Obb {
     /// The tightest box with the given (orthonormal) axes holding every point, padded against
-    /// rounding; a zero box at the origin when there is no point.
+    /// rounding; a zero box at the origin when there is no point (or a non-finite one).
     pub fn fit_with_axes<I: Iterator<Item = Vec3>>(points: I, axes: Mat3) -> Self {
-        let to_box = axes.transpose();
-        let (lo, hi) = points.fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| {
-            let q = to_box * p;
+        // In SIMD lanes: the projections are most of a hierarchy's build.
+        let to_box = Mat3A::from(axes.transpose());
+        let (lo, hi) = points.fold((Vec3A::INFINITY, Vec3A::NEG_INFINITY), |(lo, hi), p| {
+            let q = to_box * Vec3A::from(p);
             (lo.min(q), hi.max(q))
         });
+        Self::from_interval(lo.into(), hi.into(), axes)
+    }
+
+    /// [`Obb::fit_with_axes`] over triangles' corners, a triangle per step (the loop a
+    /// hierarchy build spends its time in).
+    fn fit_triangles_with_axes(corners: &[[Vec3; 3]], axes: Mat3) -> Self {
+        let to_box = Mat3A::from(axes.transpose());
+        let mut lo = Vec3A::INFINITY;
+        let mut hi = Vec3A::NEG_INFINITY;
+        for triangle in corners {
+            let [a, b, c] = triangle.map(|p| to_box * Vec3A::from(p));
+            lo = lo.min(a).min(b).min(c);
+            hi = hi.max(a).max(b).max(c);
+        }
+        Self::from_interval(lo.into(), hi.into(), axes)
+    }
+
+    /// The box `lo..hi` in the frame `axes`, padded against rounding (a zero box at the origin
+    /// when the interval is empty or not finite).
+    fn from_interval(lo: Vec3, hi: Vec3, axes: Mat3) -> Self {
         if !lo.cmple(hi).all() {
             return Self {
                 center: Vec3::ZERO,
@@ -89,7 +110,8 @@ impl Obb {
 /// Principal axes of a covariance matrix as an orthonormal right-handed `Mat3` (see the module
 /// doc for the conventions that make it stable on degenerate input).
 fn principal_axes(covariance: DMat3) -> Mat3 {
-    let eigen = symmetric_eigen(covariance);
+    // A box's axes need no more than f32 precision.
+    let eigen = symmetric_eigen_within(covariance, 1e-12);
     let mut order = [0usize, 1, 2];
     // Decreasing variance; ties keep Jacobi's order, which is deterministic.
     order.sort_by(|&i, &j| eigen.values[j].total_cmp(&eigen.values[i]));
@@ -131,14 +153,12 @@ impl Bv for Obb {
         Self::fit_with_axes(points, axes)
     }
 
-    fn fit_triangles(vertices: &[Vec3], triangles: &[[u32; 3]], subset: &[u32]) -> Self {
-        let corners = subset
-            .iter()
-            .map(|&t| triangles[t as usize].map(|i| vertices[i as usize]));
-        let points = corners.clone().flatten();
-        let covariance =
-            triangles_covariance(corners).unwrap_or_else(|| points_covariance(points.clone()));
-        Self::fit_with_axes(points, principal_axes(covariance))
+    fn fit_triangles(set: &TriangleSet) -> Self {
+        let covariance = set
+            .surface()
+            .covariance()
+            .unwrap_or_else(|| points_covariance(set.points()));
+        Self::fit_triangles_with_axes(set.corners(), principal_axes(covariance))
     }
 
     fn merged(&self, other: &Self) -> Self {

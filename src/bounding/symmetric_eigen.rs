@@ -21,15 +21,23 @@ pub(crate) struct SymmetricEigen {
     pub vectors: DMat3,
 }
 
-/// Decomposes the symmetric matrix `m` (only its symmetric part is used).
+/// Decomposes the symmetric matrix `m` (only its symmetric part is used) to f64 precision.
 pub(crate) fn symmetric_eigen(m: DMat3) -> SymmetricEigen {
+    symmetric_eigen_within(m, 1e-30)
+}
+
+/// Decomposes `m` until the off-diagonal entries' squares sum to at most `tolerance` times the
+/// diagonal's: `1e-12` leaves off-diagonals a millionth of the diagonal, eigenvectors within
+/// about a millionth of a radian of exact unless two eigenvalues are that close (then any
+/// vector of their plane is as good), in about half the sweeps of full precision.
+pub(crate) fn symmetric_eigen_within(m: DMat3, tolerance: f64) -> SymmetricEigen {
     // a[c][r]: column-major, symmetric so the layout does not matter for reads of a[p][q].
     let mut a = ((m + m.transpose()) * 0.5).to_cols_array_2d();
     let mut v = DMat3::IDENTITY.to_cols_array_2d();
     for _ in 0..MAX_SWEEPS {
         let off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
         let diag = a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2];
-        if off <= diag * 1e-30 || off == 0.0 {
+        if off <= diag * tolerance || off == 0.0 {
             break;
         }
         for (p, q) in [(0, 1), (0, 2), (1, 2)] {

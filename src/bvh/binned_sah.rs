@@ -13,80 +13,175 @@
 
 use super::build::MAX_SAH_BINS;
 use crate::bounding::Aabb;
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
+use wide::f32x4;
 
-/// What the builder needs of a triangle: its box and the box's centre.
+/// An axis-aligned box in SIMD lanes: the binning's unions are one `minps`/`maxps` each (the
+/// scalar [`Aabb`]'s NaN-aware `min` costs four instructions per coordinate, and binning is
+/// most of a build). The mesh is checked finite before the build, so no NaN reaches these.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Bounds {
+    pub min: Vec3A,
+    pub max: Vec3A,
+}
+
+impl Bounds {
+    pub const EMPTY: Self = Self {
+        min: Vec3A::INFINITY,
+        max: Vec3A::NEG_INFINITY,
+    };
+
+    #[inline]
+    pub fn union(&self, other: &Self) -> Self {
+        Self {
+            min: self.min.min(other.min),
+            max: self.max.max(other.max),
+        }
+    }
+
+    #[inline]
+    pub fn including(&self, p: Vec3A) -> Self {
+        Self {
+            min: self.min.min(p),
+            max: self.max.max(p),
+        }
+    }
+
+    /// Surface area (0 when empty or flat).
+    #[inline]
+    fn area(&self) -> f32 {
+        let e = (self.max - self.min).max(Vec3A::ZERO);
+        2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
+    }
+
+    pub fn to_aabb(self) -> Aabb {
+        Aabb::new(self.min.into(), self.max.into())
+    }
+}
+
+/// What the builder needs of a triangle: its box and which triangle it is. The builder
+/// partitions these in place, so each node's primitives are contiguous.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Primitive {
-    pub aabb: Aabb,
-    pub centroid: Vec3,
+    pub bounds: Bounds,
+    pub triangle: u32,
 }
 
 impl Primitive {
-    pub fn of_triangle(corners: [Vec3; 3]) -> Self {
-        let aabb = Aabb::from_points(corners);
+    pub fn of_triangle(triangle: u32, corners: [Vec3; 3]) -> Self {
+        let [a, b, c] = corners.map(Vec3A::from);
         Self {
-            aabb,
-            centroid: aabb.center(),
+            bounds: Bounds {
+                min: a.min(b).min(c),
+                max: a.max(b).max(c),
+            },
+            triangle,
         }
     }
+
+    /// The centre of the triangle's box, the point the split rules sort and bin.
+    #[inline]
+    pub fn centroid(&self) -> Vec3A {
+        (self.bounds.min + self.bounds.max) * 0.5
+    }
+}
+
+/// The centroids' box.
+pub(crate) fn centroid_bounds(run: &[Primitive]) -> Bounds {
+    run.iter()
+        .fold(Bounds::EMPTY, |b, p| b.including(p.centroid()))
 }
 
 #[derive(Clone, Copy)]
 struct Bin {
-    aabb: Aabb,
+    bounds: Bounds,
     count: u32,
 }
 
 const EMPTY_BIN: Bin = Bin {
-    aabb: Aabb::EMPTY,
+    bounds: Bounds::EMPTY,
     count: 0,
 };
 
-/// Surface area of a possibly empty box (0 when empty).
-fn area(b: &Aabb) -> f32 {
-    if b.is_valid() { b.surface_area() } else { 0.0 }
+/// How centroids map to bins along the three axes: bin `i` of axis `a` holds the centroids
+/// with `i <= (c[a] - lo[a]) * scale[a] < i + 1`. An axis the centroids do not spread along
+/// gets scale 0: all its centroids fall in bin 0, and no plane of it separates anything.
+#[derive(Clone, Copy)]
+struct Binning {
+    lo: Vec3A,
+    scale: Vec3A,
+    top: Vec3A,
 }
 
-/// The best plane on one axis: `(cost, bins left of the plane)`, or `None` when the centroids
-/// do not spread along it.
-fn best_plane(
-    run: &[u32],
-    primitives: &[Primitive],
-    bins: &mut [Bin],
-    axis: usize,
-    lo: f32,
-    extent: f32,
-) -> Option<(f32, usize)> {
-    if extent.is_nan() || extent <= 0.0 {
-        return None;
+impl Binning {
+    fn new(bounds: &Bounds, bins: usize) -> Self {
+        let extents = bounds.max - bounds.min;
+        let scale = (Vec3A::splat(bins as f32 * (1.0 - 1e-6)) / extents).select_finite_positive();
+        Self {
+            lo: bounds.min,
+            scale,
+            top: Vec3A::splat((bins - 1) as f32),
+        }
     }
+
+    /// Where `centroid` falls along each axis, in bins (fractional), clamped to the bins.
+    #[inline]
+    fn position(&self, centroid: Vec3A) -> Vec3A {
+        ((centroid - self.lo) * self.scale).clamp(Vec3A::ZERO, self.top)
+    }
+
+    /// The centroid's bin along each axis.
+    #[inline]
+    fn bins_of(&self, centroid: Vec3A) -> [usize; 3] {
+        // In [0, top] by the clamp, so one truncating conversion of the lanes is exact (glam's
+        // per-lane `as` casts check for overflow lane by lane).
+        let p = self.position(centroid);
+        let [x, y, z, _] = f32x4::new([p.x, p.y, p.z, 0.0]).fast_trunc_int().to_array();
+        [x, y, z].map(|b| b as usize)
+    }
+
+    /// True when the centroid's bin along `axis` is below `plane` (≥ 1): `floor(x) < plane`
+    /// exactly when `x < plane`, so this is the bin test without the truncation.
+    #[inline]
+    fn left_of(&self, centroid: Vec3A, axis: usize, plane: usize) -> bool {
+        self.position(centroid)[axis] < plane as f32
+    }
+}
+
+/// Zero in the lanes that are not finite and positive (an axis of no spread: its extent was 0,
+/// or so small that the scale overflowed).
+trait SelectFinitePositive {
+    fn select_finite_positive(self) -> Self;
+}
+
+impl SelectFinitePositive for Vec3A {
+    fn select_finite_positive(self) -> Self {
+        let keep = self.is_finite_mask() & self.cmpgt(Vec3A::ZERO);
+        Vec3A::select(keep, self, Vec3A::ZERO)
+    }
+}
+
+/// The best plane on one axis's filled bins: `(cost, bins left of the plane)`, or `None` when
+/// every centroid fell on one side of every plane.
+fn best_plane(bins: &[Bin], total: usize) -> Option<(f32, usize)> {
     let n = bins.len();
-    bins.fill(EMPTY_BIN);
-    let scale = n as f32 * (1.0 - 1e-6) / extent;
-    for &t in run {
-        let p = &primitives[t as usize];
-        let bin = &mut bins[bin_of(p.centroid[axis], lo, scale, n)];
-        bin.aabb = bin.aabb.union(&p.aabb);
-        bin.count += 1;
-    }
     // right_cost[i] = area·count of bins i.. (the right side of plane i).
     let mut right_cost = [0.0f32; MAX_SAH_BINS];
     let mut acc = EMPTY_BIN;
     for i in (1..n).rev() {
-        acc.aabb = acc.aabb.union(&bins[i].aabb);
+        acc.bounds = acc.bounds.union(&bins[i].bounds);
         acc.count += bins[i].count;
-        right_cost[i] = area(&acc.aabb) * acc.count as f32;
+        right_cost[i] = acc.bounds.area() * acc.count as f32;
     }
     let mut best: Option<(f32, usize)> = None;
     let mut left = EMPTY_BIN;
     for i in 1..n {
-        left.aabb = left.aabb.union(&bins[i - 1].aabb);
+        left.bounds = left.bounds.union(&bins[i - 1].bounds);
         left.count += bins[i - 1].count;
-        if left.count == 0 || left.count as usize == run.len() {
+        if left.count == 0 || left.count as usize == total {
             continue;
         }
-        let cost = area(&left.aabb) * left.count as f32 + right_cost[i];
+        let cost = left.bounds.area() * left.count as f32 + right_cost[i];
         if best.is_none_or(|(c, _)| cost < c) {
             best = Some((cost, i));
         }
@@ -94,46 +189,61 @@ fn best_plane(
     best
 }
 
-#[inline]
-fn bin_of(x: f32, lo: f32, scale: f32, bins: usize) -> usize {
-    // `as usize` saturates (negative and NaN give 0), and the min clamps the top.
-    (((x - lo) * scale) as usize).min(bins - 1)
+/// The bins of the three axes, allocated once per build (clearing a fixed array of the most bins
+/// at every node cost more than binning the many small nodes).
+pub(crate) struct SahBins {
+    bins: Vec<Bin>,
+    per_axis: usize,
+}
+
+impl SahBins {
+    pub fn new(bin_count: usize) -> Self {
+        let per_axis = bin_count.clamp(2, MAX_SAH_BINS);
+        Self {
+            bins: vec![EMPTY_BIN; 3 * per_axis],
+            per_axis,
+        }
+    }
 }
 
 /// Partitions `run` at the cheapest SAH plane over the three axes and returns the size of the
 /// left part, or `None` when no plane separates the centroids (the caller then splits at the
-/// median).
-pub(crate) fn binned_sah_split(
-    run: &mut [u32],
-    primitives: &[Primitive],
-    bin_count: usize,
-) -> Option<usize> {
-    let n = bin_count.clamp(2, MAX_SAH_BINS);
-    let mut bins = [EMPTY_BIN; MAX_SAH_BINS];
-    let bins = &mut bins[..n];
-    let bounds = Aabb::from_points(run.iter().map(|&t| primitives[t as usize].centroid));
-    let extents = bounds.extents();
+/// median). One pass fills the bins of all three axes.
+pub(crate) fn binned_sah_split(run: &mut [Primitive], scratch: &mut SahBins) -> Option<usize> {
+    // No more bins than primitives: a small node's planes are few anyway, and evaluating empty
+    // bins is most of its cost.
+    let n = scratch.per_axis.min(run.len()).max(2);
+    let binning = Binning::new(&centroid_bounds(run), n);
+    let bins = &mut scratch.bins[..3 * n];
+    bins.fill(EMPTY_BIN);
+    let (x, yz) = bins.split_at_mut(n);
+    let (y, z) = yz.split_at_mut(n);
+    let mut bins = [x, y, z];
+    for p in run.iter() {
+        for (axis_bins, bin) in bins.iter_mut().zip(binning.bins_of(p.centroid())) {
+            let bin = &mut axis_bins[bin];
+            bin.bounds = bin.bounds.union(&p.bounds);
+            bin.count += 1;
+        }
+    }
     let mut best: Option<(f32, usize, usize)> = None;
-    for axis in 0..3 {
-        let plane = best_plane(run, primitives, bins, axis, bounds.min[axis], extents[axis]);
-        if let Some((cost, plane)) = plane
+    for (axis, axis_bins) in bins.iter().enumerate() {
+        if let Some((cost, plane)) = best_plane(axis_bins, run.len())
             && best.is_none_or(|(c, _, _)| cost < c)
         {
             best = Some((cost, axis, plane));
         }
     }
     let (_, axis, plane) = best?;
-    let (lo, scale) = (bounds.min[axis], n as f32 * (1.0 - 1e-6) / extents[axis]);
-    let goes_left = |t: u32| bin_of(primitives[t as usize].centroid[axis], lo, scale, n) < plane;
-    let mid = partition(run, goes_left);
+    let mid = partition(run, |p| binning.left_of(p.centroid(), axis, plane));
     (mid > 0 && mid < run.len()).then_some(mid)
 }
 
 /// Moves the items satisfying `left` to the front (deterministic, not stable); returns how many.
-fn partition(run: &mut [u32], left: impl Fn(u32) -> bool) -> usize {
+fn partition(run: &mut [Primitive], left: impl Fn(&Primitive) -> bool) -> usize {
     let mut mid = 0;
     for i in 0..run.len() {
-        if left(run[i]) {
+        if left(&run[i]) {
             run.swap(i, mid);
             mid += 1;
         }
@@ -146,7 +256,7 @@ mod tests {
     use super::*;
 
     fn tiny_triangle_at(c: Vec3) -> Primitive {
-        Primitive::of_triangle([c, c + Vec3::X * 0.01, c + Vec3::Y * 0.01])
+        Primitive::of_triangle(0, [c, c + Vec3::X * 0.01, c + Vec3::Y * 0.01])
     }
 
     /// Two clusters far apart along y: the SAH must cut between them, whatever the order.
@@ -157,17 +267,10 @@ mod tests {
             prims.push(tiny_triangle_at(Vec3::new(i as f32 * 0.1, 0.0, 0.0)));
             prims.push(tiny_triangle_at(Vec3::new(i as f32 * 0.1, 50.0, 0.0)));
         }
-        let mut run: Vec<u32> = (0..prims.len() as u32).collect();
-        let mid = binned_sah_split(&mut run, &prims, 12).unwrap();
+        let mid = binned_sah_split(&mut prims, &mut SahBins::new(12)).unwrap();
         assert_eq!(mid, 10);
-        let left_y: Vec<f32> = run[..mid]
-            .iter()
-            .map(|&t| prims[t as usize].centroid.y)
-            .collect();
-        let right_y: Vec<f32> = run[mid..]
-            .iter()
-            .map(|&t| prims[t as usize].centroid.y)
-            .collect();
+        let left_y: Vec<f32> = prims[..mid].iter().map(|p| p.centroid().y).collect();
+        let right_y: Vec<f32> = prims[mid..].iter().map(|p| p.centroid().y).collect();
         let (l, r) = if left_y[0] < 1.0 {
             (left_y, right_y)
         } else {
@@ -178,8 +281,7 @@ mod tests {
 
     #[test]
     fn coincident_centroids_are_refused() {
-        let prims = vec![tiny_triangle_at(Vec3::ONE); 8];
-        let mut run: Vec<u32> = (0..8).collect();
-        assert!(binned_sah_split(&mut run, &prims, 12).is_none());
+        let mut prims = vec![tiny_triangle_at(Vec3::ONE); 8];
+        assert!(binned_sah_split(&mut prims, &mut SahBins::new(12)).is_none());
     }
 }

@@ -9,12 +9,14 @@
 //!   Falls back to the median when the centroids cannot be told apart.
 //!
 //! Whatever the rule, each node's BV is fitted to the node's own triangles (not merged from its
-//! children), which is what makes an OBB tree tight. The recursion runs on an explicit stack, so
-//! a lopsided SAH tree cannot overflow the call stack.
+//! children), which is what makes an OBB tree tight; what a fit needs of the surface (the OBB's
+//! covariance, the AABB's box) comes from moments summed bottom-up, so only the exact extents
+//! cost a pass over a node's corners.
 
-use super::binned_sah::{Primitive, binned_sah_split};
+use super::binned_sah::{Primitive, centroid_bounds};
+use super::topology::{PARALLEL_MIN_RUN, Span, split_top_down};
 use super::{Bvh, BvhError, BvhNode};
-use crate::bounding::{Aabb, Bv};
+use crate::bounding::{Bv, SurfaceMoments, TriangleSet};
 use glam::Vec3;
 
 /// Triangles per leaf unless told otherwise: small leaves keep `Ns` low, which pays when the
@@ -43,6 +45,11 @@ pub struct BuildOptions {
     pub leaf_size: usize,
     /// Bins per axis for [`BuildRule::BinnedSah`], in `2..=MAX_SAH_BINS`.
     pub sah_bins: usize,
+    /// Most threads the build may use: `0` for as many as the machine has
+    /// ([`std::thread::available_parallelism`]), `1` to build on the caller's thread only. The
+    /// tree is the same whatever the count; meshes under a few thousand triangles are built on
+    /// the caller's thread anyway.
+    pub threads: usize,
 }
 
 impl Default for BuildOptions {
@@ -51,6 +58,7 @@ impl Default for BuildOptions {
             rule: BuildRule::BinnedSah,
             leaf_size: DEFAULT_LEAF_SIZE,
             sah_bins: DEFAULT_SAH_BINS,
+            threads: 0,
         }
     }
 }
@@ -61,6 +69,17 @@ impl BuildOptions {
         Self {
             rule,
             ..Self::default()
+        }
+    }
+
+    /// The threads a build of `triangles` triangles uses.
+    fn thread_count(&self, triangles: usize) -> usize {
+        if triangles < PARALLEL_MIN_RUN {
+            return 1;
+        }
+        match self.threads {
+            0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+            n => n,
         }
     }
 
@@ -99,19 +118,18 @@ pub(crate) fn validate_mesh(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Result
     Ok(())
 }
 
-/// A node waiting to be fitted and split: its index and its run of `order`.
-struct Pending {
-    node: usize,
-    start: usize,
-    end: usize,
-}
-
 impl<B: Bv> Bvh<B> {
     /// Builds the hierarchy of the mesh `(vertices, triangles)` (triangles index `vertices`).
     ///
     /// Errors on an empty mesh, non-finite vertices, out-of-range indices or bad options.
     /// Degenerate triangles (repeated or collinear corners) are fine. Deterministic: the same
     /// input gives the same tree.
+    ///
+    /// Three passes (the first and the last on several threads for large meshes, see
+    /// [`BuildOptions::threads`]): the topology top-down (splitting the primitives in place, so that every
+    /// node's triangles are contiguous), the surface moments bottom-up (each triangle integrated
+    /// once, each inner node the sum of its children's), then every node's BV fitted to its
+    /// contiguous corners and its summed moments.
     pub fn build(
         vertices: &[Vec3],
         triangles: &[[u32; 3]],
@@ -119,81 +137,134 @@ impl<B: Bv> Bvh<B> {
     ) -> Result<Self, BvhError> {
         options.validate()?;
         validate_mesh(vertices, triangles)?;
-        let primitives: Vec<Primitive> = triangles
-            .iter()
-            .map(|t| Primitive::of_triangle(t.map(|i| vertices[i as usize])))
-            .collect();
+        let corners_of = |t: u32| triangles[t as usize].map(|i| vertices[i as usize]);
         // `validate_mesh` checked that the count fits in u32.
-        let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
-        let n = triangles.len();
-        let mut nodes: Vec<BvhNode<B>> = Vec::with_capacity(2 * n.div_ceil(options.leaf_size));
-        // A placeholder root, fitted when popped like every other node.
-        nodes.push(leaf_node(B::fit_points(std::iter::empty()), 0, n));
-        let mut pending = vec![Pending {
-            node: 0,
-            start: 0,
-            end: n,
-        }];
-        while let Some(Pending { node, start, end }) = pending.pop() {
-            let bv = B::fit_triangles(vertices, triangles, &order[start..end]);
-            nodes[node] = leaf_node(bv, start, end);
-            if end - start <= options.leaf_size {
-                continue;
-            }
-            let run = &mut order[start..end];
-            let mid = start + split(run, &primitives, options);
-            let left = nodes.len();
-            // Placeholders, fitted when popped; `left` and `left + 1` stay adjacent.
-            nodes.push(leaf_node(bv, start, mid));
-            nodes.push(leaf_node(bv, mid, end));
-            nodes[node].start = left as u32;
-            nodes[node].count = 0;
-            pending.push(Pending {
-                node: left + 1,
-                start: mid,
-                end,
-            });
-            pending.push(Pending {
-                node: left,
-                start,
-                end: mid,
-            });
-        }
+        let mut primitives: Vec<Primitive> = (0..triangles.len() as u32)
+            .map(|t| Primitive::of_triangle(t, corners_of(t)))
+            .collect();
+        let threads = options.thread_count(triangles.len());
+        let spans = split_top_down(&mut primitives, options, threads);
+        let order: Vec<u32> = primitives.iter().map(|p| p.triangle).collect();
+        let corners: Vec<[Vec3; 3]> = order.iter().map(|&t| corners_of(t)).collect();
+        let origin = centroid_bounds(&primitives).to_aabb().center();
+        let surfaces = summed_surfaces(&spans, &corners, origin);
+        let nodes = fit_nodes(&spans, &surfaces, &corners, threads);
         Ok(Self { nodes, order })
     }
 }
 
-/// A leaf over `order[start..end]` (indices fit in u32: checked by `validate_mesh`).
-fn leaf_node<B: Bv>(bv: B, start: usize, end: usize) -> BvhNode<B> {
-    BvhNode {
-        bv,
-        size: bv.size(),
-        start: start as u32,
-        count: (end - start) as u32,
-    }
-}
-
-/// Reorders `run` (at least two triangles) and returns the size of its left part, in
-/// `1..run.len()`.
-fn split(run: &mut [u32], primitives: &[Primitive], options: &BuildOptions) -> usize {
-    let sah = match options.rule {
-        BuildRule::BinnedSah => binned_sah_split(run, primitives, options.sah_bins),
-        BuildRule::Median => None,
+/// Every node's BV, fitted to its corners and summed moments, on up to `threads` threads (the
+/// nodes are independent; each thread takes a run of them holding about the same number of
+/// triangles).
+fn fit_nodes<B: Bv>(
+    spans: &[Span],
+    surfaces: &[SurfaceMoments],
+    corners: &[[Vec3; 3]],
+    threads: usize,
+) -> Vec<BvhNode<B>> {
+    let fit = |(span, surface): (&Span, &SurfaceMoments)| {
+        let bv = B::fit_triangles(&TriangleSet::new(&corners[span.start..span.end], surface));
+        let (start, count) = match span.left {
+            Some(left) => (left, 0),
+            None => (span.start, span.end - span.start),
+        };
+        // Indices and counts fit in u32: there are fewer nodes than 2 × triangles.
+        BvhNode {
+            bv,
+            size: bv.size(),
+            start: start as u32,
+            count: count as u32,
+        }
     };
-    sah.unwrap_or_else(|| median_split(run, primitives))
+    let cuts = balanced_cuts(spans, threads);
+    if cuts.len() <= 2 {
+        return spans.iter().zip(surfaces).map(fit).collect();
+    }
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = cuts
+            .windows(2)
+            .map(|w| {
+                let range = w[0]..w[1];
+                let (spans, surfaces) = (&spans[range.clone()], &surfaces[range]);
+                scope.spawn(move || spans.iter().zip(surfaces).map(fit).collect::<Vec<_>>())
+            })
+            .collect();
+        handles
+            .into_iter()
+            // A panic on a fitting thread is a bug; pass it on rather than hide it.
+            .flat_map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
+    })
 }
 
-/// Splits at the median centroid along the longest axis of the centroids' bounds; ties (and
-/// coincident centroids) are broken by triangle index, so the split always halves the run and is
-/// deterministic.
-pub(crate) fn median_split(run: &mut [u32], primitives: &[Primitive]) -> usize {
-    let bounds = Aabb::from_points(run.iter().map(|&t| primitives[t as usize].centroid));
-    let axis = bounds.longest_axis();
-    let mid = run.len() / 2;
-    run.select_nth_unstable_by(mid, |&a, &b| {
-        let ka = primitives[a as usize].centroid[axis];
-        let kb = primitives[b as usize].centroid[axis];
-        ka.total_cmp(&kb).then(a.cmp(&b))
-    });
-    mid
+/// Node indices cutting `spans` into `threads` runs of about equal work (the triangles the
+/// nodes cover), from 0 to `spans.len()`.
+fn balanced_cuts(spans: &[Span], threads: usize) -> Vec<usize> {
+    let total: usize = spans.iter().map(|s| s.end - s.start).sum();
+    let share = total.div_ceil(threads.max(1)).max(1);
+    let mut cuts = vec![0];
+    let mut work = 0;
+    for (i, span) in spans.iter().enumerate() {
+        work += span.end - span.start;
+        if work >= share * cuts.len() && i + 1 < spans.len() {
+            cuts.push(i + 1);
+        }
+    }
+    cuts.push(spans.len());
+    cuts
+}
+
+/// Every node's surface moments about `origin`: a leaf integrates its triangles, an inner node
+/// adds its children's (children sit after their parent, so one reverse sweep sees them first).
+fn summed_surfaces(spans: &[Span], corners: &[[Vec3; 3]], origin: Vec3) -> Vec<SurfaceMoments> {
+    let mut surfaces = vec![SurfaceMoments::empty(origin); spans.len()];
+    for (node, span) in spans.iter().enumerate().rev() {
+        surfaces[node] = match span.left {
+            Some(left) => surfaces[left].plus(&surfaces[left + 1]),
+            None => corners[span.start..span.end]
+                .iter()
+                .fold(SurfaceMoments::empty(origin), |sum, &t| {
+                    sum.plus(&SurfaceMoments::of_triangle(t, origin))
+                }),
+        };
+    }
+    surfaces
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The cuts cover every node once, in order, and no run holds much more than its share of
+    /// the work.
+    #[test]
+    fn balanced_cuts_cover_the_nodes_in_runs_of_about_equal_work() {
+        // A complete tree over 1024 triangles, leaves of 4, in preorder.
+        fn preorder(start: usize, end: usize, out: &mut Vec<Span>) {
+            out.push(Span {
+                start,
+                end,
+                left: None,
+            });
+            if end - start > 4 {
+                let mid = (start + end) / 2;
+                preorder(start, mid, out);
+                preorder(mid, end, out);
+            }
+        }
+        let mut spans = Vec::new();
+        preorder(0, 1024, &mut spans);
+        for threads in [1, 2, 3, 8] {
+            let cuts = balanced_cuts(&spans, threads);
+            assert_eq!((cuts[0], *cuts.last().unwrap()), (0, spans.len()));
+            assert!(cuts.windows(2).all(|w| w[0] < w[1]));
+            assert!(cuts.len() - 1 <= threads);
+            let total: usize = spans.iter().map(|s| s.end - s.start).sum();
+            for w in cuts.windows(2) {
+                let work: usize = spans[w[0]..w[1]].iter().map(|s| s.end - s.start).sum();
+                // A run overshoots its share by at most one node (the root covers 1024).
+                assert!(work <= total.div_ceil(threads) + 1024, "{threads}: {work}");
+            }
+        }
+    }
 }

@@ -2,7 +2,9 @@
 //! slides' "Gerarchie di bounding volumes" and "Uso della gerarchia").
 //!
 //! - [`Bvh`] (`tree.rs`): a binary tree in a flat array, generic over the BV kind ([`Bv`]).
-//! - `build.rs`: top-down construction by median split or binned SAH (Wald 2007).
+//! - `build.rs`: construction: the split top-down by median or binned SAH (Wald 2007;
+//!   `topology.rs`, `binned_sah.rs`), then every node's BV fitted to its triangles and their
+//!   summed surface moments.
 //! - `query.rs`: the slides' traversal of node pairs — depth-first, breadth-first or by priority —
 //!   with early-out or enumeration of every intersecting triangle pair.
 //! - `descend.rs`: one hierarchy against a single volume (mesh–sphere, –plane, –box queries).
@@ -23,6 +25,7 @@ mod error;
 mod query;
 mod refit;
 mod scratch;
+mod topology;
 mod tree;
 
 pub use build::{BuildOptions, BuildRule, DEFAULT_LEAF_SIZE, DEFAULT_SAH_BINS, MAX_SAH_BINS};

@@ -9,7 +9,7 @@
 
 use super::build::validate_mesh;
 use super::{Bvh, BvhError};
-use crate::bounding::Bv;
+use crate::bounding::{Bv, SurfaceMoments, TriangleSet};
 use glam::Vec3;
 
 impl<B: Bv> Bvh<B> {
@@ -22,11 +22,21 @@ impl<B: Bv> Bvh<B> {
                 given: triangles.len(),
             });
         }
+        let mut corners = Vec::new();
         for i in (0..self.nodes.len()).rev() {
             let node = self.nodes[i];
             let bv = match (node.children(), node.triangle_range()) {
                 (Some([l, r]), _) => self.nodes[l as usize].bv.merged(&self.nodes[r as usize].bv),
-                (None, Some(range)) => B::fit_triangles(vertices, triangles, &self.order[range]),
+                (None, Some(range)) => {
+                    corners.clear();
+                    corners.extend(
+                        self.order[range]
+                            .iter()
+                            .map(|&t| triangles[t as usize].map(|v| vertices[v as usize])),
+                    );
+                    let surface = SurfaceMoments::of_triangles(&corners);
+                    B::fit_triangles(&TriangleSet::new(&corners, &surface))
+                }
                 // A node is a leaf or has children.
                 (None, None) => continue,
             };
