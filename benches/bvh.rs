@@ -60,6 +60,17 @@ fn bench_kind<B: Bv>(c: &mut Criterion, kind: &str, s: &Scene) {
                 Bvh::<B>::build(black_box(&s.a.vertices), &s.a.triangles, &options).unwrap()
             })
         });
+        // The default build uses every core on large meshes; this is the caller's thread alone.
+        let one_thread = BuildOptions {
+            threads: 1,
+            ..options
+        };
+        let id = format!("build/{kind}/{rule:?}-1-thread/{}", s.label);
+        c.bench_function(&id, |bench| {
+            bench.iter(|| {
+                Bvh::<B>::build(black_box(&s.a.vertices), &s.a.triangles, &one_thread).unwrap()
+            })
+        });
         let ta = Bvh::<B>::build(&s.a.vertices, &s.a.triangles, &options).unwrap();
         let tb = Bvh::<B>::build(&s.b.vertices, &s.b.triangles, &options).unwrap();
         let mut scratch = QueryScratch::new();
