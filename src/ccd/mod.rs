@@ -68,7 +68,7 @@
 //! [`InitialOverlap::ApproachingOnly`]; query the candidates from the broad phase (fed with
 //! [`SphereSweep::swept_aabb`]); take the smallest `t`; move the body to
 //! [`SphereSweep::position_at`]`(t)`, respond about `normal`, and sweep the rest of the step
-//! (`remaining × (1 − t)`) again, a bounded number of times. `tests/ccd_robustness.rs` runs this
+//! (`remaining × (1 − t)`) again, a bounded number of times. `tests/core/ccd_robustness.rs` runs this
 //! loop on the core alone.
 
 mod advancement;

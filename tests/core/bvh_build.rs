@@ -2,7 +2,7 @@
 //! node's BV holding its subtree, children after parents), determinism, errors on bad input,
 //! degenerate input, and the SAH beating the median on its own cost measure.
 
-mod common;
+use crate::common;
 
 use common::Mesh;
 use common::meshes::{ply, soup, torus, uv_sphere};

@@ -2,7 +2,7 @@
 //! 10–1000 m/s with a 60 Hz step, from any angle. A discrete step misses the wall (the ball is
 //! on one side, then on the other, never overlapping it); the time of impact never does.
 
-mod ccd_common;
+use crate::ccd_common;
 
 use ccd_common::Rng;
 use glam::{Quat, Vec3};

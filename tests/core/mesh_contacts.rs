@@ -15,7 +15,7 @@
 //! Where the test and the library compute in different frames (half-space and box: the brute
 //! force works in world space), triangles within `BAND` of touching are not classified.
 
-mod common;
+use crate::common;
 
 use common::rng::Rng;
 use glam::Vec3;

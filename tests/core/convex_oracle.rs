@@ -20,8 +20,7 @@
 //!   parry 0.31 strays up to 3e-3 on flat random hulls.
 
 #[allow(dead_code)]
-#[path = "common/rng.rs"]
-mod rng;
+use crate::common::rng;
 
 use glam::{Quat, Vec3};
 use rng::Rng;

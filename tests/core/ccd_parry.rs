@@ -1,7 +1,7 @@
 //! parry3d's shape cast (`cast_shapes`, a GJK-based time of impact) as an independent oracle for
 //! the ball against a box and against a triangle mesh, on the same seeded sweeps.
 
-mod ccd_common;
+use crate::ccd_common;
 
 use ccd_common::{Rng, random_sweep};
 use glam::{Quat, Vec3};

@@ -8,7 +8,7 @@
 //! - the test is not trivially true: BVs whose bounding balls are far apart are reported apart;
 //! - `overlap_estimate` is `Some` exactly when `overlaps` is true, and lies in `[0, 1]`.
 
-mod common;
+use crate::common;
 
 use common::rng::Rng;
 use glam::Vec3;

@@ -5,7 +5,7 @@
 //! - conservative advancement on the exact point–obstacle distance (which also covers rays,
 //!   where the sampled depth test has nothing to measure).
 
-mod ccd_common;
+use crate::ccd_common;
 
 use ccd_common::{Rng, Tally, check_toi, random_sweep};
 use glam::{Quat, Vec3};

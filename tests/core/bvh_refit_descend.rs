@@ -1,7 +1,7 @@
 //! Refit after the vertices move, and the single-volume descent (mesh against a sphere), both
 //! checked against brute force.
 
-mod common;
+use crate::common;
 
 use common::meshes::{torus, uv_sphere};
 use common::rng::Rng;

@@ -4,7 +4,7 @@
 //!
 //! Placements: set `URTO_BVH_PLACEMENTS_SCALE` (default 1.0) to scale their number.
 
-mod common;
+use crate::common;
 
 use common::meshes::{ply, soup, torus, uv_sphere};
 use common::rng::Rng;
