@@ -414,3 +414,45 @@ fn joints_are_drawn_at_their_anchors_with_their_axes_loads_and_motor_torques() {
         "the hinge holds: {bob_anchor}"
     );
 }
+
+/// A joint without a motor plots what it holds but no `/motor` series (a flat zero would read
+/// as a motor holding nothing).
+#[test]
+fn a_joint_without_a_motor_logs_its_loads_and_no_motor_series() {
+    let (rec, storage) = rerun::RecordingStreamBuilder::new("urto_motorless_joint")
+        .memory()
+        .expect("memory sink");
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    app.add_plugins(RerunDebugPlugin::from_stream(
+        rec.clone(),
+        RerunConfig::file("unused.rrd"),
+    ));
+    let bob = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.1),
+            Position::new(1.0, 0.0, 2.0),
+            Velocity::default(),
+        ))
+        .id();
+    let hinge = app
+        .world_mut()
+        .spawn(
+            Joint::revolute(bob, JointEnd::World)
+                .with_axis(Vec3::Y)
+                .with_anchors(Vec3::new(-1.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 2.0)),
+        )
+        .id();
+    urto::step(app.world_mut(), STEPS).unwrap();
+    let store = common::recording::read_back(&rec, &storage);
+    let names = entities(&store);
+    for series in ["force", "torque"] {
+        let path = format!("/joints/{hinge}/{series}");
+        assert!(names.contains(&path), "{path} missing from {names:?}");
+    }
+    assert!(
+        !names.iter().any(|n| n.ends_with("/motor")),
+        "a motor series for a joint without a motor: {names:?}"
+    );
+}
