@@ -281,9 +281,10 @@ impl JointConstraint {
     /// once) otherwise grows its rigid passes' impulses step after step until they overflow.
     /// The bound is per joint: a sound joint can reach it too where a light, thin body carries
     /// a heavy one (a 0.2 kg rod holding 10 kg 10 cm off its axis), and is then held to it.
-    pub fn bound_impulses(&mut self, max_speed: f32, max_spin: f32) {
+    /// Returns whether it changed the impulses.
+    pub fn bound_impulses(&mut self, max_speed: f32, max_spin: f32) -> bool {
         if self.impulses == JointImpulses::default() {
-            return;
+            return false;
         }
         let mut effect = [BodyState::default(); 2];
         self.apply_impulses(&mut effect, (0, 1));
@@ -292,7 +293,7 @@ impl JointConstraint {
             .all(|s| s.linear_velocity.is_finite() && s.angular_velocity.is_finite());
         if !finite {
             self.impulses = JointImpulses::default();
-            return;
+            return true;
         }
         let over = effect
             .iter()
@@ -305,6 +306,7 @@ impl JointConstraint {
         if over > 1.0 {
             self.impulses.scale(1.0 / over.sqrt());
         }
+        over > 1.0
     }
 
     /// Applies the accumulated impulses to the bodies in `states` at slots `ab`.

@@ -208,6 +208,8 @@ pub struct Solver {
     stable_springs: Vec<Spring>,
     /// How many springs of the last step were lowered to that range.
     clamped_springs: usize,
+    /// How many joints of the last step carried impulses past the warm-start bound.
+    bounded_joints: usize,
     /// The step's joints, with their impulses.
     joints: Vec<JointConstraint>,
     /// Last step's joint impulses by key, for the warm start.
@@ -337,8 +339,11 @@ impl Solver {
         let s = &self.settings;
         let max_speed = WARM_START_BOUND * s.max_linear_speed;
         let max_spin = WARM_START_BOUND * s.max_rotation_per_substep * inv_h;
+        self.bounded_joints = 0;
         for j in &mut self.joints {
-            j.bound_impulses(max_speed, max_spin);
+            if j.bound_impulses(max_speed, max_spin) {
+                self.bounded_joints += 1;
+            }
         }
     }
 
@@ -375,6 +380,14 @@ impl Solver {
     /// lowered to the stable bound ([`Spring::clamped_to_stability`]).
     pub fn clamped_springs(&self) -> usize {
         self.clamped_springs
+    }
+
+    /// How many joints carried impulses into the last step that were not finite or could have
+    /// changed a body's velocity by more than [`WARM_START_BOUND`] times the speed or spin bound,
+    /// and were dropped or scaled down ([`JointConstraint::bound_impulses`]). Joints that keep
+    /// tripping it fight each other or carry far more than their bodies can take.
+    pub fn bounded_joints(&self) -> usize {
+        self.bounded_joints
     }
 
     /// Copies `springs` into the step's list, each lowered into the range a substep `h` can
