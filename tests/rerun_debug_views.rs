@@ -345,8 +345,9 @@ fn the_views_are_off_by_default_and_change_no_result() {
     assert_eq!(positions(&app, &scene), expected);
 }
 
-#[test]
-fn joints_are_drawn_at_their_anchors_with_their_axes_loads_and_motor_torques() {
+/// A hinge swinging a ball of radius 0.1 m, 1 m from a pivot at (0, 0, 2), recorded to memory for
+/// `STEPS` steps; `motor` drives it. Returns the recording, the app, the ball and the joint.
+fn recorded_hinge(motor: Option<JointMotor>) -> (ChunkStore, App, Entity, Entity) {
     let (rec, storage) = rerun::RecordingStreamBuilder::new("urto_joint_views")
         .memory()
         .expect("memory sink");
@@ -364,15 +365,25 @@ fn joints_are_drawn_at_their_anchors_with_their_axes_loads_and_motor_torques() {
             Velocity::default(),
         ))
         .id();
-    let pivot = Vec3::new(0.0, 0.0, 2.0);
-    app.world_mut().spawn(
-        Joint::revolute(bob, JointEnd::World)
-            .with_axis(Vec3::Y)
-            .with_anchors(Vec3::new(-1.0, 0.0, 0.0), pivot)
-            .with_motor(JointMotor::velocity(0.0, 0.5)),
-    );
+    let mut joint = Joint::revolute(bob, JointEnd::World)
+        .with_axis(Vec3::Y)
+        .with_anchors(Vec3::new(-1.0, 0.0, 0.0), HINGE_PIVOT);
+    if let Some(motor) = motor {
+        joint = joint.with_motor(motor);
+    }
+    let hinge = app.world_mut().spawn(joint).id();
     urto::step(app.world_mut(), STEPS).unwrap();
     let store = common::recording::read_back(&rec, &storage);
+    (store, app, bob, hinge)
+}
+
+/// Where [`recorded_hinge`]'s hinge is fixed to the world.
+const HINGE_PIVOT: Vec3 = Vec3::new(0.0, 0.0, 2.0);
+
+#[test]
+fn joints_are_drawn_at_their_anchors_with_their_axes_loads_and_motor_torques() {
+    let (store, app, bob, _) = recorded_hinge(Some(JointMotor::velocity(0.0, 0.5)));
+    let pivot = HINGE_PIVOT;
     let names = entities(&store);
     for path in [
         "/world/joints/links",
@@ -419,33 +430,7 @@ fn joints_are_drawn_at_their_anchors_with_their_axes_loads_and_motor_torques() {
 /// as a motor holding nothing).
 #[test]
 fn a_joint_without_a_motor_logs_its_loads_and_no_motor_series() {
-    let (rec, storage) = rerun::RecordingStreamBuilder::new("urto_motorless_joint")
-        .memory()
-        .expect("memory sink");
-    let mut app = common::app();
-    app.insert_resource(Gravity::EARTH_Z_UP);
-    app.add_plugins(RerunDebugPlugin::from_stream(
-        rec.clone(),
-        RerunConfig::file("unused.rrd"),
-    ));
-    let bob = app
-        .world_mut()
-        .spawn((
-            Collider::sphere(0.1),
-            Position::new(1.0, 0.0, 2.0),
-            Velocity::default(),
-        ))
-        .id();
-    let hinge = app
-        .world_mut()
-        .spawn(
-            Joint::revolute(bob, JointEnd::World)
-                .with_axis(Vec3::Y)
-                .with_anchors(Vec3::new(-1.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 2.0)),
-        )
-        .id();
-    urto::step(app.world_mut(), STEPS).unwrap();
-    let store = common::recording::read_back(&rec, &storage);
+    let (store, _, _, hinge) = recorded_hinge(None);
     let names = entities(&store);
     for series in ["force", "torque"] {
         let path = format!("/joints/{hinge}/{series}");
