@@ -130,7 +130,7 @@ fn mesh_bodies_dropped_on_a_mesh_floor_come_to_rest_on_it() {
 /// after 3 s, which takes it to the edge near 4 s): while it is over the slab, it must touch the
 /// slab's top face, and it must still be over it after 3 s.
 #[test]
-fn a_mesh_rests_on_another_mesh() {
+fn a_mesh_ball_rolling_on_a_mesh_slab_touches_its_top_within_the_sink_tolerance_for_3_s() {
     let mut app = common::app();
     app.insert_resource(Gravity::EARTH_Z_UP);
     let world = app.world_mut();

@@ -16,7 +16,7 @@ use super::covariance::points_covariance;
 use super::symmetric_eigen::symmetric_eigen_within;
 use super::{Aabb, Bv, RelativePose, TriangleSet, rounding_pad};
 use crate::geometry::Isometry;
-use glam::{DMat3, Mat3, Mat3A, Vec3, Vec3A};
+use glam::{BVec3A, DMat3, Mat3, Mat3A, Vec3, Vec3A};
 
 /// A box with centre `center`, unit axes the columns of `axes`, and `half_extents` along them.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -35,43 +35,24 @@ impl Obb {
     pub fn fit_with_axes<I: Iterator<Item = Vec3>>(points: I, axes: Mat3) -> Self {
         // In SIMD lanes: the projections are most of a hierarchy's build.
         let to_box = Mat3A::from(axes.transpose());
-        let (lo, hi) = points.fold((Vec3A::INFINITY, Vec3A::NEG_INFINITY), |(lo, hi), p| {
-            let q = to_box * Vec3A::from(p);
-            (lo.min(q), hi.max(q))
-        });
-        Self::from_interval(lo.into(), hi.into(), axes)
+        let mut interval = Interval::EMPTY;
+        for p in points {
+            interval.include(to_box * Vec3A::from(p));
+        }
+        interval.into_box(axes)
     }
 
     /// [`Obb::fit_with_axes`] over triangles' corners, a triangle per step (the loop a
     /// hierarchy build spends its time in).
     fn fit_triangles_with_axes(corners: &[[Vec3; 3]], axes: Mat3) -> Self {
         let to_box = Mat3A::from(axes.transpose());
-        let mut lo = Vec3A::INFINITY;
-        let mut hi = Vec3A::NEG_INFINITY;
+        let mut interval = Interval::EMPTY;
         for triangle in corners {
-            let [a, b, c] = triangle.map(|p| to_box * Vec3A::from(p));
-            lo = lo.min(a).min(b).min(c);
-            hi = hi.max(a).max(b).max(c);
+            for p in triangle {
+                interval.include(to_box * Vec3A::from(*p));
+            }
         }
-        Self::from_interval(lo.into(), hi.into(), axes)
-    }
-
-    /// The box `lo..hi` in the frame `axes`, padded against rounding (a zero box at the origin
-    /// when the interval is empty or not finite).
-    fn from_interval(lo: Vec3, hi: Vec3, axes: Mat3) -> Self {
-        if !lo.cmple(hi).all() {
-            return Self {
-                center: Vec3::ZERO,
-                axes,
-                half_extents: Vec3::ZERO,
-            };
-        }
-        let pad = rounding_pad(lo.abs().max(hi.abs()).max_element());
-        Self {
-            center: axes * ((lo + hi) * 0.5),
-            axes,
-            half_extents: (hi - lo) * 0.5 + Vec3::splat(pad),
-        }
+        interval.into_box(axes)
     }
 
     /// The eight corners.
@@ -104,6 +85,50 @@ impl Obb {
             Vec3A::from(other.half_extents),
         );
         all_axes::<ESTIMATE>(ha, hb, t, &c, &abs_c, rel.slack)
+    }
+}
+
+/// The projections of points on a box's axes: their least and greatest, in SIMD lanes, and
+/// the lanes in which a NaN came by (SIMD `min` forgets a NaN at the next finite value, where
+/// the scalar one ignores it: either way the box would not hold that point).
+struct Interval {
+    lo: Vec3A,
+    hi: Vec3A,
+    nan: BVec3A,
+}
+
+impl Interval {
+    const EMPTY: Self = Self {
+        lo: Vec3A::INFINITY,
+        hi: Vec3A::NEG_INFINITY,
+        nan: BVec3A::FALSE,
+    };
+
+    #[inline]
+    fn include(&mut self, q: Vec3A) {
+        self.lo = self.lo.min(q);
+        self.hi = self.hi.max(q);
+        self.nan |= q.is_nan_mask();
+    }
+
+    /// The box over the interval in the frame `axes`, padded against rounding; a zero box at
+    /// the origin when the interval is empty or saw a non-finite point.
+    fn into_box(self, axes: Mat3) -> Obb {
+        let (lo, hi) = (Vec3::from(self.lo), Vec3::from(self.hi));
+        // An infinite point leaves an infinite bound; a NaN one only its mark.
+        if self.nan.any() || !(lo.is_finite() && hi.is_finite() && lo.cmple(hi).all()) {
+            return Obb {
+                center: Vec3::ZERO,
+                axes,
+                half_extents: Vec3::ZERO,
+            };
+        }
+        let pad = rounding_pad(lo.abs().max(hi.abs()).max_element());
+        Obb {
+            center: axes * ((lo + hi) * 0.5),
+            axes,
+            half_extents: (hi - lo) * 0.5 + Vec3::splat(pad),
+        }
     }
 }
 

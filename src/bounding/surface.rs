@@ -36,7 +36,7 @@ pub struct SurfaceMoments {
 
 impl SurfaceMoments {
     /// No triangle, moments about `origin`.
-    pub fn empty(origin: Vec3) -> Self {
+    pub(crate) fn empty(origin: Vec3) -> Self {
         Self {
             origin: origin.as_dvec3(),
             area: 0.0,
@@ -49,7 +49,8 @@ impl SurfaceMoments {
     /// One triangle's moments about `origin`: area `A`, first moment `A m` and the exact second
     /// moment `A/12 · (9 m mᵀ + p pᵀ + q qᵀ + r rᵀ)` (m the centroid, p, q, r the corners, all
     /// relative to `origin`).
-    pub fn of_triangle(corners: [Vec3; 3], origin: Vec3) -> Self {
+    #[inline]
+    pub(crate) fn of_triangle(corners: [Vec3; 3], origin: Vec3) -> Self {
         let o = origin.as_dvec3();
         let [p, q, r] = corners.map(|c| c.as_dvec3() - o);
         let area = 0.5 * (q - p).cross(r - p).length();
@@ -74,8 +75,9 @@ impl SurfaceMoments {
         sum
     }
 
-    /// Adds the moments of other triangles, taken about the same origin.
-    pub fn add(&mut self, other: &Self) {
+    /// Adds the moments of other triangles, taken about the same origin (the builder's sums).
+    #[inline]
+    pub(crate) fn add(&mut self, other: &Self) {
         debug_assert_eq!(self.origin, other.origin, "moments about different origins");
         self.area += other.area;
         self.first += other.first;
@@ -85,7 +87,8 @@ impl SurfaceMoments {
 
     /// The sum of two sets' moments.
     #[must_use]
-    pub fn plus(mut self, other: &Self) -> Self {
+    #[inline]
+    pub(crate) fn plus(mut self, other: &Self) -> Self {
         self.add(other);
         self
     }
@@ -111,7 +114,7 @@ impl SurfaceMoments {
         } else {
             0.0
         };
-        if self.area.is_nan() || self.area <= DEGENERATE_AREA * extent_sq || self.area == 0.0 {
+        if self.area.is_nan() || self.area <= DEGENERATE_AREA * extent_sq {
             return None;
         }
         let mean = self.first / self.area;
@@ -123,13 +126,18 @@ impl SurfaceMoments {
 #[derive(Clone, Copy, Debug)]
 pub struct TriangleSet<'a> {
     corners: &'a [[Vec3; 3]],
-    surface: &'a SurfaceMoments,
+    surface: SurfaceMoments,
 }
 
 impl<'a> TriangleSet<'a> {
-    /// The triangles `corners`, whose moments summed are `surface` (the caller's promise: the
-    /// builder sums them bottom-up; [`SurfaceMoments::of_triangles`] computes them afresh).
-    pub fn new(corners: &'a [[Vec3; 3]], surface: &'a SurfaceMoments) -> Self {
+    /// The triangles `corners`, their moments integrated here.
+    pub fn new(corners: &'a [[Vec3; 3]]) -> Self {
+        Self::with_surface(corners, SurfaceMoments::of_triangles(corners))
+    }
+
+    /// The triangles `corners`, whose moments summed are `surface` (the builder's promise: it
+    /// sums them bottom-up; a mismatch would give boxes that miss triangles).
+    pub(crate) fn with_surface(corners: &'a [[Vec3; 3]], surface: SurfaceMoments) -> Self {
         Self { corners, surface }
     }
 
@@ -144,8 +152,8 @@ impl<'a> TriangleSet<'a> {
     }
 
     /// The triangles' summed moments.
-    pub fn surface(&self) -> &'a SurfaceMoments {
-        self.surface
+    pub fn surface(&self) -> &SurfaceMoments {
+        &self.surface
     }
 }
 

@@ -82,6 +82,8 @@ impl Primitive {
     /// The centre of the triangle's box, the point the split rules sort and bin.
     #[inline]
     pub fn centroid(&self) -> Vec3A {
+        // Past 1.7e38 the sum overflows to infinity; binning and partitioning both go through
+        // `Binning::position`, which clamps it to the top bin, so they still agree.
         (self.bounds.min + self.bounds.max) * 0.5
     }
 }
@@ -116,7 +118,7 @@ struct Binning {
 impl Binning {
     fn new(bounds: &Bounds, bins: usize) -> Self {
         let extents = bounds.max - bounds.min;
-        let scale = (Vec3A::splat(bins as f32 * (1.0 - 1e-6)) / extents).select_finite_positive();
+        let scale = finite_positive_or_zero(Vec3A::splat(bins as f32 * (1.0 - 1e-6)) / extents);
         Self {
             lo: bounds.min,
             scale,
@@ -150,15 +152,9 @@ impl Binning {
 
 /// Zero in the lanes that are not finite and positive (an axis of no spread: its extent was 0,
 /// or so small that the scale overflowed).
-trait SelectFinitePositive {
-    fn select_finite_positive(self) -> Self;
-}
-
-impl SelectFinitePositive for Vec3A {
-    fn select_finite_positive(self) -> Self {
-        let keep = self.is_finite_mask() & self.cmpgt(Vec3A::ZERO);
-        Vec3A::select(keep, self, Vec3A::ZERO)
-    }
+fn finite_positive_or_zero(v: Vec3A) -> Vec3A {
+    let keep = v.is_finite_mask() & v.cmpgt(Vec3A::ZERO);
+    Vec3A::select(keep, v, Vec3A::ZERO)
 }
 
 /// The best plane on one axis's filled bins: `(cost, bins left of the plane)`, or `None` when
@@ -212,12 +208,12 @@ impl SahBins {
 pub(crate) fn binned_sah_split(run: &mut [Primitive], scratch: &mut SahBins) -> Option<usize> {
     // No more bins than primitives: a small node's planes are few anyway, and evaluating empty
     // bins is most of its cost.
-    let n = scratch.per_axis.min(run.len()).max(2);
-    let binning = Binning::new(&centroid_bounds(run), n);
-    let bins = &mut scratch.bins[..3 * n];
+    let bins_per_axis = scratch.per_axis.min(run.len()).max(2);
+    let binning = Binning::new(&centroid_bounds(run), bins_per_axis);
+    let bins = &mut scratch.bins[..3 * bins_per_axis];
     bins.fill(EMPTY_BIN);
-    let (x, yz) = bins.split_at_mut(n);
-    let (y, z) = yz.split_at_mut(n);
+    let (x, yz) = bins.split_at_mut(bins_per_axis);
+    let (y, z) = yz.split_at_mut(bins_per_axis);
     let mut bins = [x, y, z];
     for p in run.iter() {
         for (axis_bins, bin) in bins.iter_mut().zip(binning.bins_of(p.centroid())) {

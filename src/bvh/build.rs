@@ -72,14 +72,15 @@ impl BuildOptions {
         }
     }
 
-    /// The threads a build of `triangles` triangles uses.
+    /// The threads a build of `triangles` triangles uses: never more than the machine has.
     fn thread_count(&self, triangles: usize) -> usize {
         if triangles < PARALLEL_MIN_RUN {
             return 1;
         }
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
         match self.threads {
-            0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
-            n => n,
+            0 => cores,
+            n => n.min(cores),
         }
     }
 
@@ -100,7 +101,8 @@ pub(crate) fn validate_mesh(vertices: &[Vec3], triangles: &[[u32; 3]]) -> Result
     if triangles.is_empty() {
         return Err(BvhError::EmptyMesh);
     }
-    if u32::try_from(triangles.len()).is_err() {
+    // A tree has fewer than 2 × triangles nodes, and nodes are indexed by u32.
+    if triangles.len() > u32::MAX as usize / 2 {
         return Err(BvhError::TooManyTriangles(triangles.len()));
     }
     if let Some(vertex) = vertices.iter().position(|v| !v.is_finite()) {
@@ -163,7 +165,8 @@ fn fit_nodes<B: Bv>(
     threads: usize,
 ) -> Vec<BvhNode<B>> {
     let fit = |(span, surface): (&Span, &SurfaceMoments)| {
-        let bv = B::fit_triangles(&TriangleSet::new(&corners[span.start..span.end], surface));
+        let set = TriangleSet::with_surface(&corners[span.start..span.end], *surface);
+        let bv = B::fit_triangles(&set);
         let (start, count) = match span.left {
             Some(left) => (left, 0),
             None => (span.start, span.end - span.start),
@@ -176,24 +179,45 @@ fn fit_nodes<B: Bv>(
             count: count as u32,
         }
     };
+    let fit_run = |range: std::ops::Range<usize>| -> Vec<BvhNode<B>> {
+        spans[range.clone()]
+            .iter()
+            .zip(&surfaces[range])
+            .map(fit)
+            .collect()
+    };
     let cuts = balanced_cuts(spans, threads);
-    if cuts.len() <= 2 {
-        return spans.iter().zip(surfaces).map(fit).collect();
-    }
+    let runs: Vec<_> = cuts.windows(2).map(|w| w[0]..w[1]).collect();
+    let Some((last, others)) = runs.split_last() else {
+        return Vec::new();
+    };
     std::thread::scope(|scope| {
-        let handles: Vec<_> = cuts
-            .windows(2)
-            .map(|w| {
-                let range = w[0]..w[1];
-                let (spans, surfaces) = (&spans[range.clone()], &surfaces[range]);
-                scope.spawn(move || spans.iter().zip(surfaces).map(fit).collect::<Vec<_>>())
+        let spawned: Vec<_> = others
+            .iter()
+            .map(|run| {
+                let run = run.clone();
+                let fit_run = &fit_run;
+                (
+                    run.clone(),
+                    std::thread::Builder::new().spawn_scoped(scope, move || fit_run(run)),
+                )
             })
             .collect();
-        handles
-            .into_iter()
-            // A panic on a fitting thread is a bug; pass it on rather than hide it.
-            .flat_map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
-            .collect()
+        // This thread fits the last run while the others work.
+        let last = fit_run(last.clone());
+        let mut nodes = Vec::with_capacity(spans.len());
+        for (run, handle) in spawned {
+            nodes.extend(match handle {
+                // A panic on a fitting thread is a bug; pass it on rather than hide it.
+                Ok(handle) => handle
+                    .join()
+                    .unwrap_or_else(|e| std::panic::resume_unwind(e)),
+                // No thread to be had (the system's limit): fit the run here.
+                Err(_) => fit_run(run),
+            });
+        }
+        nodes.extend(last);
+        nodes
     })
 }
 
@@ -201,7 +225,8 @@ fn fit_nodes<B: Bv>(
 /// nodes cover), from 0 to `spans.len()`.
 fn balanced_cuts(spans: &[Span], threads: usize) -> Vec<usize> {
     let total: usize = spans.iter().map(|s| s.end - s.start).sum();
-    let share = total.div_ceil(threads.max(1)).max(1);
+    // A run too small to pay for its thread is not cut off.
+    let share = total.div_ceil(threads.max(1)).max(PARALLEL_MIN_RUN);
     let mut cuts = vec![0];
     let mut work = 0;
     for (i, span) in spans.iter().enumerate() {
@@ -239,7 +264,7 @@ mod tests {
     /// the work.
     #[test]
     fn balanced_cuts_cover_the_nodes_in_runs_of_about_equal_work() {
-        // A complete tree over 1024 triangles, leaves of 4, in preorder.
+        // A complete tree over 65,536 triangles, leaves of 4, in preorder.
         fn preorder(start: usize, end: usize, out: &mut Vec<Span>) {
             out.push(Span {
                 start,
@@ -253,17 +278,23 @@ mod tests {
             }
         }
         let mut spans = Vec::new();
-        preorder(0, 1024, &mut spans);
+        preorder(0, 1 << 16, &mut spans);
         for threads in [1, 2, 3, 8] {
             let cuts = balanced_cuts(&spans, threads);
             assert_eq!((cuts[0], *cuts.last().unwrap()), (0, spans.len()));
             assert!(cuts.windows(2).all(|w| w[0] < w[1]));
             assert!(cuts.len() - 1 <= threads);
+            assert_eq!(
+                cuts.len() - 1,
+                threads,
+                "a 65,536-triangle tree keeps every thread busy"
+            );
             let total: usize = spans.iter().map(|s| s.end - s.start).sum();
             for w in cuts.windows(2) {
                 let work: usize = spans[w[0]..w[1]].iter().map(|s| s.end - s.start).sum();
-                // A run overshoots its share by at most one node (the root covers 1024).
-                assert!(work <= total.div_ceil(threads) + 1024, "{threads}: {work}");
+                // A run overshoots its share by at most one node (the root covers all 65,536).
+                let share = total.div_ceil(threads).max(PARALLEL_MIN_RUN);
+                assert!(work <= share + (1 << 16), "{threads}: {work}");
             }
         }
     }

@@ -7,7 +7,7 @@ use std::fmt;
 pub enum BvhError {
     /// No triangles: a hierarchy needs at least one.
     EmptyMesh,
-    /// More triangles than `u32` indices can name.
+    /// More triangles than a hierarchy's `u32` node indices can cover (2³¹ − 1).
     TooManyTriangles(usize),
     /// A vertex with a NaN or infinite coordinate.
     NonFiniteVertex {
@@ -40,7 +40,9 @@ impl fmt::Display for BvhError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Self::EmptyMesh => write!(f, "cannot build a hierarchy over a mesh without triangles"),
-            Self::TooManyTriangles(n) => write!(f, "{n} triangles exceed the u32 index range"),
+            Self::TooManyTriangles(n) => {
+                write!(f, "{n} triangles: a hierarchy indexes at most 2^31 - 1")
+            }
             Self::NonFiniteVertex { vertex } => {
                 write!(f, "vertex {vertex} has a NaN or infinite coordinate")
             }

@@ -9,7 +9,7 @@
 
 use super::build::validate_mesh;
 use super::{Bvh, BvhError};
-use crate::bounding::{Bv, SurfaceMoments, TriangleSet};
+use crate::bounding::{Bv, TriangleSet};
 use glam::Vec3;
 
 impl<B: Bv> Bvh<B> {
@@ -34,8 +34,7 @@ impl<B: Bv> Bvh<B> {
                             .iter()
                             .map(|&t| triangles[t as usize].map(|v| vertices[v as usize])),
                     );
-                    let surface = SurfaceMoments::of_triangles(&corners);
-                    B::fit_triangles(&TriangleSet::new(&corners, &surface))
+                    B::fit_triangles(&TriangleSet::new(&corners))
                 }
                 // A node is a leaf or has children.
                 (None, None) => continue,

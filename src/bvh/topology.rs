@@ -33,8 +33,8 @@ pub(crate) fn split_top_down(
     options: &BuildOptions,
     threads: usize,
 ) -> Vec<Span> {
-    // Each level of handing off doubles the threads at work.
-    let levels = threads.max(1).next_power_of_two().trailing_zeros();
+    // Each level of handing off doubles the threads at work: at most `threads` of them.
+    let levels = threads.max(1).ilog2();
     split_in_parallel(primitives, options, levels)
 }
 

@@ -483,3 +483,41 @@ fn unusable_settings_are_refused_with_the_defaults_and_a_dropped_ball_falls_2m_w
     let z = app.world().get::<Position>(ball).unwrap().0.z;
     assert!(z < 8.0, "z = {z}");
 }
+
+/// A 10 g ball welded to two world points 3.7 m apart: the welds fight in every pass, and the
+/// impulses they carry into the next step are held to the warm-start bound, which the
+/// recording's counter `soft_step/bounded_joints` reports; the ball stays finite and under the
+/// 400 m/s speed bound for 2 s.
+#[test]
+fn two_fighting_welds_are_held_by_the_warm_start_bound_and_the_counter_reports_it() {
+    let mut app = common::app();
+    let ball = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.02),
+            Position::default(),
+            Velocity::default(),
+            Mass(0.01),
+        ))
+        .id();
+    for (local, world) in [
+        (Vec3::new(0.5, 0.0, 0.0), Vec3::new(-2.0, 0.0, 0.0)),
+        (Vec3::new(0.0, -0.7, 0.3), Vec3::new(1.0, 2.0, 0.5)),
+    ] {
+        app.world_mut()
+            .spawn(Joint::fixed(ball, JointEnd::World).with_anchors(local, world));
+    }
+    let mut steps_bounded = 0;
+    for _ in 0..120 {
+        urto::step(app.world_mut(), 1).unwrap();
+        let v = app.world().get::<Velocity>(ball).unwrap().0;
+        assert!(v.is_finite() && v.length() <= 400.0 * 1.001, "{v}");
+        let bounded = app
+            .world()
+            .resource::<PhysicsStats>()
+            .counter("soft_step/bounded_joints");
+        steps_bounded += usize::from(bounded.is_some_and(|n| n > 0.0));
+    }
+    assert!(steps_bounded > 0, "the counter never reported the bound");
+    assert!(app.world().get::<Quarantined>(ball).is_none());
+}

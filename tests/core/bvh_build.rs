@@ -122,9 +122,9 @@ fn procedural_and_scanned_meshes_build_valid_trees() {
 }
 
 /// The build splits and fits large meshes on several threads; the tree must not depend on how
-/// many (12,800 triangles, past the size below which it stays on one thread; a soup of random
-/// triangles, and the same torus scaled to 1e-3 and moved 1e4 away, where the summed moments'
-/// cancellation is worst).
+/// many (12,800 triangles, past the size below which it stays on one thread; a torus, the same
+/// torus scaled to 1e-2 and moved 100 away, and a soup of random triangles; leaves of 4 and of
+/// 5,000, which the threads must not split either).
 #[test]
 fn any_thread_count_builds_the_same_tree_bit_for_bit() {
     let mut rng = Rng::new(5);
@@ -133,26 +133,35 @@ fn any_thread_count_builds_the_same_tree_bit_for_bit() {
         vertices: big_torus
             .vertices
             .iter()
-            .map(|v| *v * 1e-3 + Vec3::new(1e4, -1e4, 5e3))
+            .map(|v| *v * 1e-2 + Vec3::new(100.0, -100.0, 50.0))
             .collect(),
         triangles: big_torus.triangles.clone(),
     };
     let meshes = [big_torus, far_small, soup(9000, 10.0, 0.3, &mut rng)];
     for mesh in &meshes {
         assert!(mesh.triangles.len() > 8192);
-        for rule in [BuildRule::Median, BuildRule::BinnedSah] {
+        for (rule, leaf_size) in [
+            (BuildRule::Median, 4),
+            (BuildRule::BinnedSah, 4),
+            (BuildRule::BinnedSah, 5000),
+        ] {
             let with = |threads| BuildOptions {
                 threads,
+                leaf_size,
                 ..BuildOptions::with_rule(rule)
             };
             let one = Bvh::<Obb>::build(&mesh.vertices, &mesh.triangles, &with(1)).unwrap();
-            check_structure(&one, mesh, 4);
+            check_structure(&one, mesh, leaf_size);
+            let one_aabb = Bvh::<Aabb>::build(&mesh.vertices, &mesh.triangles, &with(1)).unwrap();
             for threads in [0, 2, 3, 8] {
                 let many = Bvh::<Obb>::build(&mesh.vertices, &mesh.triangles, &with(threads));
                 assert!(many.unwrap() == one, "{threads} threads, {rule:?}");
+                let aabb = Bvh::<Aabb>::build(&mesh.vertices, &mesh.triangles, &with(threads));
+                assert!(
+                    aabb.unwrap() == one_aabb,
+                    "AABB, {threads} threads, {rule:?}"
+                );
             }
-            let aabb = Bvh::<Aabb>::build(&mesh.vertices, &mesh.triangles, &with(4)).unwrap();
-            check_structure(&aabb, mesh, 4);
         }
     }
 }

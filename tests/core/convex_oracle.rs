@@ -19,11 +19,8 @@
 //! - Hull–ball pairs are checked against an exact brute force over the hull's triangles instead:
 //!   parry 0.31 strays up to 3e-3 on flat random hulls.
 
-#[allow(dead_code)]
-use crate::common::rng;
-
+use crate::common::rng::Rng;
 use glam::{Quat, Vec3};
-use rng::Rng;
 use urto::geometry::contacts::contact;
 use urto::geometry::convex::signed_distance;
 use urto::geometry::{Isometry, Shape};

@@ -260,6 +260,8 @@ impl Solver {
         // the defaults rather than hang or spread NaN.
         let s = self.settings.validated().unwrap_or_default();
         self.settings = s;
+        // A step that returns early bounds nothing.
+        self.bounded_joints = 0;
         let substeps = s.substeps.max(1);
         let h = dt / substeps as f32;
         if !(h > 0.0 && h.is_finite()) {

@@ -264,7 +264,7 @@ fn solve_soft_step(
         );
     }
     stats.set_counter("soft_step/springs_clamped", clamped as f64);
-    stats.set_counter("soft_step/joints_bounded", s.solver.bounded_joints() as f64);
+    stats.set_counter("soft_step/bounded_joints", s.solver.bounded_joints() as f64);
     for (slot, &e) in s.entities.iter().enumerate() {
         if let Ok(m) = movers.get_mut(e)
             && !held(m.10, e, &s.waking)
