@@ -23,6 +23,7 @@ mod relative_pose;
 mod sphere;
 mod surface;
 pub(crate) mod symmetric_eigen;
+mod wide_box;
 
 pub use aabb::Aabb;
 pub use kdop::{Kdop, Kdop14, Kdop18, Kdop26, KdopRelative};
@@ -30,6 +31,7 @@ pub use obb::Obb;
 pub use relative_pose::{ABS_ROTATION_EPSILON, RELATIVE_SLACK, RelativePose};
 pub use sphere::BoundingSphere;
 pub use surface::{SurfaceMoments, TriangleSet};
+pub(crate) use wide_box::WideBox;
 
 use crate::geometry::Isometry;
 use glam::Vec3;

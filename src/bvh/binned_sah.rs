@@ -12,58 +12,15 @@
 //! Embree does): the bins are cheap next to fitting the nodes' BVs.
 
 use super::build::MAX_SAH_BINS;
-use crate::bounding::Aabb;
+use crate::bounding::WideBox;
 use glam::{Vec3, Vec3A};
 use wide::f32x4;
-
-/// An axis-aligned box in SIMD lanes: the binning's unions are one `minps`/`maxps` each (the
-/// scalar [`Aabb`]'s NaN-aware `min` costs four instructions per coordinate, and binning is
-/// most of a build). The mesh is checked finite before the build, so no NaN reaches these.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Bounds {
-    pub min: Vec3A,
-    pub max: Vec3A,
-}
-
-impl Bounds {
-    pub const EMPTY: Self = Self {
-        min: Vec3A::INFINITY,
-        max: Vec3A::NEG_INFINITY,
-    };
-
-    #[inline]
-    pub fn union(&self, other: &Self) -> Self {
-        Self {
-            min: self.min.min(other.min),
-            max: self.max.max(other.max),
-        }
-    }
-
-    #[inline]
-    pub fn including(&self, p: Vec3A) -> Self {
-        Self {
-            min: self.min.min(p),
-            max: self.max.max(p),
-        }
-    }
-
-    /// Surface area (0 when empty or flat).
-    #[inline]
-    fn area(&self) -> f32 {
-        let e = (self.max - self.min).max(Vec3A::ZERO);
-        2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
-    }
-
-    pub fn to_aabb(self) -> Aabb {
-        Aabb::new(self.min.into(), self.max.into())
-    }
-}
 
 /// What the builder needs of a triangle: its box and which triangle it is. The builder
 /// partitions these in place, so each node's primitives are contiguous.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Primitive {
-    pub bounds: Bounds,
+    pub bounds: WideBox,
     pub triangle: u32,
 }
 
@@ -71,7 +28,7 @@ impl Primitive {
     pub fn of_triangle(triangle: u32, corners: [Vec3; 3]) -> Self {
         let [a, b, c] = corners.map(Vec3A::from);
         Self {
-            bounds: Bounds {
+            bounds: WideBox {
                 min: a.min(b).min(c),
                 max: a.max(b).max(c),
             },
@@ -89,19 +46,19 @@ impl Primitive {
 }
 
 /// The centroids' box.
-pub(crate) fn centroid_bounds(run: &[Primitive]) -> Bounds {
+pub(crate) fn centroid_bounds(run: &[Primitive]) -> WideBox {
     run.iter()
-        .fold(Bounds::EMPTY, |b, p| b.including(p.centroid()))
+        .fold(WideBox::EMPTY, |b, p| b.including(p.centroid()))
 }
 
 #[derive(Clone, Copy)]
 struct Bin {
-    bounds: Bounds,
+    bounds: WideBox,
     count: u32,
 }
 
 const EMPTY_BIN: Bin = Bin {
-    bounds: Bounds::EMPTY,
+    bounds: WideBox::EMPTY,
     count: 0,
 };
 
@@ -116,7 +73,7 @@ struct Binning {
 }
 
 impl Binning {
-    fn new(bounds: &Bounds, bins: usize) -> Self {
+    fn new(bounds: &WideBox, bins: usize) -> Self {
         let extents = bounds.max - bounds.min;
         let scale = finite_positive_or_zero(Vec3A::splat(bins as f32 * (1.0 - 1e-6)) / extents);
         Self {
@@ -167,7 +124,7 @@ fn best_plane(bins: &[Bin], total: usize) -> Option<(f32, usize)> {
     for i in (1..n).rev() {
         acc.bounds = acc.bounds.union(&bins[i].bounds);
         acc.count += bins[i].count;
-        right_cost[i] = acc.bounds.area() * acc.count as f32;
+        right_cost[i] = acc.bounds.surface_area() * acc.count as f32;
     }
     let mut best: Option<(f32, usize)> = None;
     let mut left = EMPTY_BIN;
@@ -177,7 +134,7 @@ fn best_plane(bins: &[Bin], total: usize) -> Option<(f32, usize)> {
         if left.count == 0 || left.count as usize == total {
             continue;
         }
-        let cost = left.bounds.area() * left.count as f32 + right_cost[i];
+        let cost = left.bounds.surface_area() * left.count as f32 + right_cost[i];
         if best.is_none_or(|(c, _)| cost < c) {
             best = Some((cost, i));
         }

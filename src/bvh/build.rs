@@ -16,7 +16,7 @@
 use super::binned_sah::{Primitive, centroid_bounds};
 use super::topology::{PARALLEL_MIN_RUN, Span, split_top_down};
 use super::{Bvh, BvhError, BvhNode};
-use crate::bounding::{Bv, SurfaceMoments, TriangleSet};
+use crate::bounding::{Aabb, Bv, SurfaceMoments, TriangleSet};
 use glam::Vec3;
 
 /// Triangles per leaf unless told otherwise: small leaves keep `Ns` low, which pays when the
@@ -148,7 +148,7 @@ impl<B: Bv> Bvh<B> {
         let spans = split_top_down(&mut primitives, options, threads);
         let order: Vec<u32> = primitives.iter().map(|p| p.triangle).collect();
         let corners: Vec<[Vec3; 3]> = order.iter().map(|&t| corners_of(t)).collect();
-        let origin = centroid_bounds(&primitives).to_aabb().center();
+        let origin = Aabb::from(centroid_bounds(&primitives)).center();
         let surfaces = summed_surfaces(&spans, &corners, origin);
         let nodes = fit_nodes(&spans, &surfaces, &corners, threads);
         Ok(Self { nodes, order })

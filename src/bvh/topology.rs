@@ -12,6 +12,7 @@
 
 use super::binned_sah::{Primitive, SahBins, binned_sah_split, centroid_bounds};
 use super::build::{BuildOptions, BuildRule};
+use crate::bounding::Aabb;
 
 /// Runs shorter than this are never handed to another thread (the thread would cost more than
 /// the split work it takes over).
@@ -139,7 +140,7 @@ fn split(run: &mut [Primitive], options: &BuildOptions, bins: &mut SahBins) -> u
 /// coincident centroids) are broken by triangle index, so the split always halves the run and is
 /// deterministic.
 fn median_split(run: &mut [Primitive]) -> usize {
-    let axis = centroid_bounds(run).to_aabb().longest_axis();
+    let axis = Aabb::from(centroid_bounds(run)).longest_axis();
     let mid = run.len() / 2;
     run.select_nth_unstable_by(mid, |a, b| {
         a.centroid()[axis]

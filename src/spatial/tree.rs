@@ -8,7 +8,7 @@
 //! scene whose bodies only moved is refitted every step, rebuilt only when colliders come or
 //! go.
 
-use crate::bounding::Aabb;
+use crate::bounding::{Aabb, WideBox};
 use glam::{Vec3, Vec3A};
 
 /// Most items in a leaf.
@@ -33,55 +33,6 @@ pub struct AabbTree {
     boxes: Vec<WideBox>,
     /// Where each input item went in the leaf order (for refits).
     slot_of_input: Vec<u32>,
-}
-
-/// A box in 16-byte lanes (`Vec3A`), so that the slab and overlap tests of the traversal run
-/// as SIMD operations on all three axes at once.
-#[derive(Clone, Copy, Debug)]
-struct WideBox {
-    min: Vec3A,
-    max: Vec3A,
-}
-
-impl WideBox {
-    const EMPTY: Self = Self {
-        min: Vec3A::splat(f32::INFINITY),
-        max: Vec3A::splat(f32::NEG_INFINITY),
-    };
-
-    fn union(&self, other: &Self) -> Self {
-        Self {
-            min: self.min.min(other.min),
-            max: self.max.max(other.max),
-        }
-    }
-
-    #[inline(always)]
-    fn intersects(&self, other: &Self) -> bool {
-        self.min.cmple(other.max).all() && other.min.cmple(self.max).all()
-    }
-
-    /// The squared distance from `p` to the box (0 inside).
-    #[inline(always)]
-    fn distance_squared(&self, p: Vec3A) -> f32 {
-        let outside = (self.min - p).max(p - self.max).max(Vec3A::ZERO);
-        outside.length_squared()
-    }
-}
-
-impl From<Aabb> for WideBox {
-    fn from(b: Aabb) -> Self {
-        Self {
-            min: b.min.into(),
-            max: b.max.into(),
-        }
-    }
-}
-
-impl From<WideBox> for Aabb {
-    fn from(b: WideBox) -> Self {
-        Aabb::new(b.min.into(), b.max.into())
-    }
 }
 
 /// A ray against boxes: `origin + t·direction`, `t` in `[0, max]`.
