@@ -124,7 +124,8 @@ fn procedural_and_scanned_meshes_build_valid_trees() {
 /// The build splits and fits large meshes on several threads; the tree must not depend on how
 /// many (12,800 triangles, past the size below which it stays on one thread; a torus, the same
 /// torus scaled to 1e-2 and moved 100 away, and a soup of random triangles; leaves of 4 and of
-/// 5,000, which the threads must not split either).
+/// 5,000, which the threads must not split either; counts up to `usize::MAX`, capped at the
+/// machine's cores).
 #[test]
 fn any_thread_count_builds_the_same_tree_bit_for_bit() {
     let mut rng = Rng::new(5);
@@ -153,7 +154,7 @@ fn any_thread_count_builds_the_same_tree_bit_for_bit() {
             let one = Bvh::<Obb>::build(&mesh.vertices, &mesh.triangles, &with(1)).unwrap();
             check_structure(&one, mesh, leaf_size);
             let one_aabb = Bvh::<Aabb>::build(&mesh.vertices, &mesh.triangles, &with(1)).unwrap();
-            for threads in [0, 2, 3, 8] {
+            for threads in [0, 2, 3, 8, usize::MAX] {
                 let many = Bvh::<Obb>::build(&mesh.vertices, &mesh.triangles, &with(threads));
                 assert!(many.unwrap() == one, "{threads} threads, {rule:?}");
                 let aabb = Bvh::<Aabb>::build(&mesh.vertices, &mesh.triangles, &with(threads));
