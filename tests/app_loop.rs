@@ -128,3 +128,49 @@ fn an_interpolated_body_renders_smoothly_at_twice_the_step_rate_within_10_percen
     let p = app.world().get::<Position>(body).unwrap().0.x;
     assert!((p - x(&app, plain)).abs() < 1e-6);
 }
+
+#[test]
+fn app_run_under_schedule_runner_steps_at_60_hz_from_50_hz_frames_within_one_step() {
+    // A game's loop: `app.run()` under `ScheduleRunnerPlugin`, frames of 20 ms (each advances
+    // the clock by exactly that), an `Update` system that ends the game after 150 frames, and
+    // a `FixedUpdate` system of the game's own. The runner owns the app, so the exit system
+    // reports what it saw through shared counters.
+    use bevy_app::{AppExit, FixedUpdate, ScheduleRunnerPlugin, Update};
+    use bevy_ecs::prelude::*;
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicU64, Ordering};
+
+    let (steps, fixed_runs) = (Arc::new(AtomicU64::new(0)), Arc::new(AtomicU64::new(0)));
+    let mut app = App::new();
+    app.add_plugins((
+        TimePlugin,
+        UrtoPlugins::default(),
+        ScheduleRunnerPlugin::run_loop(Duration::ZERO),
+    ))
+    .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_millis(
+        20,
+    )));
+    app.world_mut().spawn(Velocity::new(1.0, 0.0, 0.0));
+    let counted = fixed_runs.clone();
+    app.add_systems(FixedUpdate, move || {
+        counted.fetch_add(1, Ordering::Relaxed);
+    });
+    let seen = steps.clone();
+    let mut frames = 0u32;
+    app.add_systems(
+        Update,
+        move |stats: Res<PhysicsStats>, mut exit: MessageWriter<AppExit>| {
+            frames += 1;
+            if frames == 151 {
+                seen.store(stats.step, Ordering::Relaxed);
+                exit.write(AppExit::Success);
+            }
+        },
+    );
+    assert_eq!(app.run(), AppExit::Success);
+    // 150 frames of 20 ms after the first = 3 s = 180 steps of 1/60 s, give or take the
+    // rounding of the two clocks' nanoseconds at the boundary.
+    let steps = steps.load(Ordering::Relaxed);
+    assert!((179..=180).contains(&steps), "{steps} steps");
+    assert_eq!(fixed_runs.load(Ordering::Relaxed), steps);
+}
