@@ -81,7 +81,7 @@ impl PointX4 {
 }
 
 /// Up to four contacts that move no common body, solved side by side.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct ContactBatch {
     /// Which constraint each lane holds (`None`: padding).
     constraints: [Option<u32>; LANES],
@@ -107,14 +107,28 @@ impl ContactBatch {
     /// Packs `indices` (1 to [`LANES`] constraints moving no common body) of `constraints`;
     /// `None` for no index, more than [`LANES`] or an index out of range.
     pub fn pack(indices: &[u32], constraints: &[ContactConstraint]) -> Option<Self> {
+        let mut batch = Self::default();
+        batch.repack(indices, constraints).then_some(batch)
+    }
+
+    /// [`Self::pack`] into this batch, in place (the solver refills last step's batches: a
+    /// batch is a few kilobytes, and building one to move it into the list copied it twice);
+    /// false, the batch unusable, where `pack` gives `None`. Only the points some lane has are
+    /// gathered: the passes never read past [`Self::count`].
+    pub fn repack(&mut self, indices: &[u32], constraints: &[ContactConstraint]) -> bool {
         if indices.is_empty() || indices.len() > LANES {
-            return None;
+            return false;
         }
         let mut lanes: [Option<&ContactConstraint>; LANES] = [None; LANES];
         for (lane, &i) in lanes.iter_mut().zip(indices) {
-            *lane = Some(constraints.get(i as usize)?);
+            match constraints.get(i as usize) {
+                Some(c) => *lane = Some(c),
+                None => return false,
+            }
         }
-        let first = lanes[0]?;
+        let Some(first) = lanes[0] else {
+            return false;
+        };
         let real = |l: usize| lanes[l].unwrap_or(first);
         let each = |f: fn(&ContactConstraint) -> f32| {
             Lanes::new(std::array::from_fn(|l| lanes[l].map_or(0.0, f)))
@@ -122,39 +136,39 @@ impl ContactBatch {
         let vectors = |f: fn(&ContactConstraint) -> Vec3| {
             Vec3x4::gather(std::array::from_fn(|l| lanes[l].map_or(Vec3::ZERO, f)))
         };
+        self.constraints = std::array::from_fn(|l| indices.get(l).copied());
+        self.bodies = [
+            std::array::from_fn(|l| real(l).a as usize),
+            std::array::from_fn(|l| real(l).b as usize),
+        ];
+        self.writes =
+            [0, 1].map(|k| std::array::from_fn(|l| lanes[l].is_some_and(|c| c.dynamic[k])));
+        self.normal = vectors(|c| c.normal);
+        self.tangents = [vectors(|c| c.tangents[0]), vectors(|c| c.tangents[1])];
+        self.friction = each(|c| c.friction);
+        self.inverse_mass = [each(|c| c.inverse_mass[0]), each(|c| c.inverse_mass[1])];
+        self.softness = [
+            each(|c| c.softness.mass_scale * c.softness.bias_rate),
+            each(|c| c.softness.mass_scale),
+            each(|c| c.softness.impulse_scale),
+        ];
+        self.closing_acceleration = each(|c| c.closing_acceleration);
+        self.count = lanes
+            .iter()
+            .flatten()
+            .map(|c| c.count as usize)
+            .max()
+            .unwrap_or(0)
+            .min(MAX_MANIFOLD_POINTS);
         let zero = ConstraintPoint::default();
-        let points = std::array::from_fn(|k| {
-            PointX4::gather(std::array::from_fn(|l| match lanes[l] {
+        for (k, point) in self.points[..self.count].iter_mut().enumerate() {
+            *point = PointX4::gather(std::array::from_fn(|l| match lanes[l] {
                 Some(c) if k < c.count as usize => &c.points[k],
                 _ => &zero,
-            }))
-        });
-        Some(Self {
-            constraints: std::array::from_fn(|l| indices.get(l).copied()),
-            bodies: [
-                std::array::from_fn(|l| real(l).a as usize),
-                std::array::from_fn(|l| real(l).b as usize),
-            ],
-            writes: [0, 1].map(|k| std::array::from_fn(|l| lanes[l].is_some_and(|c| c.dynamic[k]))),
-            normal: vectors(|c| c.normal),
-            tangents: [vectors(|c| c.tangents[0]), vectors(|c| c.tangents[1])],
-            friction: each(|c| c.friction),
-            inverse_mass: [each(|c| c.inverse_mass[0]), each(|c| c.inverse_mass[1])],
-            softness: [
-                each(|c| c.softness.mass_scale * c.softness.bias_rate),
-                each(|c| c.softness.mass_scale),
-                each(|c| c.softness.impulse_scale),
-            ],
-            closing_acceleration: each(|c| c.closing_acceleration),
-            points,
-            count: lanes
-                .iter()
-                .flatten()
-                .map(|c| c.count as usize)
-                .max()
-                .unwrap_or(0),
-            rubs: lanes.iter().flatten().any(|c| c.friction > 0.0),
-        })
+            }));
+        }
+        self.rubs = lanes.iter().flatten().any(|c| c.friction > 0.0);
+        true
     }
 
     /// Writes the impulses and approach speeds back into the constraints the lanes came from.
@@ -457,5 +471,25 @@ mod tests {
                 .any(|c| c.points().iter().any(|p| p.normal_impulse > 0.0))
         );
         assert_ne!(batch_states, bodies.states);
+    }
+
+    #[test]
+    fn a_batch_repacked_over_a_fuller_one_solves_bit_for_bit_as_a_fresh_pack() {
+        // The solver refills last step's batches in place: a batch that held four points per
+        // lane, refilled with contacts of two and one, must leave no trace of the old points.
+        let (bodies, constraints) = scene();
+        let solve = |batch: &mut ContactBatch| {
+            let mut states = bodies.states.clone();
+            batch.warm_start(&mut states);
+            batch.solve(&mut states, 240.0, 3.0, true, false);
+            batch.solve(&mut states, 240.0, 3.0, false, true);
+            states
+        };
+        let mut reused = ContactBatch::pack(&[0], &constraints).unwrap();
+        assert!(reused.repack(&[1, 2], &constraints));
+        let mut fresh = ContactBatch::pack(&[1, 2], &constraints).unwrap();
+        assert_eq!(solve(&mut reused), solve(&mut fresh));
+        // A refused repack says so.
+        assert!(!reused.repack(&[9], &constraints));
     }
 }

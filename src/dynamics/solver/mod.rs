@@ -507,13 +507,16 @@ impl Solver {
             s.warm_start_distance,
         );
         self.batching.pack(&self.constraints, bodies.len());
-        let constraints = &self.constraints;
-        self.batches.clear();
-        self.batches.extend(
-            self.batching
-                .batches()
-                .filter_map(|indices| ContactBatch::pack(indices, constraints)),
-        );
+        let mut used = 0;
+        for indices in self.batching.batches() {
+            if used == self.batches.len() {
+                self.batches.push(ContactBatch::default());
+            }
+            if self.batches[used].repack(indices, &self.constraints) {
+                used += 1;
+            }
+        }
+        self.batches.truncate(used);
     }
 }
 
