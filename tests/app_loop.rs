@@ -150,27 +150,36 @@ fn app_run_under_schedule_runner_steps_at_60_hz_from_50_hz_frames_within_one_ste
     .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_millis(
         20,
     )));
-    app.world_mut().spawn(Velocity::new(1.0, 0.0, 0.0));
+    let body = app.world_mut().spawn(Velocity::new(1.0, 0.0, 0.0)).id();
     let counted = fixed_runs.clone();
     app.add_systems(FixedUpdate, move || {
         counted.fetch_add(1, Ordering::Relaxed);
     });
-    let seen = steps.clone();
+    let (seen, travelled) = (steps.clone(), Arc::new(AtomicU64::new(0)));
+    let moved = travelled.clone();
     let mut frames = 0u32;
     app.add_systems(
         Update,
-        move |stats: Res<PhysicsStats>, mut exit: MessageWriter<AppExit>| {
+        move |stats: Res<PhysicsStats>,
+              bodies: Query<&Position>,
+              mut exit: MessageWriter<AppExit>| {
             frames += 1;
             if frames == 151 {
                 seen.store(stats.step, Ordering::Relaxed);
+                let x = bodies.get(body).map_or(f32::NAN, |p| p.0.x);
+                moved.store(u64::from(x.to_bits()), Ordering::Relaxed);
                 exit.write(AppExit::Success);
             }
         },
     );
     assert_eq!(app.run(), AppExit::Success);
-    // 150 frames of 20 ms after the first = 3 s = 180 steps of 1/60 s, give or take the
-    // rounding of the two clocks' nanoseconds at the boundary.
+    // 150 frames of 20 ms after the first = 3 s: 180 steps of 1/60 s, or 179 where the f32
+    // step (a hair over 1/60 s) puts the 180th just past 3 s.
     let steps = steps.load(Ordering::Relaxed);
     assert!((179..=180).contains(&steps), "{steps} steps");
     assert_eq!(fixed_runs.load(Ordering::Relaxed), steps);
+    // And the steps moved the body: 1 m/s for `steps` steps.
+    let x = f32::from_bits(travelled.load(Ordering::Relaxed) as u32);
+    let expected = steps as f32 / 60.0;
+    assert!((x - expected).abs() < 1e-3, "x = {x}, expected {expected}");
 }

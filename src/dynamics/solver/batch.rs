@@ -113,8 +113,8 @@ impl ContactBatch {
 
     /// [`Self::pack`] into this batch, in place (the solver refills last step's batches: a
     /// batch is a few kilobytes, and building one to move it into the list copied it twice);
-    /// false, the batch unusable, where `pack` gives `None`. Only the points some lane has are
-    /// gathered: the passes never read past [`Self::count`].
+    /// false, the batch left as it was, where `pack` gives `None`. Only the points some lane
+    /// has are gathered: the passes never read past [`Self::count`].
     pub fn repack(&mut self, indices: &[u32], constraints: &[ContactConstraint]) -> bool {
         if indices.is_empty() || indices.len() > LANES {
             return false;
@@ -158,8 +158,11 @@ impl ContactBatch {
             .flatten()
             .map(|c| c.count as usize)
             .max()
-            .unwrap_or(0)
-            .min(MAX_MANIFOLD_POINTS);
+            .unwrap_or(0);
+        debug_assert!(
+            self.count <= MAX_MANIFOLD_POINTS,
+            "prepare caps a contact's points"
+        );
         let zero = ConstraintPoint::default();
         for (k, point) in self.points[..self.count].iter_mut().enumerate() {
             *point = PointX4::gather(std::array::from_fn(|l| match lanes[l] {
@@ -475,8 +478,8 @@ mod tests {
 
     #[test]
     fn a_batch_repacked_over_a_fuller_one_solves_bit_for_bit_as_a_fresh_pack() {
-        // The solver refills last step's batches in place: a batch that held four points per
-        // lane, refilled with contacts of two and one, must leave no trace of the old points.
+        // The solver refills last step's batches in place: a batch whose lane 0 held four
+        // points, refilled with contacts of two and one, must leave no trace of the old ones.
         let (bodies, constraints) = scene();
         let solve = |batch: &mut ContactBatch| {
             let mut states = bodies.states.clone();
@@ -489,6 +492,18 @@ mod tests {
         assert!(reused.repack(&[1, 2], &constraints));
         let mut fresh = ContactBatch::pack(&[1, 2], &constraints).unwrap();
         assert_eq!(solve(&mut reused), solve(&mut fresh));
+        let unpacked = |batch: &ContactBatch| {
+            let mut out = constraints.clone();
+            batch.unpack(&mut out);
+            out
+        };
+        assert_eq!(unpacked(&reused), unpacked(&fresh));
+        // Three lanes down to one: the lanes left over hold nothing of before.
+        let mut shrunk = ContactBatch::pack(&[0, 1, 2], &constraints).unwrap();
+        assert!(shrunk.repack(&[2], &constraints));
+        let mut single = ContactBatch::pack(&[2], &constraints).unwrap();
+        assert_eq!(solve(&mut shrunk), solve(&mut single));
+        assert_eq!(unpacked(&shrunk), unpacked(&single));
         // A refused repack says so.
         assert!(!reused.repack(&[9], &constraints));
     }

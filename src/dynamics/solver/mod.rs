@@ -512,9 +512,9 @@ impl Solver {
             if used == self.batches.len() {
                 self.batches.push(ContactBatch::default());
             }
-            if self.batches[used].repack(indices, &self.constraints) {
-                used += 1;
-            }
+            let packed = self.batches[used].repack(indices, &self.constraints);
+            debug_assert!(packed, "the batching hands out 1 to 4 valid indices");
+            used += usize::from(packed);
         }
         self.batches.truncate(used);
     }
