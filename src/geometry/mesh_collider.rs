@@ -110,6 +110,11 @@ impl PartialEq for MeshCollider {
 
 impl MeshCollider {
     /// Builds the hierarchy of `mesh` (binned SAH, default leaf size), named `"mesh"`.
+    ///
+    /// A mesh of a few thousand triangles or more is built on scoped threads, as many as the
+    /// machine has ([`BuildOptions::threads`] `0`), joined before this returns; the tree is
+    /// the same as a one-thread build's. A game that wants the build off its main thread calls
+    /// this from a task of its own.
     pub fn new(mesh: TriMesh) -> Result<Self, MeshColliderError> {
         Self::named("mesh", mesh)
     }
