@@ -138,7 +138,7 @@ fn app_run_under_schedule_runner_steps_at_60_hz_from_50_hz_frames_within_one_ste
     use bevy_app::{AppExit, FixedUpdate, ScheduleRunnerPlugin, Update};
     use bevy_ecs::prelude::*;
     use std::sync::Arc;
-    use std::sync::atomic::{AtomicU64, Ordering};
+    use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 
     let (steps, fixed_runs) = (Arc::new(AtomicU64::new(0)), Arc::new(AtomicU64::new(0)));
     let mut app = App::new();
@@ -155,7 +155,7 @@ fn app_run_under_schedule_runner_steps_at_60_hz_from_50_hz_frames_within_one_ste
     app.add_systems(FixedUpdate, move || {
         counted.fetch_add(1, Ordering::Relaxed);
     });
-    let (seen, travelled) = (steps.clone(), Arc::new(AtomicU64::new(0)));
+    let (seen, travelled) = (steps.clone(), Arc::new(AtomicU32::new(0)));
     let moved = travelled.clone();
     let mut frames = 0u32;
     app.add_systems(
@@ -167,7 +167,7 @@ fn app_run_under_schedule_runner_steps_at_60_hz_from_50_hz_frames_within_one_ste
             if frames == 151 {
                 seen.store(stats.step, Ordering::Relaxed);
                 let x = bodies.get(body).map_or(f32::NAN, |p| p.0.x);
-                moved.store(u64::from(x.to_bits()), Ordering::Relaxed);
+                moved.store(x.to_bits(), Ordering::Relaxed);
                 exit.write(AppExit::Success);
             }
         },
@@ -179,7 +179,7 @@ fn app_run_under_schedule_runner_steps_at_60_hz_from_50_hz_frames_within_one_ste
     assert!((179..=180).contains(&steps), "{steps} steps");
     assert_eq!(fixed_runs.load(Ordering::Relaxed), steps);
     // And the steps moved the body: 1 m/s for `steps` steps.
-    let x = f32::from_bits(travelled.load(Ordering::Relaxed) as u32);
+    let x = f32::from_bits(travelled.load(Ordering::Relaxed));
     let expected = steps as f32 / 60.0;
     assert!((x - expected).abs() < 1e-3, "x = {x}, expected {expected}");
 }

@@ -14,7 +14,7 @@
 use super::box_sat::all_axes;
 use super::covariance::points_covariance;
 use super::symmetric_eigen::symmetric_eigen_within;
-use super::{Aabb, Bv, RelativePose, TriangleSet, rounding_pad};
+use super::{Aabb, Bv, RelativePose, TriangleSet, WideBox, rounding_pad};
 use crate::geometry::Isometry;
 use glam::{BVec3A, DMat3, Mat3, Mat3A, Vec3, Vec3A};
 
@@ -88,33 +88,30 @@ impl Obb {
     }
 }
 
-/// The projections of points on a box's axes: their least and greatest, in SIMD lanes, and
-/// the lanes in which a NaN came by (SIMD `min` forgets a NaN at the next finite value, where
-/// the scalar one ignores it: either way the box would not hold that point).
+/// The projections of points on a box's axes: their box in SIMD lanes ([`WideBox`]), and the
+/// lanes in which a NaN came by (SIMD `min` forgets a NaN at the next finite value, where the
+/// scalar one ignores it: either way the box would not hold that point).
 struct Interval {
-    lo: Vec3A,
-    hi: Vec3A,
+    bounds: WideBox,
     nan: BVec3A,
 }
 
 impl Interval {
     const EMPTY: Self = Self {
-        lo: Vec3A::INFINITY,
-        hi: Vec3A::NEG_INFINITY,
+        bounds: WideBox::EMPTY,
         nan: BVec3A::FALSE,
     };
 
     #[inline]
     fn include(&mut self, q: Vec3A) {
-        self.lo = self.lo.min(q);
-        self.hi = self.hi.max(q);
+        self.bounds = self.bounds.including(q);
         self.nan |= q.is_nan_mask();
     }
 
     /// The box over the interval in the frame `axes`, padded against rounding; a zero box at
     /// the origin when the interval is empty or saw a non-finite point.
     fn into_box(self, axes: Mat3) -> Obb {
-        let (lo, hi) = (Vec3::from(self.lo), Vec3::from(self.hi));
+        let (lo, hi) = (Vec3::from(self.bounds.min), Vec3::from(self.bounds.max));
         // An infinite point leaves an infinite bound; a NaN one only its mark.
         if self.nan.any() || !(lo.is_finite() && hi.is_finite() && lo.cmple(hi).all()) {
             return Obb {

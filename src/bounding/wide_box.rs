@@ -1,8 +1,9 @@
 //! [`WideBox`]: an axis-aligned box in 16-byte SIMD lanes (`Vec3A`), for the loops that handle
-//! many boxes: the query tree's slab and overlap tests (`spatial/tree.rs`) and the hierarchy
-//! build's SAH bins (`bvh/binned_sah.rs`). A union is one `minps`/`maxps` pair, where the
+//! many boxes or points: the query tree's slab and overlap tests (`spatial/tree.rs`), the
+//! hierarchy build's SAH bins (`bvh/binned_sah.rs`) and the OBB fit's projections
+//! (`bounding/obb.rs`). A union is one `minps`/`maxps` pair, where the
 //! scalar [`Aabb`]'s NaN-aware `min` costs four instructions a coordinate. Callers keep NaN
-//! out (SIMD `min` forgets it at the next finite value).
+//! out or mark it (SIMD `min` forgets it at the next finite value).
 
 use super::Aabb;
 use glam::Vec3A;

@@ -195,12 +195,9 @@ fn fit_nodes<B: Bv>(
         let spawned: Vec<_> = others
             .iter()
             .map(|run| {
-                let run = run.clone();
-                let fit_run = &fit_run;
-                (
-                    run.clone(),
-                    std::thread::Builder::new().spawn_scoped(scope, move || fit_run(run)),
-                )
+                let (fit_run, mine) = (&fit_run, run.clone());
+                let handle = std::thread::Builder::new().spawn_scoped(scope, move || fit_run(mine));
+                (run.clone(), handle)
             })
             .collect();
         // This thread fits the last run while the others work.
