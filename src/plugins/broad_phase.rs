@@ -90,8 +90,7 @@ impl BroadPhaseIndex {
             moving: (plugin.moving)(),
             grid: StaticGrid::new(plugin.grid).unwrap_or_else(|e| {
                 log::error!("urto: bad static grid settings ({e}); using the defaults");
-                // The default configuration is valid by construction, so this cannot fail.
-                StaticGrid::new(StaticGridConfig::default()).expect("default grid config")
+                StaticGrid::default()
             }),
             grid_config: plugin.grid,
             proxies: ProxyTable::default(),

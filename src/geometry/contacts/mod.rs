@@ -55,6 +55,7 @@ mod capsule_halfspace;
 mod capsule_sphere;
 mod closest_segment_points;
 mod convex_convex;
+mod cuboid_axes;
 mod cuboid_cuboid;
 mod cuboid_halfspace;
 mod manifold_cache;
