@@ -12,7 +12,8 @@
 //!   `Transform` (a teleport the next step reads).
 //! - A turret fires a bullet when a ray cast (`SpatialQuery::cast_ray`) sees the player; bullets
 //!   are in a layer that ignores the other bullets, run with `Ccd`, and are despawned when they
-//!   hit the player (an observer on the player) or after three seconds (entities removed while
+//!   hit the player (an observer on the player, which also sums the hits' impact speeds and
+//!   impulses from the event's `ContactData`) or after three seconds (entities removed while
 //!   the game runs).
 //! - The `CollisionStarted` messages are read once per frame (in `Last`, where a renderer draws); the player's drawn
 //!   `Transform` is interpolated between fixed steps (`TransformInterpolation`).
@@ -101,6 +102,10 @@ struct Score {
     goals: u32,
     shots: u32,
     hits: u32,
+    /// The hits' impact speeds (m/s) and their summed normal impulse (N·s), from the contact
+    /// data each collision start carries.
+    hit_speeds: Vec<f32>,
+    hit_impulse: f32,
     expired: u32,
     collisions_started: u32,
     frames: u32,
@@ -258,6 +263,10 @@ fn take_a_hit(
 ) {
     if bullets.contains(event.other) {
         score.hits += 1;
+        if let Some(contact) = event.contact {
+            score.hit_speeds.push(contact.impact_speed);
+            score.hit_impulse += contact.normal_impulse;
+        }
         commands.entity(event.other).try_despawn();
     }
 }
@@ -467,6 +476,16 @@ fn end_after_playtime(
         score.expired,
         score.shots.saturating_sub(score.hits + score.expired)
     );
+    let (slowest, fastest) = (score.hit_speeds.iter())
+        .fold((f32::INFINITY, 0.0f32), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        });
+    if !score.hit_speeds.is_empty() {
+        println!(
+            "  the hits' contact data: impact speeds {slowest:.1} to {fastest:.1} m/s, normal impulses {:.1} N·s in all",
+            score.hit_impulse
+        );
+    }
     println!(
         "  collisions started (messages read once a frame): {}",
         score.collisions_started

@@ -66,7 +66,7 @@ pub mod prelude {
     pub use crate::dynamics::solver::SoftStepSettings;
     pub use crate::plugins::{
         CollisionEnd, CollisionEnded, CollisionEventsEnabled, CollisionStart, CollisionStarted,
-        PointProjection, RayHit, SoftStepPlugin, SpatialQuery, SpatialQueryFilter,
+        ContactData, PointProjection, RayHit, SoftStepPlugin, SpatialQuery, SpatialQueryFilter,
         TransformInterpolation, UrtoPlugins,
     };
     pub use crate::schedule::{PhysicsSchedule, PhysicsSet, SubstepSchedule, SubstepSet};

@@ -435,3 +435,133 @@ fn a_fast_ball_under_ccd_passes_through_a_thin_sensor_wall() {
     let x = app.world().get::<Position>(fast).unwrap().0.x;
     assert!(x > 2.5, "{x}");
 }
+
+/// The starts read since `cursor`, each with its contact.
+fn starts_with_contact(
+    app: &bevy_app::App,
+    cursor: &mut bevy_ecs::message::MessageCursor<CollisionStarted>,
+) -> Vec<CollisionStarted> {
+    let messages = app.world().resource::<Messages<CollisionStarted>>();
+    cursor.read(messages).copied().collect()
+}
+
+/// `m`'s contact seen from `first`.
+fn contact_from(m: &CollisionStarted, first: Entity) -> ContactData {
+    let c = m.contact.expect("a contact, not a sensor overlap");
+    if m.a == first { c } else { c.flipped() }
+}
+
+#[test]
+fn a_dropped_ball_reports_its_impact_speed_within_2_percent_and_its_normal_within_1e_4() {
+    let (mass, h, g) = (2.0, 1.8, 9.8);
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    let ground = app
+        .world_mut()
+        .spawn((Collider::half_space(Vec3::Z), Static, Restitution(0.0)))
+        .id();
+    let b = ball(
+        &mut app,
+        Vec3::new(0.3, -0.2, 0.5 + h),
+        Vec3::ZERO,
+        mass,
+        0.0,
+    );
+    let mut cursor = app
+        .world()
+        .resource::<Messages<CollisionStarted>>()
+        .get_cursor();
+    let mut starts = Vec::new();
+    for _ in 0..60 {
+        urto::step(app.world_mut(), 1).unwrap();
+        starts.extend(starts_with_contact(&app, &mut cursor));
+    }
+    assert_eq!(starts.len(), 1, "{starts:?}");
+    let c = contact_from(&starts[0], b);
+    let v = (2.0 * g * h).sqrt();
+    assert_eq!((c.collider, c.other_collider), (b, ground));
+    // Restitution 0: the one point's push in the first substep stops the ball (m v).
+    assert!((c.normal_impulse / (mass * v) - 1.0).abs() < 0.03, "{c:?}");
+    assert!(c.manifold.normal.dot(-Vec3::Z) > 1.0 - 1e-4, "{c:?}");
+    assert!(
+        (c.impact_speed / v - 1.0).abs() < 0.02,
+        "{} vs {v}",
+        c.impact_speed
+    );
+    assert!(!c.manifold.is_empty());
+    for p in c.manifold.points() {
+        assert!(
+            (p.point.truncate() - glam::Vec2::new(0.3, -0.2)).length() < 1e-3,
+            "{p:?}"
+        );
+        // Detected up to one step's fall (v dt) before it touched: midway, at most half of it.
+        assert!(p.point.z.abs() < 0.5 * v / 60.0, "{p:?}");
+    }
+}
+
+#[test]
+fn a_compound_reports_the_part_that_hit_and_both_sides_see_one_contact_normal_within_1e_6() {
+    #[derive(Resource, Default)]
+    struct Seen(Vec<CollisionStart>);
+    let mut app = common::app();
+    app.init_resource::<Seen>();
+    app.world_mut()
+        .add_observer(|e: On<CollisionStart>, mut seen: ResMut<Seen>| seen.0.push(*e));
+    // A dumbbell flying along +x, its lower bell leading: the bell is what hits the wall.
+    let dumbbell = app
+        .world_mut()
+        .spawn((
+            Position::new(-3.0, 0.0, 0.0),
+            Velocity(Vec3::new(4.0, 0.0, 0.0)),
+            CollisionEventsEnabled,
+        ))
+        .id();
+    let spawn_bell = |app: &mut bevy_app::App, at: Vec3| {
+        let part = (Collider::sphere(0.3), Position(at), ChildOf(dumbbell));
+        app.world_mut().spawn(part).id()
+    };
+    let leading = spawn_bell(&mut app, Vec3::new(0.5, 0.0, 0.0));
+    spawn_bell(&mut app, Vec3::new(-0.5, 0.0, 0.0));
+    let wall = app
+        .world_mut()
+        .spawn((
+            Collider::cuboid(0.1, 2.0, 2.0),
+            Position::new(0.0, 0.0, 0.0),
+            Velocity::default(),
+            Mass(50.0),
+            CollisionEventsEnabled,
+        ))
+        .id();
+    // And a sensor the dumbbell starts in: an overlap, no contact.
+    let zone = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(-3.0, 0.0, 0.0),
+            Static,
+            Sensor,
+        ))
+        .id();
+    urto::step(app.world_mut(), 60).unwrap();
+    let seen = &app.world().resource::<Seen>().0;
+    let between = |entity: Entity, other: Entity| -> Vec<&CollisionStart> {
+        let pair = |e: &&CollisionStart| e.entity == entity && e.other == other;
+        seen.iter().filter(pair).collect()
+    };
+    let (from_bell, from_wall) = (between(dumbbell, wall), between(wall, dumbbell));
+    assert_eq!((from_bell.len(), from_wall.len()), (1, 1), "{seen:?}");
+    let sensed = between(dumbbell, zone);
+    // (Entered again after the bounce off the heavy wall.)
+    assert!(!sensed.is_empty(), "{seen:?}");
+    assert!(sensed.iter().all(|e| e.contact.is_none()), "{seen:?}");
+    let (c, w) = (from_bell[0].contact.unwrap(), from_wall[0].contact.unwrap());
+    assert_eq!((c.collider, c.other_collider), (leading, wall));
+    assert_eq!((w.collider, w.other_collider), (wall, leading));
+    assert!((c.manifold.normal - Vec3::X).length() < 1e-6, "{c:?}");
+    assert!((w.manifold.normal + Vec3::X).length() < 1e-6, "{w:?}");
+    assert!((c.impact_speed - 4.0).abs() < 1e-3 * 4.0, "{c:?}");
+    assert_eq!(
+        (c.impact_speed, c.normal_impulse),
+        (w.impact_speed, w.normal_impulse)
+    );
+}

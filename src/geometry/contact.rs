@@ -88,6 +88,21 @@ impl ContactManifold {
         self.points().iter().any(|p| p.depth >= -tolerance)
     }
 
+    /// The points closer than `tolerance` (where the shapes touch), or every point when none
+    /// is that close (a speculative contact the solver stopped at the surface: its points
+    /// are where the bodies met).
+    #[must_use]
+    pub fn touching_points(&self, tolerance: f32) -> Self {
+        if !self.touching(tolerance) {
+            return *self;
+        }
+        let mut out = Self::new(self.normal);
+        for &p in self.points().iter().filter(|p| p.depth >= -tolerance) {
+            out.push(p);
+        }
+        out
+    }
+
     /// The manifold of a local frame carried to the frame `pose` places it in (normal turned,
     /// points moved, depths kept).
     #[must_use]
@@ -122,5 +137,29 @@ impl ContactManifold {
     pub fn flipped(mut self) -> Self {
         self.normal = -self.normal;
         self
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn manifold(depths: &[f32]) -> ContactManifold {
+        let mut m = ContactManifold::new(Vec3::Z);
+        for (i, &depth) in depths.iter().enumerate() {
+            let point = Vec3::new(i as f32, 0.0, 0.0);
+            m.push(ContactPoint { point, depth });
+        }
+        m
+    }
+
+    #[test]
+    fn touching_points_drop_points_apart_beyond_the_tolerance_unless_none_is_within_it() {
+        let tipping = manifold(&[0.01, -0.004, -0.2, -0.5]).touching_points(0.005);
+        let depths: Vec<f32> = tipping.points().iter().map(|p| p.depth).collect();
+        assert_eq!(depths, [0.01, -0.004]);
+        assert_eq!(tipping.normal, Vec3::Z);
+        let approaching = manifold(&[-0.2, -0.3]);
+        assert_eq!(approaching.touching_points(0.005), approaching);
     }
 }

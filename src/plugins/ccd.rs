@@ -262,6 +262,7 @@ fn sweep_fast_bodies(
                 collider_b: leaf,
                 manifold: ContactManifold::single(-hit.normal, hit.point, 0.0),
                 normal_impulse: 0.0,
+                impact_speed: approach.max(0.0),
             });
         }
         // Impacts left over (max_impacts reached): stay at the last impact point.

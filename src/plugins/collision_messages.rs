@@ -1,5 +1,6 @@
 //! Collision started / ended messages: each substep's touching pairs compared with the last
-//! substep's, and likewise the overlaps of [`Sensor`]s (which the solver never sees).
+//! substep's, and likewise the overlaps of [`Sensor`]s (which the solver never sees). A start
+//! carries the [`ContactData`] of the pair's strongest collider contact (`collision_data.rs`).
 //!
 //! Pairs of sleeping or static bodies are not tested (nothing moved), so they are not in the
 //! substep's contacts; they are kept aside, sorted, as the *dormant* pairs, and looked at again
@@ -8,8 +9,9 @@
 //! island's contacts in the island's solver set, out of the awake contact array), and falling
 //! asleep ends no collision.
 
+pub use super::collision_data::ContactData;
 use crate::components::*;
-use crate::plugins::narrow_phase::{Contacts, SensorOverlaps};
+use crate::plugins::narrow_phase::{ContactPair, Contacts, SensorOverlaps};
 use crate::plugins::required_resources::RequireResource;
 use crate::plugins::sleep::{Waker, dormant};
 use crate::stats::PhysicsStats;
@@ -18,12 +20,15 @@ use bevy_ecs::message::Messages;
 use bevy_ecs::prelude::*;
 
 /// Two bodies started touching this step (`a < b`).
-#[derive(Message, Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Message, Debug, Clone, Copy, PartialEq)]
 pub struct CollisionStarted {
     /// One body.
     pub a: Entity,
     /// The other.
     pub b: Entity,
+    /// How they met, from `a` to `b` (of the pair's colliders, the contact the solver pushed
+    /// hardest); `None` for a [`Sensor`]'s overlap, for which no contact is computed.
+    pub contact: Option<ContactData>,
 }
 
 /// Two bodies stopped touching this step (`a < b`).
@@ -44,13 +49,16 @@ pub struct CollisionEventsEnabled;
 
 /// Triggered on an entity with [`CollisionEventsEnabled`] when it starts touching `other`
 /// (after [`CollisionStarted`]; sensors' overlaps too).
-#[derive(EntityEvent, Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(EntityEvent, Clone, Copy, Debug, PartialEq)]
 pub struct CollisionStart {
     /// The entity observed.
     #[event_target]
     pub entity: Entity,
     /// What it touches.
     pub other: Entity,
+    /// How they met, seen from `entity` (normal towards `other`); `None` for a sensor's
+    /// overlap.
+    pub contact: Option<ContactData>,
 }
 
 /// Triggered on an entity with [`CollisionEventsEnabled`] when it stops touching `other`.
@@ -97,6 +105,10 @@ pub(crate) struct TouchingPairs {
 /// Whether the bodies of a pair are both static or asleep.
 use crate::plugins::narrow_phase::Dormancy;
 
+/// A pair touching in this substep, with the index of its strongest contact in [`Contacts`]
+/// (of the pair's collider contacts, the one the solver pushed hardest; the first on a tie).
+type Touch = (Pair, u32);
+
 /// Compares this substep's touching pairs with the last one's; when a pair ends, a sleeping
 /// body in it wakes (what it rested on moved away or vanished).
 #[allow(clippy::too_many_arguments)]
@@ -108,27 +120,20 @@ pub(crate) fn report_collisions(
     mut unfixed: RemovedComponents<Static>,
     mut despawned: RemovedComponents<BoundingVolume>,
     overlaps: Option<Res<SensorOverlaps>>,
-    mut fresh: Local<Vec<Pair>>,
+    mut fresh: Local<Vec<Touch>>,
     mut previous: Local<Vec<Pair>>,
+    mut sensed: Local<Vec<Pair>>,
     mut started: MessageWriter<CollisionStarted>,
     mut ended: MessageWriter<CollisionEnded>,
     mut waker: Waker,
     mut stats: ResMut<PhysicsStats>,
 ) {
-    fresh.clear();
-    fresh.extend(
-        contacts
-            .pairs
-            .iter()
-            .filter(|c| c.normal_impulse > 0.0 || c.manifold.touching(TOUCHING_TOLERANCE))
-            .map(|c| (c.a.min(c.b), c.a.max(c.b))),
-    );
-    fresh.sort_unstable();
-    fresh.dedup();
+    touching_now(&contacts, &mut fresh);
     let touching = &mut *touching;
     let is_dormant = |e: Entity, bodies: &Query<(Dormancy, Option<&mut SleepState>)>| {
         dormant(bodies.get(e).ok().map(|(d, _)| d))
     };
+    let is_fresh = |pair: &Pair, fresh: &[Touch]| fresh.binary_search_by_key(pair, |t| t.0);
     // Dormant pairs come back into play only after something woke or went.
     let stirred = woke.read().count() + unfixed.read().count() + despawned.read().count() > 0;
     previous.clear();
@@ -149,7 +154,7 @@ pub(crate) fn report_collisions(
     // Each pair touching before is touching still, newly dormant (not tested now), or ended.
     let mut newly_dormant = false;
     for &(a, b) in previous.iter() {
-        if fresh.binary_search(&(a, b)).is_ok() {
+        if is_fresh(&(a, b), &fresh).is_ok() {
             continue;
         }
         if is_dormant(a, &bodies) && is_dormant(b, &bodies) {
@@ -168,7 +173,7 @@ pub(crate) fn report_collisions(
         touching.dormant.sort_unstable();
     }
     let mut resumed = false;
-    for &pair in fresh.iter() {
+    for &(pair, contact) in fresh.iter() {
         if previous.binary_search(&pair).is_ok() {
             continue;
         }
@@ -178,21 +183,24 @@ pub(crate) fn report_collisions(
             resumed = true;
             continue;
         }
+        let data = |c: &ContactPair| ContactData::of_pair(c, pair.0, TOUCHING_TOLERANCE);
         started.write(CollisionStarted {
             a: pair.0,
             b: pair.1,
+            contact: contacts.pairs.get(contact as usize).map(data),
         });
     }
     if resumed {
         touching.dormant.retain(|p| p.0 != Entity::PLACEHOLDER);
     }
-    touching.active.clone_from(&fresh);
+    touching.active.clear();
+    touching.active.extend(fresh.iter().map(|t| t.0));
     if let Some(overlaps) = overlaps {
-        fresh.clear();
-        fresh.extend(overlaps.pairs.iter().map(|p| (p.a.min(p.b), p.a.max(p.b))));
+        sensed.clear();
+        sensed.extend(overlaps.pairs.iter().map(|p| (p.a.min(p.b), p.a.max(p.b))));
         let dormant_pair = |(a, b): Pair| is_dormant(a, &bodies) && is_dormant(b, &bodies);
         report_sensors(
-            &mut fresh,
+            &mut sensed,
             &mut touching.sensing,
             dormant_pair,
             &mut started,
@@ -202,6 +210,26 @@ pub(crate) fn report_collisions(
     // Every pair touching now, tested this substep or at rest asleep.
     let all = touching.active.len() + touching.dormant.len();
     stats.set_counter("collisions/touching_pairs", all as f64);
+}
+
+/// This substep's touching body pairs (a contact within [`TOUCHING_TOLERANCE`], or one the
+/// solver pushed along), each once with its strongest contact, sorted.
+fn touching_now(contacts: &Contacts, fresh: &mut Vec<Touch>) {
+    fresh.clear();
+    fresh.extend(
+        (contacts.pairs.iter().zip(0u32..))
+            .filter(|(c, _)| c.normal_impulse > 0.0 || c.manifold.touching(TOUCHING_TOLERANCE))
+            .map(|(c, i)| ((c.a.min(c.b), c.a.max(c.b)), i)),
+    );
+    fresh.sort_unstable();
+    let impulse = |i: u32| contacts.pairs[i as usize].normal_impulse;
+    fresh.dedup_by(|later, kept| {
+        let same = later.0 == kept.0;
+        if same && impulse(later.1) > impulse(kept.1) {
+            kept.1 = later.1;
+        }
+        same
+    });
 }
 
 /// The sensor overlaps' messages: `fresh` (this substep's pairs) against `sensing` (the last
@@ -230,7 +258,11 @@ fn report_sensors(
     }
     for &(a, b) in fresh.iter() {
         if sensing.binary_search(&(a, b)).is_err() {
-            started.write(CollisionStarted { a, b });
+            started.write(CollisionStarted {
+                a,
+                b,
+                contact: None,
+            });
         }
     }
     if kept {
@@ -256,7 +288,14 @@ pub(crate) fn trigger_collision_events(
     for m in started.read() {
         for (entity, other) in sides(m.a, m.b) {
             if enabled.contains(entity) {
-                commands.trigger(CollisionStart { entity, other });
+                let contact = m
+                    .contact
+                    .map(|c| if entity == m.a { c } else { c.flipped() });
+                commands.trigger(CollisionStart {
+                    entity,
+                    other,
+                    contact,
+                });
             }
         }
     }
@@ -288,6 +327,36 @@ mod tests {
 
     #[derive(Resource, Default)]
     struct Seen(Vec<(&'static str, Entity, Entity)>);
+
+    #[test]
+    fn a_pair_touching_through_several_colliders_is_listed_once_with_its_strongest_contact() {
+        let e = |i| Entity::from_raw_u32(i).unwrap();
+        let touching = crate::geometry::ContactManifold::single(Vec3::Z, Vec3::ZERO, 0.0);
+        let contact = |a: u32, b: u32, normal_impulse: f32| ContactPair {
+            a: e(a),
+            b: e(b),
+            collider_a: e(a + 10),
+            collider_b: e(b + 10),
+            manifold: touching,
+            normal_impulse,
+            impact_speed: 0.0,
+        };
+        let contacts = Contacts {
+            // Pair (1, 2) through three collider pairs, listed both ways round.
+            pairs: vec![
+                contact(1, 2, 0.5),
+                contact(3, 4, 0.0),
+                contact(2, 1, 2.0),
+                contact(1, 2, 1.0),
+            ],
+        };
+        let mut fresh = Vec::new();
+        touching_now(&contacts, &mut fresh);
+        let pair = |a: u32, b: u32| (e(a).min(e(b)), e(a).max(e(b)));
+        let mut expected = vec![(pair(1, 2), 2), (pair(3, 4), 1)];
+        expected.sort_unstable();
+        assert_eq!(fresh, expected);
+    }
 
     #[test]
     fn an_entity_with_collision_events_sees_its_own_start_and_end_and_no_other_pair() {

@@ -14,6 +14,7 @@
 
 pub mod broad_phase;
 pub mod ccd;
+mod collision_data;
 mod collision_messages;
 pub mod core;
 pub mod forces;
@@ -45,7 +46,7 @@ pub use joints::{JointPlugin, JointedPairs};
 pub use narrow_phase::{ContactHooks, ContactPair, Contacts, NarrowPhasePlugin};
 pub use response::{
     CollisionEnd, CollisionEnded, CollisionEventsEnabled, CollisionStart, CollisionStarted,
-    ReportCollisions, ResponsePlugin,
+    ContactData, ReportCollisions, ResponsePlugin,
 };
 pub use rotation::RotationPlugin;
 pub use sleep::SleepPlugin;

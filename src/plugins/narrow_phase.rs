@@ -112,6 +112,11 @@ pub struct ContactPair {
     /// The largest normal impulse the rigid-body solver applied to this contact in one substep
     /// of the step (N·s); 0 until it has solved, and without it.
     pub normal_impulse: f32,
+    /// The speed (m/s) at which the two bodies met along the normal: the fastest approach of
+    /// the points the rigid-body solver pushed this step, taken when each first pushed (a
+    /// speculative point's speed carried on to the surface). What a game scales a hit sound or
+    /// damage by; about 0 for a resting contact, 0 until it has solved, and without it.
+    pub impact_speed: f32,
 }
 
 /// A sensor's overlap: `a` and `b` are the root bodies, `collider_a` and `collider_b` the parts
@@ -477,6 +482,7 @@ impl NarrowPhaseScratch {
                 collider_b: lb,
                 manifold,
                 normal_impulse: 0.0,
+                impact_speed: 0.0,
             });
             if debug.enabled && involves_mesh {
                 let overlap = leaf_overlap(la, &ca.shape, lb, &cb.shape, &self.contact);

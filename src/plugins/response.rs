@@ -5,7 +5,7 @@
 
 pub use super::collision_messages::{
     CollisionEnd, CollisionEnded, CollisionEventsEnabled, CollisionStart, CollisionStarted,
-    ReportCollisions,
+    ContactData, ReportCollisions,
 };
 use super::collision_messages::{
     add_collision_messages, report_collisions, trigger_collision_events,

@@ -134,15 +134,22 @@ pub(super) fn add_part_motion(
     }
 }
 
-/// Each contact's largest normal impulse of the step, back to the pair it came from (the
-/// collision messages count a speculative contact that pushed as touching).
+/// Each contact's largest normal impulse of the step and its impact speed, back to the pair it
+/// came from (the collision messages count a speculative contact that pushed as touching, and
+/// report both).
 pub(super) fn report_impulses(solver: &Solver, sources: &[u32], contacts: &mut Contacts) {
     for (c, &source) in solver.constraints().iter().zip(sources) {
-        let impulse = c.points[..c.count as usize]
-            .iter()
-            .fold(0.0f32, |m, p| m.max(p.max_normal_impulse));
+        let pushed = || {
+            c.points[..c.count as usize]
+                .iter()
+                .filter(|p| p.max_normal_impulse > 0.0)
+        };
+        let impulse = pushed().fold(0.0f32, |m, p| m.max(p.max_normal_impulse));
+        // `relative_velocity` is the normal speed at first push, negative when closing.
+        let speed = pushed().fold(0.0f32, |m, p| m.max(-p.relative_velocity));
         if let Some(pair) = contacts.pairs.get_mut(source as usize) {
             pair.normal_impulse = impulse;
+            pair.impact_speed = speed;
         }
     }
 }
