@@ -73,7 +73,7 @@ fn main() -> Result<(), Box<dyn Error>> {
                         1.0 + 4.0 * rng.next(),
                     ),
                     Velocity::new(rng.next() - 0.5, rng.next() - 0.5, 0.0),
-                    Mass(radius.powi(3) * 4.19 * 1000.0),
+                    Density(1000.0), // water: the mass follows the size
                     Restitution(0.5 + 0.45 * rng.next()),
                     RollingResistance(0.01),
                 ))

@@ -290,7 +290,14 @@ fn respawn(
 /// Pushes the player toward the goal at a walking speed, turning aside (and keeping to that
 /// side) where a cast of its own ball meets a crate or a wall within a few metres.
 fn steer_player(
-    mut players: Query<(Entity, &Position, &Velocity, &Mass, &mut Force, &mut Player)>,
+    mut players: Query<(
+        Entity,
+        &Position,
+        &Velocity,
+        &ComputedMass,
+        &mut Force,
+        &mut Player,
+    )>,
     space: SpatialQuery,
 ) {
     const SPEED: f32 = 4.0;
@@ -324,7 +331,7 @@ fn steer_player(
             player.side = turn.signum();
         }
         // A velocity controller in the ground plane: a = 3/s × (wanted − current).
-        let push = (heading * SPEED - v.0.with_z(0.0)) * 3.0 * mass.0;
+        let push = (heading * SPEED - v.0.with_z(0.0)) * 3.0 * mass.value();
         force.0 += push;
     }
 }
@@ -434,7 +441,7 @@ fn end_after_playtime(
     run: Res<Run>,
     score: Res<Score>,
     stats: Res<PhysicsStats>,
-    players: Query<&Mass, With<Player>>,
+    players: Query<&ComputedMass, With<Player>>,
     mut exit: MessageWriter<AppExit>,
 ) {
     if time.elapsed_secs() < run.seconds {
@@ -461,7 +468,7 @@ fn end_after_playtime(
         fixed.timestep().as_secs_f64() * 1e3
     );
     if let Ok(mass) = players.single() {
-        println!("  player ball: {:.0} kg from its density", mass.0);
+        println!("  player ball: {:.0} kg from its density", mass.value());
     }
     println!(
         "  per frame the ball moved, over its speed × the frame time: drawn (interpolated) {}, stepped {}",

@@ -21,10 +21,10 @@ fn get<T: Component + Copy>(app: &App, e: Entity) -> T {
     *app.world().get::<T>(e).expect("component present")
 }
 
+/// A 1 kg ball (whatever its size), so that loads read as multiples of `g`.
 fn ball(app: &mut App, at: Vec3, radius: f32) -> Entity {
-    app.world_mut()
-        .spawn((Collider::sphere(radius), Position(at), Velocity::default()))
-        .id()
+    let body = (Collider::sphere(radius), Position(at), Velocity::default());
+    app.world_mut().spawn((body, Mass(1.0))).id()
 }
 
 /// The mean period of `x(t)` from its upward zero crossings, at 60 Hz.
@@ -75,6 +75,7 @@ fn a_hinge_motor_spins_a_wheel_at_its_target_within_2_percent_and_holds_what_it_
             Collider::cuboid(0.4, 0.4, 0.05),
             Position::new(0.0, 0.0, 3.0),
             Velocity::default(),
+            Mass(1.0),
             AngularDrag(0.5),
         ))
         .id();

@@ -32,10 +32,10 @@ fn body_rates(app: &App, e: Entity) -> Vec3 {
 }
 
 /// A 1 kg ball of radius 0.5 at `at`.
+/// A 1 kg ball of radius 0.5 (I = 0.1 kg m²), whatever its volume would weigh.
 fn ball(app: &mut App, at: Vec3) -> Entity {
-    app.world_mut()
-        .spawn((Collider::sphere(0.5), Position(at), Velocity::default()))
-        .id()
+    let body = (Collider::sphere(0.5), Position(at), Velocity::default());
+    app.world_mut().spawn((body, Mass(1.0))).id()
 }
 
 fn spinning_box(app: &mut App, half: Vec3, w: Vec3) -> Entity {
@@ -183,6 +183,7 @@ fn a_torque_gives_alpha_tau_over_i_and_locked_axes_refuse_it() {
             Collider::sphere(0.5),
             Position::new(5.0, 0.0, 0.0),
             Velocity::default(),
+            Mass(1.0),
             LockedAxes::ROTATION_LOCKED,
         ))
         .id();
@@ -483,7 +484,7 @@ fn density_gives_a_ball_a_box_and_a_compound_the_mass_of_their_volume_within_1e_
         ))
         .id();
     urto::step(app.world_mut(), 2).unwrap();
-    let mass = |e| app.world().get::<Mass>(e).unwrap().0;
+    let mass = |e| app.world().get::<ComputedMass>(e).unwrap().value();
     let close = |a: f32, b: f32| ((a - b) / b).abs() < 1e-5;
     let ball_mass = 1000.0 * 4.0 / 3.0 * PI * 0.125;
     assert!(close(mass(ball), ball_mass), "{}", mass(ball));
@@ -493,7 +494,64 @@ fn density_gives_a_ball_a_box_and_a_compound_the_mass_of_their_volume_within_1e_
     assert!(close(mass(crate_box), 2.0 * 1.0 * 2.0 * 3.0));
     let compound = 10.0 * (1.0 + 4.0 / 3.0 * PI * 0.25f32.powi(3));
     assert!(close(mass(root), compound), "{} vs {compound}", mass(root));
-    assert_eq!(mass(bad), 1.0);
+    // A NaN density is reported and the default one used.
+    assert!(close(mass(bad), DEFAULT_DENSITY * 4.0 / 3.0 * PI * 0.125));
     assert!(mass(kinematic).is_infinite());
     assert!(app.world().get::<Quarantined>(bad).is_none());
+}
+
+#[test]
+fn a_body_weighs_its_volume_by_default_a_given_mass_wins_and_removing_it_restores_within_1e_5() {
+    use std::f32::consts::PI;
+    let mut app = common::app();
+    let world = app.world_mut();
+    let spawn = |world: &mut bevy_ecs::world::World, x: f32| {
+        let at = Position::new(x, 0.0, 5.0);
+        world
+            .spawn((Collider::sphere(2.0), at, Velocity::default()))
+            .id()
+    };
+    let boulder = spawn(world, 0.0);
+    let pebble = world
+        .spawn((
+            Collider::sphere(0.1),
+            Position::new(9.0, 0.0, 5.0),
+            Velocity::default(),
+        ))
+        .id();
+    let given = spawn(world, -9.0);
+    world.entity_mut(given).insert((Mass(3.0), Density(500.0)));
+    let no_volume = world
+        .spawn((Position::new(0.0, 9.0, 5.0), Velocity::default()))
+        .id();
+    urto::step(app.world_mut(), 1).unwrap();
+    let mass = |app: &bevy_app::App, e| app.world().get::<ComputedMass>(e).unwrap().value();
+    let inertia = |app: &bevy_app::App, e| app.world().get::<Inertia>(e).unwrap().principal.x;
+    let close = |a: f32, b: f32| ((a - b) / b).abs() < 1e-5;
+    let ball = |r: f32| DEFAULT_DENSITY * 4.0 / 3.0 * PI * r.powi(3);
+    assert!(
+        close(mass(&app, boulder), ball(2.0)),
+        "{}",
+        mass(&app, boulder)
+    );
+    assert!(close(mass(&app, pebble), ball(0.1)));
+    assert!(close(mass(&app, given), 3.0));
+    assert!(close(inertia(&app, given), 0.4 * 3.0 * 4.0));
+    assert_eq!(mass(&app, no_volume), 1.0);
+    // The mass set by the game goes: the density it also has takes over, inertia too.
+    app.world_mut().entity_mut(given).remove::<Mass>();
+    urto::step(app.world_mut(), 1).unwrap();
+    let from_density = 500.0 * ball(2.0) / DEFAULT_DENSITY;
+    assert!(
+        close(mass(&app, given), from_density),
+        "{}",
+        mass(&app, given)
+    );
+    assert!(close(inertia(&app, given), 0.4 * from_density * 4.0));
+    // And without the density, the default one.
+    app.world_mut().entity_mut(given).remove::<Density>();
+    urto::step(app.world_mut(), 1).unwrap();
+    assert!(close(mass(&app, given), ball(2.0)));
+    // 20 times the radius, 8,000 times the mass.
+    assert!(close(mass(&app, boulder) / mass(&app, pebble), 8000.0));
 }

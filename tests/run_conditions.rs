@@ -178,7 +178,7 @@ fn busy_scene(app: &mut bevy_app::App) -> [bevy_ecs::entity::Entity; 2] {
 }
 
 #[test]
-fn every_one_of_the_16_plugins_can_be_disabled_and_a_busy_scene_steps_without_a_panic_the_ball_resting_within_2_cm()
+fn every_one_of_the_17_plugins_can_be_disabled_and_a_busy_scene_steps_without_a_panic_the_ball_resting_within_2_cm()
  {
     use bevy_app::{App, PluginGroup};
     use urto::plugins::*;
@@ -188,11 +188,12 @@ fn every_one_of_the_16_plugins_can_be_disabled_and_a_busy_scene_steps_without_a_
         app
     }
     type MakeApp = fn() -> App;
-    let apps: [(&str, MakeApp); 16] = [
+    let apps: [(&str, MakeApp); 17] = [
         ("core", without::<PhysicsCorePlugin>),
         ("validation", without::<ValidationPlugin>),
         ("forces", without::<ForcesPlugin>),
         ("integration", without::<IntegrationPlugin>),
+        ("mass properties", without::<MassPropertiesPlugin>),
         ("rotation", without::<RotationPlugin>),
         ("hierarchy", without::<HierarchyPlugin>),
         ("broad phase", without::<BroadPhasePlugin>),

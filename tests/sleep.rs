@@ -282,7 +282,7 @@ fn position(app: &App, e: Entity) -> Vec3 {
 #[test]
 fn a_nan_mass_written_to_a_sleeping_body_is_quarantined_within_one_step() {
     let (mut app, stack) = sleeping_stack();
-    app.world_mut().get_mut::<Mass>(stack[1]).unwrap().0 = f32::NAN;
+    app.world_mut().entity_mut(stack[1]).insert(Mass(f32::NAN));
     urto::step(app.world_mut(), 1).unwrap();
     assert!(app.world().get::<Quarantined>(stack[1]).is_some());
     urto::step(app.world_mut(), 60).unwrap();

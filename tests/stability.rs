@@ -454,6 +454,9 @@ fn far_scene_in(mut app: App, d: f32) -> (Vec<(f32, f32)>, Vec3) {
             Velocity::new(1.0, 0.0, 0.0),
             Restitution(0.8),
             Friction(0.0),
+            // Both 1 kg, the masses these bounds were measured with (the ball would weigh
+            // 0.52 kg from its volume).
+            Mass(1.0),
         ))
         .id();
     let block = app
@@ -463,6 +466,7 @@ fn far_scene_in(mut app: App, d: f32) -> (Vec<(f32, f32)>, Vec3) {
             Position(offset + Vec3::new(5.0, 0.0, 0.5)),
             Velocity::default(),
             Restitution(0.0),
+            Mass(1.0),
         ))
         .id();
     let mut heights = Vec::new();

@@ -4,7 +4,7 @@
 //!
 //! Every dynamic body turns by default, as in Avian and rapier: [`Velocity`](super::Velocity) brings an
 //! [`AngularVelocity`] and an [`Inertia`] computed from the collider (scaled to the body's
-//! [`Mass`](super::Mass)). [`LockedAxes::ROTATION_LOCKED`] keeps a body upright.
+//! [`ComputedMass`](super::ComputedMass)). [`LockedAxes::ROTATION_LOCKED`] keeps a body upright.
 
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
@@ -118,8 +118,9 @@ impl LockedAxes {
 ///
 /// Left at its default it is **computed** from the body's collider and those of its
 /// [`ChildOf`](bevy_ecs::hierarchy::ChildOf) parts (the scene graph as a compound body, by the
-/// parallel-axis theorem), at uniform density scaled to the body's [`Mass`](super::Mass), and recomputed when
-/// the collider or mass changes. [`Inertia::custom`] overrides it. A body without any collider
+/// parallel-axis theorem), at uniform density scaled to the body's
+/// [`ComputedMass`](super::ComputedMass), and recomputed when the collider, mass or density
+/// changes. [`Inertia::custom`] overrides it. A body without any collider
 /// has infinite inertia: torques and contacts do not turn it, its angular velocity still does.
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
 pub struct Inertia {

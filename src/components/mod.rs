@@ -7,15 +7,16 @@
 //! # use bevy_ecs::prelude::*;
 //! # use urto::prelude::*;
 //! # let mut world = World::new();
-//! // A dynamic ball: Velocity, Mass (1 kg), Rotation, AngularVelocity, Inertia and
-//! // BoundingVolume come by default.
+//! // A dynamic ball: Velocity, ComputedMass (from its volume at 1 kg/m³), Rotation,
+//! // AngularVelocity, Inertia and BoundingVolume come by default.
 //! world.spawn((Collider::sphere(0.5), Position::new(0.0, 0.0, 3.0), Velocity::default()));
 //! // Static scenery: never moves, collides as infinitely heavy.
 //! world.spawn((Collider::half_space(glam::Vec3::Z), Static));
 //! ```
 //!
 //! # Kinds of body
-//! - **dynamic**: has [`Velocity`] and a finite [`Mass`]; forces and contacts move it.
+//! - **dynamic**: has [`Velocity`] and a finite mass (from its colliders' volume at its
+//!   [`Density`], or a [`Mass`] it is given); forces and contacts move it.
 //! - **kinematic**: has [`Velocity`] and [`Mass::INFINITE`]; it moves at its velocity, pushes
 //!   dynamic bodies and is never pushed back.
 //! - **static**: has the [`Static`] marker (or no [`Velocity`]); never moves, collides as
@@ -27,12 +28,14 @@
 
 mod angular;
 mod joint;
+mod mass;
 mod sleeping;
 
 pub use angular::{AngularDrag, AngularVelocity, ForceAtPoint, Inertia, LockedAxes, Torque};
 pub use joint::{
     Joint, JointBroken, JointDisabled, JointEnd, JointKind, JointLimit, JointLoad, JointMotor,
 };
+pub use mass::{ComputedMass, DEFAULT_DENSITY, Density, Mass};
 pub(crate) use sleeping::SleepTransitions;
 pub use sleeping::{SleepState, Sleeping, SleepingIslands};
 
@@ -67,51 +70,13 @@ pub struct Rotation(pub Quat);
 /// Linear velocity of the centre of mass (m/s). Brings what a dynamic body needs, including an
 /// [`AngularVelocity`] and a computed [`Inertia`]: dynamic bodies turn by default.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
-#[require(Position, Rotation, Mass, SleepState, AngularVelocity, Inertia)]
+#[require(Position, Rotation, ComputedMass, SleepState, AngularVelocity, Inertia)]
 pub struct Velocity(pub Vec3);
 
 impl Velocity {
     /// A velocity from components.
     pub const fn new(x: f32, y: f32, z: f32) -> Self {
         Self(Vec3::new(x, y, z))
-    }
-}
-
-/// Mass in kg: finite and `> 0` for dynamic bodies, [`Mass::INFINITE`] for kinematic ones.
-/// Zero, negative or NaN mass quarantines the body.
-#[derive(Component, Clone, Copy, Debug, PartialEq)]
-pub struct Mass(pub f32);
-
-impl Default for Mass {
-    fn default() -> Self {
-        Self(1.0)
-    }
-}
-
-/// Mass from size (kg/m³): a body with a `Density` gets the [`Mass`] of its colliders' volume
-/// (its parts' included) at this density, recomputed when a collider or part changes, as Avian's
-/// and rapier's colliders give by default (water is 1,000, steel about 7,850). Without it a
-/// body keeps its `Mass` (1 kg by default, whatever its size). A density that is not finite and
-/// positive, or a body without volume (no collider, a half-space), keeps the `Mass` it has.
-#[derive(Component, Clone, Copy, Debug, PartialEq)]
-pub struct Density(pub f32);
-
-impl Mass {
-    /// A body no force or impulse can move.
-    pub const INFINITE: Self = Self(f32::INFINITY);
-
-    /// `1/m`, 0 for infinite mass.
-    pub fn inverse(self) -> f32 {
-        if self.0.is_infinite() {
-            0.0
-        } else {
-            1.0 / self.0
-        }
-    }
-
-    /// True for finite positive masses and for infinity.
-    pub fn is_valid(self) -> bool {
-        self.0 > 0.0 && !self.0.is_nan()
     }
 }
 

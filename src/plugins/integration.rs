@@ -51,7 +51,7 @@ struct IntegrationBuffers {
     scratch: IntegratorScratch,
 }
 
-type Moving<'a> = (Entity, &'a mut Position, &'a mut Velocity, &'a Mass);
+type Moving<'a> = (Entity, &'a mut Position, &'a mut Velocity, &'a ComputedMass);
 /// Sleeping bodies are not integrated: their archetypes are left out.
 type MovingFilter = (
     Without<Static>,

@@ -22,6 +22,7 @@ pub mod hierarchy;
 pub mod integration;
 pub mod interpolation;
 pub mod joints;
+pub mod mass_properties;
 pub mod narrow_phase;
 mod proxy_table;
 mod required_resources;
@@ -43,6 +44,7 @@ pub use hierarchy::HierarchyPlugin;
 pub use integration::IntegrationPlugin;
 pub use interpolation::{InterpolationPlugin, PreviousPose, TransformInterpolation};
 pub use joints::{JointPlugin, JointedPairs};
+pub use mass_properties::MassPropertiesPlugin;
 pub use narrow_phase::{ContactHooks, ContactPair, Contacts, NarrowPhasePlugin};
 pub use response::{
     CollisionEnd, CollisionEnded, CollisionEventsEnabled, CollisionStart, CollisionStarted,
@@ -95,6 +97,7 @@ impl PluginGroup for UrtoPlugins {
             .add(ValidationPlugin)
             .add(ForcesPlugin)
             .add(IntegrationPlugin)
+            .add(MassPropertiesPlugin)
             .add(RotationPlugin)
             .add(HierarchyPlugin)
             .add(BroadPhasePlugin::default())

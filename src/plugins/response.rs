@@ -79,7 +79,7 @@ type ContactKey = (Entity, Entity, u16);
 type Movable<'a> = (
     &'a mut Position,
     &'a mut Velocity,
-    &'a Mass,
+    &'a ComputedMass,
     Has<Sleeping>,
     Option<&'a mut SleepState>,
 );

@@ -134,7 +134,7 @@ type Sleeper<'a> = (
         Option<&'a ForceAtPoint>,
     ),
     (
-        Ref<'a, Mass>,
+        (Option<Ref<'a, Mass>>, Option<Ref<'a, Density>>),
         Option<Ref<'a, Collider>>,
         Option<Ref<'a, Inertia>>,
         Option<Ref<'a, LinearDrag>>,
@@ -158,6 +158,7 @@ type Touched = (
         Changed<Torque>,
         Changed<ForceAtPoint>,
         Changed<Mass>,
+        Changed<Density>,
         Changed<Collider>,
         Changed<Inertia>,
         Changed<LinearDrag>,
@@ -192,8 +193,9 @@ fn wake_on_game_changes(
             || at_point.is_some_and(|f| !f.is_empty());
         let spun = w.is_some_and(|w| w.0 != Vec3::ZERO);
         let moved = p.0 != sleep.at || r.0 != sleep.orientation || v.0 != Vec3::ZERO;
-        let (mass, collider, inertia, drag, angular_drag, parent, children) = settings;
-        let rebuilt = mass.is_changed()
+        let ((mass, density), collider, inertia, drag, angular_drag, parent, children) = settings;
+        let rebuilt = written(mass)
+            || written(density)
             || written(collider)
             || written(inertia)
             || written(drag)
@@ -260,7 +262,7 @@ type Candidate<'a> = (
     &'a mut SleepState,
     (&'a Position, &'a Rotation),
     &'a mut Velocity,
-    &'a Mass,
+    &'a ComputedMass,
     Option<&'a mut AngularVelocity>,
     &'a BoundingVolume,
 );

@@ -4,7 +4,7 @@
 //! a viewer sees which bodies sleep and which sleep together (`crate::dynamics::islands`).
 
 use super::DebugColor;
-use crate::components::{Mass, Quarantined, Static};
+use crate::components::{ComputedMass, Quarantined, Static};
 use bevy_ecs::prelude::*;
 
 const DYNAMIC: [u8; 3] = [230, 126, 34];
@@ -14,10 +14,10 @@ const QUARANTINED: [u8; 3] = [231, 76, 60];
 
 /// What decides a body's colour: whether it (or, for a part, its root) is static, its mass, and
 /// whether it is quarantined.
-pub(super) type KindView<'a> = (Has<Static>, Option<&'a Mass>, Has<Quarantined>);
+pub(super) type KindView<'a> = (Has<Static>, Option<&'a ComputedMass>, Has<Quarantined>);
 
 /// The colour of a body's kind from whether it is static and its mass.
-pub(super) fn kind_tint(is_static: bool, mass: Option<&Mass>) -> [u8; 3] {
+pub(super) fn kind_tint(is_static: bool, mass: Option<&ComputedMass>) -> [u8; 3] {
     match mass {
         _ if is_static => STATIC,
         Some(m) if m.inverse() == 0.0 => KINEMATIC,

@@ -14,7 +14,7 @@ type MeshBody<'a> = (
     Ref<'a, Collider>,
     Ref<'a, GlobalPose>,
     Has<Static>,
-    Option<&'a Mass>,
+    Option<&'a ComputedMass>,
     Option<&'a DebugColor>,
     (Has<Sleeping>, Option<&'a SleepState>),
 );

@@ -144,7 +144,7 @@ type Mover<'a> = (
     &'a mut Rotation,
     &'a mut Velocity,
     &'a mut AngularVelocity,
-    &'a Mass,
+    &'a ComputedMass,
     &'a Inertia,
     Option<&'a LockedAxes>,
     Option<&'a AngularDrag>,
