@@ -3,6 +3,7 @@
 
 use crate::dynamics::Integrator;
 use crate::dynamics::response::SolverSettings;
+#[cfg(feature = "ecs")]
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 use std::fmt;
@@ -51,7 +52,8 @@ impl std::error::Error for SettingsError {}
 
 /// The fixed step: `dt` seconds split into `substeps` equal substeps, and at most
 /// `max_steps_per_frame` steps run per frame in an `App` ("the frame rate is sacred").
-#[derive(Resource, Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "ecs", derive(Resource))]
 pub struct PhysicsTimestep {
     dt: f32,
     substeps: u32,
@@ -130,7 +132,8 @@ fn check_dt(dt: f32) -> Result<(), SettingsError> {
 
 /// Uniform gravitational acceleration (m/s²). Without this resource there is no gravity and the
 /// gravity system does not run. The slides' value, z up: `(0, 0, -9.8)`.
-#[derive(Resource, Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "ecs", derive(Resource))]
 pub struct Gravity(Vec3);
 
 impl Gravity {
@@ -153,7 +156,8 @@ impl Gravity {
 }
 
 /// Which integrator advances the state (default: symplectic Euler).
-#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "ecs", derive(Resource))]
 pub struct Integration(pub Integrator);
 
 /// How bodies turn. With `gyroscopic` on (the default) a free body keeps its angular
@@ -161,7 +165,8 @@ pub struct Integration(pub Integrator);
 /// with it off it keeps its angular *velocity*, which is cheaper and is what engines that leave
 /// the term out (rapier and Jolt by default) do. The integrator is the step's [`Integration`];
 /// see [`crate::dynamics::rotation`] for how each method treats rotation.
-#[derive(Resource, Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "ecs", derive(Resource))]
 pub struct RotationSettings {
     /// Include the gyroscopic term `ω × Iω`.
     pub gyroscopic: bool,
@@ -174,7 +179,8 @@ impl Default for RotationSettings {
 }
 
 /// Contact response settings.
-#[derive(Resource, Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "ecs", derive(Resource))]
 pub struct ContactSettings {
     /// Restitution of bodies without a [`Restitution`](crate::components::Restitution).
     pub default_restitution: f32,
@@ -200,7 +206,8 @@ impl Default for ContactSettings {
 /// body is left out of every per-step pass (`benches/effects.rs`, group `sleeping`, measures
 /// what a sleeping scene still costs). Turn it off (`enabled: false`) to watch a scene settle
 /// for ever; turning it off wakes every sleeping body.
-#[derive(Resource, Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "ecs", derive(Resource))]
 pub struct SleepSettings {
     /// Whether bodies may fall asleep.
     pub enabled: bool,

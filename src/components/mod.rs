@@ -40,6 +40,7 @@ pub(crate) use sleeping::SleepTransitions;
 pub use sleeping::{SleepState, Sleeping, SleepingIslands};
 
 use crate::bounding::Aabb;
+#[cfg(feature = "mesh-io")]
 use crate::geometry::convex::HullFileError;
 use crate::geometry::{HullError, Isometry, MeshCollider, MeshColliderError, Shape, TriMesh};
 pub use crate::spatial::{LayerMask, Layers};
@@ -186,6 +187,7 @@ impl Collider {
 
     /// The convex hull of the vertices of an OBJ, STL or PLY file (chosen by extension): the
     /// usual way to give a detailed prop a cheap dynamic collider.
+    #[cfg(feature = "mesh-io")]
     pub fn convex_hull_from_file(path: impl AsRef<std::path::Path>) -> Result<Self, HullFileError> {
         let hull = crate::geometry::convex::hull_from_file(path)?;
         Ok(Self {
@@ -209,6 +211,7 @@ impl Collider {
     /// A mesh loaded from an OBJ, STL or PLY file (chosen by extension). Errors: unreadable
     /// file, unknown extension, content that does not parse, or geometry that is not a valid
     /// mesh (no triangles, non-finite coordinates, every triangle degenerate).
+    #[cfg(feature = "mesh-io")]
     pub fn from_mesh_file(path: impl AsRef<std::path::Path>) -> Result<Self, MeshColliderError> {
         MeshCollider::from_file(path).map(Self::mesh)
     }

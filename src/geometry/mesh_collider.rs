@@ -13,11 +13,10 @@
 
 use crate::bounding::{Aabb, Obb};
 use crate::bvh::{BuildOptions, Bvh, BvhError};
-use crate::geometry::mesh_io::{self, MeshLoadError};
+use crate::geometry::mesh_io::MeshLoadError;
 use crate::geometry::{Isometry, MeshError, TriMesh};
 use glam::{Mat3, Vec3};
 use std::fmt;
-use std::path::Path;
 use std::sync::Arc;
 
 /// Why a mesh collider could not be made.
@@ -155,11 +154,12 @@ impl MeshCollider {
         Self::new(TriMesh::new(vertices, triangles)?)
     }
 
-    /// Loads an OBJ, STL or PLY file (by extension, see [`mesh_io::load`]) and builds the
+    /// Loads an OBJ, STL or PLY file (by extension, see [`load`](crate::geometry::mesh_io::load)) and builds the
     /// collider, named after the file's stem.
-    pub fn from_file(path: impl AsRef<Path>) -> Result<Self, MeshColliderError> {
+    #[cfg(feature = "mesh-io")]
+    pub fn from_file(path: impl AsRef<std::path::Path>) -> Result<Self, MeshColliderError> {
         let path = path.as_ref();
-        let mesh = mesh_io::load(path)?;
+        let mesh = crate::geometry::mesh_io::load(path)?;
         let name = path
             .file_stem()
             .map_or_else(|| "mesh".into(), |s| s.to_string_lossy().into_owned());
@@ -291,6 +291,11 @@ mod tests {
         ));
         let nan = vec![Vec3::ZERO, Vec3::X, Vec3::new(0.0, f32::NAN, 0.0)];
         assert!(MeshCollider::from_arrays(nan, vec![[0, 1, 2]]).is_err());
+    }
+
+    #[cfg(feature = "mesh-io")]
+    #[test]
+    fn a_missing_or_unknown_file_is_an_error() {
         let missing = MeshCollider::from_file("no/such/file.ply").unwrap_err();
         assert!(missing.to_string().contains("cannot load"), "{missing}");
         assert!(matches!(

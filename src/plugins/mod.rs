@@ -72,7 +72,7 @@ use bevy_app::{PluginGroup, PluginGroupBuilder};
 /// do not turn) runs with `UrtoPlugins::default().build().disable::<SoftStepPlugin>()`.
 ///
 /// The rerun recording is not in the group because it needs a destination that can fail to
-/// open: add [`RerunDebugPlugin`](crate::debug::RerunDebugPlugin) separately.
+/// open: add `urto::debug::RerunDebugPlugin` (the `rerun` feature) separately.
 #[derive(Debug, Clone, Default)]
 pub struct UrtoPlugins {
     /// The fixed step (default 60 Hz, one substep).

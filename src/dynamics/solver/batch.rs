@@ -114,7 +114,7 @@ impl ContactBatch {
     /// [`Self::pack`] into this batch, in place (the solver refills last step's batches: a
     /// batch is a few kilobytes, and building one to move it into the list copied it twice);
     /// false, the batch left as it was, where `pack` gives `None`. Only the points some lane
-    /// has are gathered: the passes never read past [`Self::count`].
+    /// has are gathered: the passes never read past the batch's point count.
     pub fn repack(&mut self, indices: &[u32], constraints: &[ContactConstraint]) -> bool {
         if indices.is_empty() || indices.len() > LANES {
             return false;

@@ -385,7 +385,7 @@ impl Solver {
     }
 
     /// How many joints carried impulses into the last step that were not finite or could have
-    /// changed a body's velocity by more than [`WARM_START_BOUND`] times the speed or spin bound,
+    /// changed a body's velocity by more than twice the speed or spin bound,
     /// and were dropped or scaled down ([`JointConstraint::bound_impulses`]). Joints that keep
     /// tripping it fight each other or carry far more than their bodies can take.
     pub fn bounded_joints(&self) -> usize {

@@ -101,6 +101,7 @@ impl ContactScratch {
     }
 
     /// Replaces the last query's hits (an answer that came from a cache brings its own).
+    #[cfg(feature = "ecs")]
     pub(crate) fn set_hits(&mut self, hits: &[[u32; 2]]) {
         self.hits.clear();
         self.hits.extend_from_slice(hits);

@@ -12,8 +12,8 @@ mod epa;
 mod gjk;
 pub(crate) mod support;
 
-use crate::geometry::mesh_io::{self, MeshLoadError};
-use crate::geometry::{ConvexHull, HullError, Isometry, Shape};
+use crate::geometry::mesh_io::MeshLoadError;
+use crate::geometry::{HullError, Isometry, Shape};
 pub(crate) use epa::epa;
 pub(crate) use gjk::{Gjk, gjk};
 use glam::Vec3;
@@ -135,8 +135,11 @@ impl From<HullError> for HullFileError {
 }
 
 /// The convex hull of the vertices of an OBJ, STL or PLY file (by extension, as
-/// [`mesh_io::load`]).
-pub fn hull_from_file(path: impl AsRef<std::path::Path>) -> Result<ConvexHull, HullFileError> {
-    let mesh = mesh_io::load(path)?;
-    Ok(ConvexHull::from_points(mesh.vertices())?)
+/// [`load`](crate::geometry::mesh_io::load)).
+#[cfg(feature = "mesh-io")]
+pub fn hull_from_file(
+    path: impl AsRef<std::path::Path>,
+) -> Result<crate::geometry::ConvexHull, HullFileError> {
+    let mesh = crate::geometry::mesh_io::load(path)?;
+    Ok(crate::geometry::ConvexHull::from_points(mesh.vertices())?)
 }

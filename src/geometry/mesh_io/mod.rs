@@ -1,6 +1,6 @@
 //! Loading triangle meshes from files: Wavefront OBJ (`tobj`), STL (`stl_io`, ASCII or
 //! binary) and PLY (`ply-rs-bw`, ASCII or binary), each parsed by a maintained crate and then
-//! validated into a [`TriMesh`].
+//! validated into a [triangle mesh](crate::geometry::TriMesh).
 //!
 //! Only geometry is read: positions and faces. Polygons are split into triangle fans (OBJ, PLY);
 //! normals, texture coordinates, colours and materials are ignored (collision needs none of
@@ -8,17 +8,27 @@
 //! file without faces, and corrupt counts (see the PLY notes) all come back as a
 //! [`MeshLoadError`].
 
+#[cfg(feature = "mesh-io")]
 mod obj;
+#[cfg(feature = "mesh-io")]
 mod ply;
+#[cfg(feature = "mesh-io")]
 mod stl;
 
+#[cfg(feature = "mesh-io")]
 pub use obj::read_obj;
+#[cfg(feature = "mesh-io")]
 pub use ply::read_ply;
+#[cfg(feature = "mesh-io")]
 pub use stl::read_stl;
 
-use crate::geometry::{MeshError, TriMesh};
+use crate::geometry::MeshError;
+#[cfg(feature = "mesh-io")]
+use crate::geometry::TriMesh;
 use std::fmt;
-use std::path::{Path, PathBuf};
+#[cfg(feature = "mesh-io")]
+use std::path::Path;
+use std::path::PathBuf;
 
 /// Why a mesh file could not be loaded.
 #[derive(Debug)]
@@ -84,6 +94,7 @@ impl From<MeshError> for MeshLoadError {
     }
 }
 
+#[cfg(feature = "mesh-io")]
 /// Loads a mesh, choosing the format by the file extension (`.obj`, `.stl`, `.ply`, any case).
 pub fn load(path: impl AsRef<Path>) -> Result<TriMesh, MeshLoadError> {
     let path = path.as_ref();
@@ -99,21 +110,25 @@ pub fn load(path: impl AsRef<Path>) -> Result<TriMesh, MeshLoadError> {
     }
 }
 
+#[cfg(feature = "mesh-io")]
 /// Loads a Wavefront OBJ file (see [`read_obj`]).
 pub fn load_obj(path: impl AsRef<Path>) -> Result<TriMesh, MeshLoadError> {
     read_obj(&read_file(path.as_ref())?)
 }
 
+#[cfg(feature = "mesh-io")]
 /// Loads an STL file, ASCII or binary (see [`read_stl`]).
 pub fn load_stl(path: impl AsRef<Path>) -> Result<TriMesh, MeshLoadError> {
     read_stl(&read_file(path.as_ref())?)
 }
 
+#[cfg(feature = "mesh-io")]
 /// Loads a PLY file, ASCII or binary (see [`read_ply`]).
 pub fn load_ply(path: impl AsRef<Path>) -> Result<TriMesh, MeshLoadError> {
     read_ply(&read_file(path.as_ref())?)
 }
 
+#[cfg(feature = "mesh-io")]
 fn read_file(path: &Path) -> Result<Vec<u8>, MeshLoadError> {
     std::fs::read(path).map_err(|source| MeshLoadError::Io {
         path: path.to_path_buf(),
