@@ -168,6 +168,13 @@ impl Inertia {
         self
     }
 
+    /// `I⁻¹ v` in world axes for a body turned by `orientation`: `v` carried into the
+    /// principal frame, divided by the moments (0 for infinite ones), carried back.
+    pub fn inverse_world_times(&self, orientation: Quat, v: Vec3) -> Vec3 {
+        let to_world = orientation * self.frame;
+        to_world * (self.inverse_principal() * (to_world.inverse() * v))
+    }
+
     /// `1/I` per principal axis, 0 for infinite moments.
     pub fn inverse_principal(&self) -> Vec3 {
         let inv = |i: f32| {

@@ -27,11 +27,13 @@
 //! spread to their neighbours.
 
 mod angular;
+mod impulse;
 mod joint;
 mod mass;
 mod sleeping;
 
 pub use angular::{AngularDrag, AngularVelocity, ForceAtPoint, Inertia, LockedAxes, Torque};
+pub use impulse::{GravityScale, Impulse};
 pub use joint::{
     Joint, JointBroken, JointDisabled, JointEnd, JointKind, JointLimit, JointLoad, JointMotor,
 };

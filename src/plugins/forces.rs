@@ -1,7 +1,8 @@
 //! The Forces stage: gathers the step's forces and torques, one system per kind of force, each running only
 //! when the world has that kind (no `Gravity` resource: no gravity system; no `Force`
 //! component anywhere: no force system). What they gather is evaluated by the integrator at every
-//! intermediate state it needs.
+//! intermediate state it needs. [`Impulse`]s change velocities here at once, before anything
+//! integrates; a [`GravityScale`] adds the force `(s − 1) m g`.
 
 use crate::components::*;
 use crate::schedule::{PhysicsSchedule, PhysicsSet};
@@ -9,7 +10,7 @@ use crate::settings::Gravity;
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
-use glam::Vec3;
+use glam::{Quat, Vec3};
 
 /// Gathers gravity, user forces, drag and springs.
 #[derive(Debug, Clone, Default)]
@@ -50,6 +51,10 @@ impl Plugin for ForcesPlugin {
                 gather_springs.run_if(any_with_component::<Spring>),
                 gather_torques.run_if(any_with_component::<Torque>),
                 gather_point_forces.run_if(any_with_component::<ForceAtPoint>),
+                scale_gravity
+                    .run_if(resource_exists::<Gravity>)
+                    .run_if(any_with_component::<GravityScale>),
+                apply_impulses.run_if(any_with_component::<Impulse>),
             )
                 .chain()
                 .in_set(PhysicsSet::Forces),
@@ -164,6 +169,59 @@ fn gather_point_forces(
                 .torques
                 .push((entity, at_point.torque_about(center)));
             *at_point = ForceAtPoint::default();
+        }
+    });
+}
+
+/// Bodies with their own share of gravity: the force `(s − 1) m g` on top of the world's
+/// gravity, through the user-force path every integrator and solver reads (so the lookahead,
+/// the integrators and both solvers need no per-body gravity). Kinematic bodies ignore it.
+fn scale_gravity(
+    bodies: Query<(Entity, &GravityScale, &ComputedMass), Active>,
+    gravity: Res<Gravity>,
+    mut gathered: ResMut<GatheredForces>,
+    mut stats: ResMut<PhysicsStats>,
+) {
+    stats.time(Stage::Forces, "forces/gravity_scale", || {
+        let g = gravity.acceleration();
+        for (entity, scale, mass) in &bodies {
+            let m = mass.value();
+            if scale.0 != 1.0 && m.is_finite() {
+                gathered.forces.push((entity, g * ((scale.0 - 1.0) * m)));
+            }
+        }
+    });
+}
+
+type Kicked<'a> = (
+    &'a mut Impulse,
+    &'a mut Velocity,
+    Option<&'a mut AngularVelocity>,
+    &'a ComputedMass,
+    (&'a Position, Option<&'a Rotation>),
+    Option<&'a Inertia>,
+    Option<&'a LockedAxes>,
+);
+
+/// Consumes every [`Impulse`]: `Δv = J / m`, `Δω = I⁻¹ L` about the centre of mass (in world
+/// axes, locked axes left alone), before the step integrates. Kinematic bodies ignore it.
+fn apply_impulses(mut bodies: Query<Kicked, Active>, mut stats: ResMut<PhysicsStats>) {
+    stats.time(Stage::Forces, "forces/impulses", || {
+        for (mut impulse, mut v, w, mass, (p, r), inertia, locked) in &mut bodies {
+            if impulse.is_empty() {
+                continue;
+            }
+            let inverse_mass = mass.inverse();
+            if inverse_mass > 0.0 {
+                v.0 += impulse.linear() * inverse_mass;
+                if let (Some(mut w), Some(inertia)) = (w, inertia) {
+                    let turn = r.map_or(Quat::IDENTITY, |r| r.0);
+                    let center = p.0 + turn * inertia.local_center_of_mass;
+                    let spin = inertia.inverse_world_times(turn, impulse.angular_about(center));
+                    w.0 += spin * locked.map_or(Vec3::ONE, |l| l.free_rotation_axes());
+                }
+            }
+            *impulse = Impulse::default();
         }
     });
 }

@@ -132,9 +132,14 @@ type Sleeper<'a> = (
         Option<&'a Force>,
         Option<&'a Torque>,
         Option<&'a ForceAtPoint>,
+        Option<&'a Impulse>,
     ),
     (
-        (Option<Ref<'a, Mass>>, Option<Ref<'a, Density>>),
+        (
+            Option<Ref<'a, Mass>>,
+            Option<Ref<'a, Density>>,
+            Option<Ref<'a, GravityScale>>,
+        ),
         Option<Ref<'a, Collider>>,
         Option<Ref<'a, Inertia>>,
         Option<Ref<'a, LinearDrag>>,
@@ -147,26 +152,30 @@ type Sleeper<'a> = (
 /// body costs (change ticks, no values). It covers everything validation checks, so that
 /// validation and the other stages can leave sleeping bodies out: a bad value written to a
 /// sleeper wakes it and is then validated.
-type Touched = (
-    With<Sleeping>,
-    Or<(
-        Changed<Position>,
-        Changed<Rotation>,
-        Changed<Velocity>,
-        Changed<AngularVelocity>,
-        Changed<Force>,
-        Changed<Torque>,
-        Changed<ForceAtPoint>,
-        Changed<Mass>,
-        Changed<Density>,
-        Changed<Collider>,
-        Changed<Inertia>,
-        Changed<LinearDrag>,
-        Changed<AngularDrag>,
-        Changed<ChildOf>,
-        Changed<Children>,
-    )>,
-);
+type Touched = (With<Sleeping>, Or<(Moved, Pushed, Reshaped)>);
+type Moved = Or<(
+    Changed<Position>,
+    Changed<Rotation>,
+    Changed<Velocity>,
+    Changed<AngularVelocity>,
+)>;
+type Pushed = Or<(
+    Changed<Force>,
+    Changed<Torque>,
+    Changed<ForceAtPoint>,
+    Changed<Impulse>,
+    Changed<GravityScale>,
+)>;
+type Reshaped = Or<(
+    Changed<Mass>,
+    Changed<Density>,
+    Changed<Collider>,
+    Changed<Inertia>,
+    Changed<LinearDrag>,
+    Changed<AngularDrag>,
+    Changed<ChildOf>,
+    Changed<Children>,
+)>;
 
 /// Wakes sleeping bodies that game code moved, turned, set moving, pushed or reshaped since the
 /// last step, and every body when gravity changed. Values the physics itself writes when a body
@@ -187,15 +196,26 @@ fn wake_on_game_changes(
         }
         return;
     }
-    for (e, mut sleep, (p, r, v), w, (force, torque, at_point), settings) in &mut sleepers.p0() {
+    for (e, mut sleep, (p, r, v), w, pushes, settings) in &mut sleepers.p0() {
+        let (force, torque, at_point, impulse) = pushes;
         let pushed = force.is_some_and(|f| f.0 != Vec3::ZERO)
             || torque.is_some_and(|t| t.0 != Vec3::ZERO)
-            || at_point.is_some_and(|f| !f.is_empty());
+            || at_point.is_some_and(|f| !f.is_empty())
+            || impulse.is_some_and(|i| !i.is_empty());
         let spun = w.is_some_and(|w| w.0 != Vec3::ZERO);
         let moved = p.0 != sleep.at || r.0 != sleep.orientation || v.0 != Vec3::ZERO;
-        let ((mass, density), collider, inertia, drag, angular_drag, parent, children) = settings;
+        let (
+            (mass, density, gravity_scale),
+            collider,
+            inertia,
+            drag,
+            angular_drag,
+            parent,
+            children,
+        ) = settings;
         let rebuilt = written(mass)
             || written(density)
+            || written(gravity_scale)
             || written(collider)
             || written(inertia)
             || written(drag)

@@ -28,6 +28,7 @@ impl Plugin for ValidationPlugin {
             (
                 quarantine_invalid_bodies,
                 quarantine_invalid_rotation,
+                quarantine_invalid_pushes,
                 quarantine_parent_cycles,
                 quarantine_unplaced_bodies,
             )
@@ -148,6 +149,35 @@ fn why_invalid_rotation(
                 )
             })
         })
+}
+
+type Pushes<'a> = (Entity, Option<&'a Impulse>, Option<&'a GravityScale>);
+type ChangedPushes = (
+    Without<Quarantined>,
+    Without<Sleeping>,
+    Or<(Changed<Impulse>, Changed<GravityScale>)>,
+);
+
+/// Impulses and gravity scales must be finite.
+fn quarantine_invalid_pushes(
+    bodies: Query<Pushes, ChangedPushes>,
+    mut stats: ResMut<PhysicsStats>,
+    mut commands: Commands,
+) {
+    stats.time(Stage::Prepare, "prepare/validate_pushes", || {
+        for (entity, impulse, scale) in &bodies {
+            let reason = if impulse.is_some_and(|i| !i.is_finite()) {
+                Some(format!("impulse is not finite: {impulse:?}"))
+            } else {
+                scale
+                    .filter(|s| !s.0.is_finite())
+                    .map(|s| format!("gravity scale must be finite, got {}", s.0))
+            };
+            if let Some(reason) = reason {
+                quarantine(&mut commands, entity, reason);
+            }
+        }
+    });
 }
 
 /// Deepest `ChildOf` chain walked: the hierarchy's walks up a chain stop here, so a loop of

@@ -1,0 +1,252 @@
+//! What a body weighs and what pushes it, through the ECS: mass from the colliders' volume at a
+//! density (by default 1 kg/m³), a `Mass` that overrides it and comes undone, impulses (linear,
+//! at a point, angular, on a sleeper, bad ones) and a per-body gravity scale.
+
+mod common;
+
+use bevy_app::App;
+use bevy_ecs::prelude::*;
+use glam::Vec3;
+use urto::prelude::*;
+
+fn get<T: Component + Copy>(app: &App, e: Entity) -> T {
+    *app.world().get::<T>(e).expect("component present")
+}
+
+#[test]
+fn density_gives_a_ball_a_box_and_a_compound_the_mass_of_their_volume_within_1e_5() {
+    use bevy_ecs::hierarchy::ChildOf;
+    use std::f32::consts::PI;
+    let mut app = common::app();
+    let world = app.world_mut();
+    let ball = world
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(0.0, 0.0, 5.0),
+            Velocity::default(),
+            Density(1000.0),
+        ))
+        .id();
+    let crate_box = world
+        .spawn((
+            Collider::cuboid(0.5, 1.0, 1.5),
+            Position::new(5.0, 0.0, 5.0),
+            Velocity::default(),
+            Density(2.0),
+        ))
+        .id();
+    let root = world
+        .spawn((
+            Collider::cuboid(0.5, 0.5, 0.5),
+            Position::new(-5.0, 0.0, 5.0),
+            Velocity::default(),
+            Density(10.0),
+        ))
+        .id();
+    world.spawn((
+        Collider::sphere(0.25),
+        Position::new(1.0, 0.0, 0.0),
+        ChildOf(root),
+    ));
+    let bad = world
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(0.0, 5.0, 5.0),
+            Velocity::default(),
+            Density(f32::NAN),
+        ))
+        .id();
+    let kinematic = world
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(0.0, -5.0, 5.0),
+            Velocity::default(),
+            Mass::INFINITE,
+            Density(1000.0),
+        ))
+        .id();
+    urto::step(app.world_mut(), 2).unwrap();
+    let mass = |e| app.world().get::<ComputedMass>(e).unwrap().value();
+    let close = |a: f32, b: f32| ((a - b) / b).abs() < 1e-5;
+    let ball_mass = 1000.0 * 4.0 / 3.0 * PI * 0.125;
+    assert!(close(mass(ball), ball_mass), "{}", mass(ball));
+    // The inertia follows the new mass: 2/5 m r².
+    let inertia = app.world().get::<Inertia>(ball).unwrap().principal;
+    assert!(close(inertia.x, 0.4 * ball_mass * 0.25), "{inertia}");
+    assert!(close(mass(crate_box), 2.0 * 1.0 * 2.0 * 3.0));
+    let compound = 10.0 * (1.0 + 4.0 / 3.0 * PI * 0.25f32.powi(3));
+    assert!(close(mass(root), compound), "{} vs {compound}", mass(root));
+    // A NaN density is reported and the default one used.
+    assert!(close(mass(bad), DEFAULT_DENSITY * 4.0 / 3.0 * PI * 0.125));
+    assert!(mass(kinematic).is_infinite());
+    assert!(app.world().get::<Quarantined>(bad).is_none());
+}
+
+#[test]
+fn a_body_weighs_its_volume_by_default_a_given_mass_wins_and_removing_it_restores_within_1e_5() {
+    use std::f32::consts::PI;
+    let mut app = common::app();
+    let world = app.world_mut();
+    let spawn = |world: &mut bevy_ecs::world::World, x: f32| {
+        let at = Position::new(x, 0.0, 5.0);
+        world
+            .spawn((Collider::sphere(2.0), at, Velocity::default()))
+            .id()
+    };
+    let boulder = spawn(world, 0.0);
+    let pebble = world
+        .spawn((
+            Collider::sphere(0.1),
+            Position::new(9.0, 0.0, 5.0),
+            Velocity::default(),
+        ))
+        .id();
+    let given = spawn(world, -9.0);
+    world.entity_mut(given).insert((Mass(3.0), Density(500.0)));
+    let no_volume = world
+        .spawn((Position::new(0.0, 9.0, 5.0), Velocity::default()))
+        .id();
+    urto::step(app.world_mut(), 1).unwrap();
+    let mass = |app: &bevy_app::App, e| app.world().get::<ComputedMass>(e).unwrap().value();
+    let inertia = |app: &bevy_app::App, e| app.world().get::<Inertia>(e).unwrap().principal.x;
+    let close = |a: f32, b: f32| ((a - b) / b).abs() < 1e-5;
+    let ball = |r: f32| DEFAULT_DENSITY * 4.0 / 3.0 * PI * r.powi(3);
+    assert!(
+        close(mass(&app, boulder), ball(2.0)),
+        "{}",
+        mass(&app, boulder)
+    );
+    assert!(close(mass(&app, pebble), ball(0.1)));
+    assert!(close(mass(&app, given), 3.0));
+    assert!(close(inertia(&app, given), 0.4 * 3.0 * 4.0));
+    assert_eq!(mass(&app, no_volume), 1.0);
+    // The mass set by the game goes: the density it also has takes over, inertia too.
+    app.world_mut().entity_mut(given).remove::<Mass>();
+    urto::step(app.world_mut(), 1).unwrap();
+    let from_density = 500.0 * ball(2.0) / DEFAULT_DENSITY;
+    assert!(
+        close(mass(&app, given), from_density),
+        "{}",
+        mass(&app, given)
+    );
+    assert!(close(inertia(&app, given), 0.4 * from_density * 4.0));
+    // And without the density, the default one.
+    app.world_mut().entity_mut(given).remove::<Density>();
+    urto::step(app.world_mut(), 1).unwrap();
+    assert!(close(mass(&app, given), ball(2.0)));
+    // 20 times the radius, 8,000 times the mass.
+    assert!(close(mass(&app, boulder) / mass(&app, pebble), 8000.0));
+}
+
+/// A ball of radius 0.5 and `mass` kg (I = 0.1 m kg m²) at `at`.
+fn ball(app: &mut App, at: Vec3, mass: f32) -> Entity {
+    let body = (Collider::sphere(0.5), Position(at), Velocity::default());
+    app.world_mut().spawn((body, Mass(mass))).id()
+}
+
+#[test]
+fn an_impulse_changes_velocity_by_j_over_m_and_spin_by_r_cross_j_over_i_within_1e_6() {
+    let mut app = common::app();
+    let (m, dt) = (2.0, 1.0 / 60.0);
+    let through = ball(&mut app, Vec3::ZERO, m);
+    let at_point = ball(&mut app, Vec3::new(5.0, 0.0, 0.0), m);
+    let locked = ball(&mut app, Vec3::new(10.0, 0.0, 0.0), m);
+    let spun = ball(&mut app, Vec3::new(15.0, 0.0, 0.0), m);
+    let world = app.world_mut();
+    world
+        .entity_mut(through)
+        .insert(Impulse::new(Vec3::X * 4.0));
+    // 4 N·s along x, 0.5 m above the centre: 2 N·m·s about +y.
+    let mut shove = Impulse::default();
+    shove.add_at_point(Vec3::X * 4.0, Vec3::new(5.0, 0.0, 0.5));
+    world.entity_mut(at_point).insert(shove);
+    let mut shove_locked = Impulse::default();
+    shove_locked.add_at_point(Vec3::X * 4.0, Vec3::new(10.0, 0.0, 0.5));
+    world
+        .entity_mut(locked)
+        .insert((shove_locked, LockedAxes::ROTATION_LOCKED));
+    let mut twist = Impulse::default();
+    twist.add_angular(Vec3::Z * 0.3);
+    world.entity_mut(spun).insert(twist);
+    urto::step(app.world_mut(), 1).unwrap();
+    let close = |a: Vec3, b: Vec3| (a - b).length() < 1e-6;
+    let v = |e| get::<Velocity>(&app, e).0;
+    let w = |e| get::<AngularVelocity>(&app, e).0;
+    let i = 0.1 * m;
+    assert!(close(v(through), Vec3::X * 2.0), "{}", v(through));
+    assert!(close(w(through), Vec3::ZERO));
+    assert!(close(get::<Position>(&app, through).0, Vec3::X * 2.0 * dt));
+    assert!(close(v(at_point), Vec3::X * 2.0));
+    assert!(close(w(at_point), Vec3::Y * 2.0 / i), "{}", w(at_point));
+    assert!(close(v(locked), Vec3::X * 2.0) && w(locked) == Vec3::ZERO);
+    assert!(close(w(spun), Vec3::Z * 0.3 / i) && v(spun) == Vec3::ZERO);
+    // Spent: the next step leaves the velocities as they are.
+    assert!(get::<Impulse>(&app, through).is_empty());
+    urto::step(app.world_mut(), 1).unwrap();
+    assert!(close(get::<Velocity>(&app, through).0, Vec3::X * 2.0));
+}
+
+#[test]
+fn an_impulse_wakes_a_sleeper_kinematic_bodies_ignore_it_and_a_nan_one_is_quarantined() {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    app.world_mut()
+        .spawn((Collider::half_space(Vec3::Z), Static));
+    let sleeper = ball(&mut app, Vec3::new(0.0, 0.0, 0.5), 1.0);
+    let kinematic = ball(&mut app, Vec3::new(5.0, 0.0, 3.0), 1.0);
+    app.world_mut().entity_mut(kinematic).insert(Mass::INFINITE);
+    let bad = ball(&mut app, Vec3::new(-5.0, 0.0, 0.5), 1.0);
+    urto::step(app.world_mut(), 120).unwrap();
+    assert!(
+        app.world().get::<Sleeping>(sleeper).is_some(),
+        "asleep first"
+    );
+    let world = app.world_mut();
+    world
+        .entity_mut(sleeper)
+        .insert(Impulse::new(Vec3::Z * 3.0));
+    world
+        .entity_mut(kinematic)
+        .insert(Impulse::new(Vec3::Z * 3.0));
+    world
+        .entity_mut(bad)
+        .insert(Impulse::new(Vec3::new(f32::NAN, 0.0, 0.0)));
+    urto::step(app.world_mut(), 1).unwrap();
+    let up = get::<Velocity>(&app, sleeper).0.z;
+    // 3 m/s up, less one step of gravity.
+    assert!((up - (3.0 - 9.8 / 60.0)).abs() < 0.05, "{up}");
+    assert!(app.world().get::<Sleeping>(sleeper).is_none());
+    assert_eq!(get::<Velocity>(&app, kinematic).0, Vec3::ZERO);
+    assert!(app.world().get::<Quarantined>(bad).is_some());
+}
+
+#[test]
+fn a_gravity_scale_of_half_falls_at_half_g_zero_floats_minus_one_rises_within_1e_4() {
+    // Through the rigid-body solver and through the lecture's pipeline.
+    gravity_scales_in(common::app());
+    gravity_scales_in(common::legacy_app());
+}
+
+fn gravity_scales_in(mut app: App) {
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    let scaled = |app: &mut App, x: f32, s: f32| {
+        let b = ball(app, Vec3::new(x, 0.0, 50.0), 3.0);
+        app.world_mut().entity_mut(b).insert(GravityScale(s));
+        b
+    };
+    let (half, none, up) = (
+        scaled(&mut app, 0.0, 0.5),
+        scaled(&mut app, 5.0, 0.0),
+        scaled(&mut app, 10.0, -1.0),
+    );
+    let plain = ball(&mut app, Vec3::new(15.0, 0.0, 50.0), 3.0);
+    let bad = scaled(&mut app, 20.0, f32::INFINITY);
+    urto::step(app.world_mut(), 60).unwrap();
+    let vz = |e| get::<Velocity>(&app, e).0.z;
+    let g = 9.8;
+    assert!((vz(half) + 0.5 * g).abs() < 1e-4, "{}", vz(half));
+    assert!(vz(none).abs() < 1e-4 && (get::<Position>(&app, none).0.z - 50.0).abs() < 1e-4);
+    assert!((vz(up) - g).abs() < 1e-4, "{}", vz(up));
+    assert!((vz(plain) + g).abs() < 1e-4);
+    assert!(app.world().get::<Quarantined>(bad).is_some());
+}
