@@ -1,6 +1,7 @@
 //! What a body weighs and what pushes it, through the ECS: mass from the colliders' volume at a
 //! density (by default 1 kg/m³), a `Mass` that overrides it and comes undone, impulses (linear,
-//! at a point, angular, on a sleeper, bad ones) and a per-body gravity scale.
+//! at a point, angular, on a sleeper, bad ones), a per-body gravity scale, and a cone standing
+//! on its base or falling over from its apex.
 
 mod common;
 
@@ -249,4 +250,40 @@ fn gravity_scales_in(mut app: App) {
     assert!((vz(up) - g).abs() < 1e-4, "{}", vz(up));
     assert!((vz(plain) + g).abs() < 1e-4);
     assert!(app.world().get::<Quarantined>(bad).is_some());
+}
+
+#[test]
+fn a_cone_stands_on_its_base_within_1_degree_and_one_on_its_apex_falls_over_past_60() {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    app.world_mut()
+        .spawn((Collider::half_space(Vec3::Z), Static));
+    let (h, r) = (0.4, 0.3);
+    let cone = |app: &mut App, at: Vec3, turn: f32| {
+        let pose = (Position(at), Rotation(glam::Quat::from_rotation_x(turn)));
+        let body = (Collider::cone(h, r), Velocity::default(), Density(500.0));
+        app.world_mut().spawn((body, pose)).id()
+    };
+    let standing = cone(&mut app, Vec3::new(0.0, 0.0, h + 0.05), 0.0);
+    // Upside down, a hair off its apex's balance.
+    let tipping = cone(
+        &mut app,
+        Vec3::new(3.0, 0.0, h + 0.05),
+        std::f32::consts::PI - 0.02,
+    );
+    urto::step(app.world_mut(), 180).unwrap();
+    let up = |e| get::<Rotation>(&app, e).0 * Vec3::Z;
+    let tilt = |e| up(e).angle_between(Vec3::Z).to_degrees();
+    assert!(tilt(standing) < 1.0, "{}", tilt(standing));
+    // Its base rests on the ground: the origin half the height above it.
+    let z = get::<Position>(&app, standing).0.z;
+    assert!((z - h).abs() < 0.01, "{z}");
+    assert!(
+        tilt(tipping) > 60.0 && tilt(tipping) < 179.0,
+        "{}",
+        tilt(tipping)
+    );
+    let mass = get::<ComputedMass>(&app, standing).value();
+    let expected = 500.0 * std::f32::consts::PI * r * r * 2.0 * h / 3.0;
+    assert!((mass / expected - 1.0).abs() < 1e-5, "{mass} vs {expected}");
 }

@@ -43,7 +43,7 @@ pub fn toi_sphere_shape(
         Shape::Cuboid(c) => toi_sphere_cuboid(sweep, pose, c),
         Shape::HalfSpace(h) => toi_sphere_halfspace(sweep, pose, h),
         Shape::Capsule(c) => toi_sphere_capsule(sweep, pose, c),
-        Shape::Cylinder(_) | Shape::Ellipsoid(_) | Shape::ConvexHull(_) => {
+        Shape::Cylinder(_) | Shape::Cone(_) | Shape::Ellipsoid(_) | Shape::ConvexHull(_) => {
             toi_sphere_convex(sweep, shape, pose)
         }
         Shape::TriMesh(m) => toi_sphere_trimesh(sweep, m.mesh(), m.bvh(), pose, scratch)

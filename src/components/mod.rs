@@ -174,6 +174,15 @@ impl Collider {
         }
     }
 
+    /// A solid cone along the body's local z axis (apex up when unrotated): its base of `radius`
+    /// `half_height` below the body's origin, its apex `half_height` above; the centre of mass
+    /// is a quarter of the height above the base. Traffic cones, spikes, lamp shades.
+    pub fn cone(half_height: f32, radius: f32) -> Self {
+        Self {
+            shape: Shape::cone(half_height, radius),
+        }
+    }
+
     /// A solid ellipsoid of semi-axes `rx`, `ry`, `rz` along the body's local axes.
     pub fn ellipsoid(rx: f32, ry: f32, rz: f32) -> Self {
         Self {

@@ -138,6 +138,18 @@ impl MassProperties {
         Self::from_f64(mass, DVec3::ZERO, tensor)
     }
 
+    /// A solid cone along z ([`Cone`](crate::geometry::Cone): base at `−half_height`, apex at
+    /// `+half_height`) of `radius` and `density` (kg/m³): `m = π r² (2h) ρ / 3`, its centre of
+    /// mass at `z = −h/2` (a quarter of the height above the base), and about it
+    /// `I_z = 3 m r²/10`, `I_x = I_y = 3 m (r²/20 + (2h)²/80) = 3 m (r² + h²)/20`.
+    pub fn cone(half_height: f32, radius: f32, density: f32) -> Self {
+        let (h, r) = (half_height as f64, radius as f64);
+        let mass = std::f64::consts::PI * r * r * 2.0 * h * density as f64 / 3.0;
+        let across = 3.0 * mass * (r * r + h * h) / 20.0;
+        let tensor = DMat3::from_diagonal(DVec3::new(across, across, 0.3 * mass * r * r));
+        Self::from_f64(mass, DVec3::new(0.0, 0.0, -h / 2.0), tensor)
+    }
+
     /// A solid ellipsoid of semi-axes `radii` and `density` (kg/m³), centred on the origin:
     /// `m = 4/3 π abc ρ`, `I_x = m (b² + c²)/5` and so on.
     pub fn ellipsoid(radii: Vec3, density: f32) -> Self {
@@ -272,7 +284,7 @@ impl MassProperties {
 }
 
 impl Shape {
-    /// Mass properties at `density` (kg/m³): sphere, cuboid, capsule, cylinder, ellipsoid,
+    /// Mass properties at `density` (kg/m³): sphere, cuboid, capsule, cylinder, cone, ellipsoid,
     /// convex hull, half-space (infinite), triangle mesh (solid if closed, else a thin shell: see [`MassProperties::trimesh`]).
     pub fn mass_properties(&self, density: f32) -> MassProperties {
         match self {
@@ -281,6 +293,7 @@ impl Shape {
             Self::HalfSpace(_) => MassProperties::infinite(),
             Self::Capsule(c) => MassProperties::capsule(c.half_length, c.radius, density),
             Self::Cylinder(c) => MassProperties::cylinder(c.half_height, c.radius, density),
+            Self::Cone(c) => MassProperties::cone(c.half_height, c.radius, density),
             Self::Ellipsoid(e) => MassProperties::ellipsoid(e.radii, density),
             Self::ConvexHull(h) => MassProperties::convex_hull(h, density),
             Self::TriMesh(m) => MassProperties::trimesh(m.mesh(), density),

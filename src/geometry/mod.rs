@@ -26,7 +26,9 @@ pub use mass_properties::MassProperties;
 pub use mesh_collider::{MeshCollider, MeshColliderError};
 pub use mesh_intersects::BadPose;
 pub use primitives_mesh::MAX_PROCEDURAL_VERTICES;
-pub use shapes::{Capsule, Cuboid, Cylinder, Ellipsoid, HalfSpace, Shape, ShapeError, Sphere};
+pub use shapes::{
+    Capsule, Cone, Cuboid, Cylinder, Ellipsoid, HalfSpace, Shape, ShapeError, Sphere,
+};
 pub use tri_tri::{TriTriIntersection, tri_tri_intersect, tri_tri_intersection};
 pub use triangle::{
     Triangle, contact_triangle_halfspace, contact_triangle_sphere,

@@ -57,6 +57,17 @@ pub struct Cylinder {
     pub radius: f32,
 }
 
+/// A solid cone along the local **z** axis (as [`Cylinder`]): its flat base at `z = −half_height`
+/// of `radius`, its apex at `z = +half_height` (parry's and rapier's convention, turned to z). Its
+/// centre of mass is a quarter of the height above the base, at `z = −half_height / 2`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cone {
+    /// Half the height, from the centre to the apex and to the base, `>= 0`.
+    pub half_height: f32,
+    /// Radius of the base, `>= 0`.
+    pub radius: f32,
+}
+
 /// A solid ellipsoid centred on the local origin with semi-axes `radii` along the local axes:
 /// the slides' closed-form quadric `(x/a)² + (y/b)² + (z/c)² <= 1`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -90,6 +101,8 @@ pub enum Shape {
     Cylinder(Cylinder),
     /// See [`Ellipsoid`].
     Ellipsoid(Ellipsoid),
+    /// See [`Cone`].
+    Cone(Cone),
     /// A convex polyhedron; see [`ConvexHull`]. Cheap to clone (shared).
     ConvexHull(Arc<ConvexHull>),
     /// A triangle mesh (a surface: open meshes are fine) with its hierarchy; see
@@ -171,6 +184,15 @@ impl Shape {
         })
     }
 
+    /// A cone along local z: its base `half_height` below the centre, of `radius`, its apex
+    /// `half_height` above.
+    pub fn cone(half_height: f32, radius: f32) -> Self {
+        Self::Cone(Cone {
+            half_height,
+            radius,
+        })
+    }
+
     /// An ellipsoid of semi-axes `radii` along the local axes.
     pub fn ellipsoid(radii: Vec3) -> Self {
         Self::Ellipsoid(Ellipsoid { radii })
@@ -201,6 +223,7 @@ impl Shape {
             Self::Sphere(Sphere { radius })
             | Self::Capsule(Capsule { radius, .. })
             | Self::Cylinder(Cylinder { radius, .. })
+            | Self::Cone(Cone { radius, .. })
                 if !(radius.is_finite() && *radius >= 0.0) =>
             {
                 Err(ShapeError::BadRadius(*radius))
@@ -211,12 +234,22 @@ impl Shape {
             Self::Capsule(c) if c.half_length.max(c.radius) > MAX_SHAPE_EXTENT => {
                 Err(ShapeError::TooLarge(c.half_length.max(c.radius)))
             }
-            Self::Cylinder(c) if !(c.half_height.is_finite() && c.half_height >= 0.0) => {
-                Err(ShapeError::BadLength(c.half_height))
-            }
-            Self::Cylinder(c) if c.half_height.max(c.radius) > MAX_SHAPE_EXTENT => {
-                Err(ShapeError::TooLarge(c.half_height.max(c.radius)))
-            }
+            Self::Cylinder(Cylinder {
+                half_height: h,
+                radius: r,
+            })
+            | Self::Cone(Cone {
+                half_height: h,
+                radius: r,
+            }) if !(h.is_finite() && *h >= 0.0) => Err(ShapeError::BadLength(*h)),
+            Self::Cylinder(Cylinder {
+                half_height: h,
+                radius: r,
+            })
+            | Self::Cone(Cone {
+                half_height: h,
+                radius: r,
+            }) if h.max(*r) > MAX_SHAPE_EXTENT => Err(ShapeError::TooLarge(h.max(*r))),
             Self::Ellipsoid(e) if !(e.radii.is_finite() && e.radii.cmpge(Vec3::ZERO).all()) => {
                 Err(ShapeError::BadRadii(e.radii))
             }
@@ -268,6 +301,15 @@ impl Shape {
                 let half = axis.abs() * c.half_height + rim;
                 Aabb::from_center_half_extents(pose.translation, half)
             }
+            Self::Cone(c) => {
+                // The apex, and the base's circle (as a cylinder's cap).
+                let axis = pose.rotation * Vec3::Z;
+                let rim = (Vec3::ONE - axis * axis).max(Vec3::ZERO).sqrt() * c.radius;
+                let (apex, base) = (axis * c.half_height, -axis * c.half_height);
+                let lo = apex.min(base - rim) + pose.translation;
+                let hi = apex.max(base + rim) + pose.translation;
+                Aabb::new(lo, hi)
+            }
             Self::Ellipsoid(e) => {
                 // Row i of R·diag(radii) has length sqrt(Σ_j (R_ij r_j)²): the support along
                 // world axis i.
@@ -303,6 +345,8 @@ impl Shape {
             Self::HalfSpace(_) => f32::INFINITY,
             Self::Capsule(c) => c.half_length + c.radius,
             Self::Cylinder(c) => c.half_height.hypot(c.radius),
+            // The base's rim is farther than the apex.
+            Self::Cone(c) => c.half_height.hypot(c.radius),
             Self::Ellipsoid(e) => e.radii.max_element(),
             Self::ConvexHull(h) => h.bounding_radius(),
             Self::TriMesh(m) => m.bounding_radius(),
@@ -326,10 +370,41 @@ mod tests {
         assert!(Shape::capsule(0.5, f32::NAN).validate().is_err());
         assert!(Shape::capsule(f32::INFINITY, 0.5).validate().is_err());
         assert!(Shape::capsule(2e6, 0.5).validate().is_err());
+        assert!(Shape::cone(0.0, 0.0).validate().is_ok());
+        for (h, r) in [
+            (-0.1, 0.5),
+            (0.5, -0.1),
+            (f32::NAN, 0.5),
+            (0.5, f32::INFINITY),
+            (2e6, 1.0),
+        ] {
+            assert!(Shape::cone(h, r).validate().is_err(), "{h} {r}");
+        }
         assert!(
             Shape::half_space(Vec3::new(0.0, 0.0, 3.0))
                 .validate()
                 .is_ok()
         );
+    }
+
+    #[test]
+    fn a_turned_cones_aabb_is_its_support_along_each_world_axis_within_1e_5() {
+        use crate::geometry::convex::support::ConvexPart;
+        use glam::Quat;
+        let cone = Shape::cone(0.7, 0.4);
+        for k in 0..50 {
+            let t = k as f32 * 0.37;
+            let turn = Quat::from_euler(glam::EulerRot::XYZ, t, 1.3 * t, 0.7 * t);
+            let pose = Isometry::new(Vec3::new(t, -1.0, 2.0), turn);
+            let aabb = cone.world_aabb(&pose);
+            let Some(part) = ConvexPart::of_shape(&cone, pose) else {
+                panic!("a cone is convex");
+            };
+            for axis in Vec3::AXES {
+                let (hi, lo) = (part.support(axis).dot(axis), part.support(-axis).dot(axis));
+                assert!((aabb.max.dot(axis) - hi).abs() < 1e-5, "{k}: {aabb:?} {hi}");
+                assert!((aabb.min.dot(axis) - lo).abs() < 1e-5, "{k}: {aabb:?} {lo}");
+            }
+        }
     }
 }

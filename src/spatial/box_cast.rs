@@ -77,7 +77,7 @@ pub fn cast_box(
             against_plane(lowest, 0.0, motion, target, h)
         }
         Shape::Capsule(c) => against_capsule(cast, target, c),
-        Shape::Cylinder(_) | Shape::Ellipsoid(_) | Shape::ConvexHull(_) => {
+        Shape::Cylinder(_) | Shape::Cone(_) | Shape::Ellipsoid(_) | Shape::ConvexHull(_) => {
             let me = Shape::cuboid(cast.half_extents);
             let motion = (cast.direction, cast.max_distance);
             against_convex((&me, &cast.pose), motion, (shape, target))

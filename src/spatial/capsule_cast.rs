@@ -107,7 +107,7 @@ pub fn cast_capsule(
                 gap_from(on_other, on_axis, other.radius)
             })
         }
-        Shape::Cylinder(_) | Shape::Ellipsoid(_) | Shape::ConvexHull(_) => {
+        Shape::Cylinder(_) | Shape::Cone(_) | Shape::Ellipsoid(_) | Shape::ConvexHull(_) => {
             let me = Shape::Capsule(cast.capsule);
             let motion = (cast.direction, cast.max_distance);
             against_convex((&me, &cast.pose), motion, (shape, target))

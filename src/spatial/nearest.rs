@@ -80,7 +80,7 @@ pub fn nearest_point(
                 on_axis + out * (c.radius / d.max(f32::MIN_POSITIVE)),
             )
         }
-        Shape::Cylinder(_) | Shape::Ellipsoid(_) | Shape::ConvexHull(_) => {
+        Shape::Cylinder(_) | Shape::Cone(_) | Shape::Ellipsoid(_) | Shape::ConvexHull(_) => {
             let probe = Isometry::from_translation(local);
             match signed_distance(shape, &Isometry::IDENTITY, &Shape::sphere(0.0), &probe) {
                 Some(d) => solid(d.distance <= 0.0, d.on_a),

@@ -98,6 +98,7 @@ fn bad_shapes_and_rotations_are_quarantined() {
         .spawn(Collider::cylinder(f32::NAN, 0.5))
         .id();
     let e9 = app.world_mut().spawn(Collider::cylinder(0.5, -1.0)).id();
+    let e9b = app.world_mut().spawn(Collider::cone(0.5, f32::NAN)).id();
     let e10 = app
         .world_mut()
         .spawn(Collider::ellipsoid(0.5, f32::INFINITY, 0.5))
@@ -130,7 +131,7 @@ fn bad_shapes_and_rotations_are_quarantined() {
         .spawn((Collider::capsule(0.5, 0.25), Velocity::default()))
         .id();
     urto::step(app.world_mut(), 1).unwrap();
-    for e in [e1, e2, e3, e4, e5, e6, e7, e8, e9, e10, e11] {
+    for e in [e1, e2, e3, e4, e5, e6, e7, e8, e9, e9b, e10, e11] {
         assert!(quarantined(&app, e));
     }
     assert!(!quarantined(&app, good));

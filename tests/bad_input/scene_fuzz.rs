@@ -36,7 +36,7 @@ const STEPS: u32 = 90;
 fn random_shape(rng: &mut Rng, size: f32) -> Collider {
     let mut side = || size * rng.range(0.05, 1.0);
     let (a, b, c) = (side(), side(), side());
-    match rng.below(7) {
+    match rng.below(8) {
         0 => Collider::sphere(a),
         1 => Collider::cuboid(a, b, c),
         2 => Collider::capsule(a, b),
@@ -47,6 +47,7 @@ fn random_shape(rng: &mut Rng, size: f32) -> Collider {
             // A cloud too flat for a hull is an `Err` (tested elsewhere): a box stands in.
             Collider::convex_hull(&points).unwrap_or(Collider::cuboid(a, b, c))
         }
+        6 => Collider::cone(a, b),
         _ => {
             let mesh = TriMesh::uv_sphere(a, 6 + rng.below(10) as u32, 4 + rng.below(8) as u32);
             mesh.ok()

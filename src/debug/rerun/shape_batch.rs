@@ -87,6 +87,23 @@ impl ShapeBatch {
                 batch.colors.push(color);
                 batch.labels.push(label);
             }
+            Shape::Cone(c) => {
+                // No cone primitive in rerun: the base's circle and four lines to the apex,
+                // drawn as a hull's outline is.
+                let at = |v: Vec3| arr(p + r * v);
+                let apex = Vec3::Z * c.half_height;
+                let rim = |k: usize| {
+                    let turn = std::f32::consts::TAU * k as f32 / 24.0;
+                    Vec3::new(turn.cos(), turn.sin(), 0.0) * c.radius - apex
+                };
+                self.hull_strips
+                    .push((0..=24).map(|k| at(rim(k))).collect());
+                self.hull_colors.push(color);
+                for k in [0, 6, 12, 18] {
+                    self.hull_strips.push(vec![at(rim(k)), at(apex)]);
+                    self.hull_colors.push(color);
+                }
+            }
             Shape::ConvexHull(h) => {
                 for face in 0..h.faces().len() {
                     let mut strip: Vec<[f32; 3]> =

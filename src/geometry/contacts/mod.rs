@@ -219,8 +219,8 @@ fn primitive_contact(
             primitive_contact(b, pose_b, a, pose_a).map(ContactManifold::flipped)
         }
         (HalfSpace(_), HalfSpace(_)) | (TriMesh(_), _) | (_, TriMesh(_)) => None,
-        (Cylinder(_) | Ellipsoid(_) | ConvexHull(_), _)
-        | (_, Cylinder(_) | Ellipsoid(_) | ConvexHull(_)) => None,
+        (Cylinder(_) | Cone(_) | Ellipsoid(_) | ConvexHull(_), _)
+        | (_, Cylinder(_) | Cone(_) | Ellipsoid(_) | ConvexHull(_)) => None,
     }
 }
 
@@ -228,7 +228,7 @@ fn primitive_contact(
 pub(crate) fn is_general_convex(shape: &Shape) -> bool {
     matches!(
         shape,
-        Shape::Cylinder(_) | Shape::Ellipsoid(_) | Shape::ConvexHull(_)
+        Shape::Cylinder(_) | Shape::Cone(_) | Shape::Ellipsoid(_) | Shape::ConvexHull(_)
     )
 }
 
@@ -281,7 +281,8 @@ fn canonical_swap(a: &Shape, pose_a: &Isometry, b: &Shape, pose_b: &Isometry) ->
         Shape::Cuboid(_) => 2,
         Shape::Cylinder(_) => 3,
         Shape::Ellipsoid(_) => 4,
-        _ => 5,
+        Shape::Cone(_) => 5,
+        _ => 6,
     };
     let key = |p: &Isometry| {
         let (t, r) = (p.translation, p.rotation);
@@ -298,7 +299,7 @@ mod tests {
     use super::*;
     use glam::Quat;
 
-    fn shapes() -> [Shape; 8] {
+    fn shapes() -> [Shape; 9] {
         let ball = crate::geometry::TriMesh::uv_sphere(0.7, 24, 12).unwrap();
         let gem = [
             Vec3::new(0.6, 0.1, 0.0),
@@ -317,6 +318,7 @@ mod tests {
             Shape::cylinder(0.4, 0.5),
             Shape::ellipsoid(Vec3::new(0.6, 0.4, 0.3)),
             Shape::convex_hull(&gem).unwrap(),
+            Shape::cone(0.5, 0.5),
         ]
     }
 
@@ -358,6 +360,8 @@ mod tests {
                 Shape::capsule(0.5, x),
                 Shape::cylinder(x, 0.5),
                 Shape::cylinder(0.5, x),
+                Shape::cone(x, 0.5),
+                Shape::cone(0.5, x),
                 Shape::ellipsoid(Vec3::new(0.5, x, 0.5)),
             ];
             for a in shapes().iter().chain(&bad_shapes) {
@@ -380,6 +384,8 @@ mod tests {
             Shape::cylinder(0.0, 0.5),
             Shape::cylinder(0.5, 0.0),
             Shape::cylinder(0.0, 0.0),
+            Shape::cone(0.0, 0.5),
+            Shape::cone(0.5, 0.0),
             Shape::ellipsoid(Vec3::new(0.5, 0.0, 0.5)),
             Shape::ellipsoid(Vec3::ZERO),
             Shape::cuboid(Vec3::new(0.5, 0.0, 0.5)),
@@ -426,9 +432,12 @@ mod tests {
             cylinder,
             ellipsoid,
             hull,
+            cone,
         ] = shapes();
         for (a, b) in [
             (&cylinder, &hull),
+            (&cone, &cylinder),
+            (&mesh, &cone),
             (&hull, &ellipsoid),
             (&mesh, &cylinder),
             (&ellipsoid, &sphere),
@@ -455,5 +464,6 @@ mod tests {
         assert!(contact(&mesh, &pa, &half_space, &pb).is_some());
         assert!(contact(&half_space, &pa, &hull, &pb).is_none());
         assert!(contact(&cylinder, &pa, &half_space, &pb).is_some());
+        assert!(contact(&half_space, &pa, &cone, &pb).is_none());
     }
 }

@@ -34,6 +34,7 @@ fn grown(shape: &Shape, margin: f32) -> Option<Shape> {
         Shape::HalfSpace(_)
         | Shape::TriMesh(_)
         | Shape::Cylinder(_)
+        | Shape::Cone(_)
         | Shape::Ellipsoid(_)
         | Shape::ConvexHull(_) => None,
     }

@@ -42,6 +42,8 @@ pub(crate) enum Core<'a> {
     Cuboid(Vec3),
     /// A cylinder along z: `(half_height, radius)`.
     Cylinder(f32, f32),
+    /// A cone along z, base at `−half_height`, apex at `+half_height`: `(half_height, radius)`.
+    Cone(f32, f32),
     /// An ellipsoid of these semi-axes.
     Ellipsoid(Vec3),
     /// A convex polyhedron.
@@ -117,6 +119,7 @@ impl<'a> ConvexPart<'a> {
             Shape::Capsule(c) => (Core::Segment(c.half_length), c.radius),
             Shape::Cuboid(c) => (Core::Cuboid(c.half_extents), 0.0),
             Shape::Cylinder(c) => (Core::Cylinder(c.half_height, c.radius), 0.0),
+            Shape::Cone(c) => (Core::Cone(c.half_height, c.radius), 0.0),
             Shape::Ellipsoid(e) => (Core::Ellipsoid(e.radii), 0.0),
             Shape::ConvexHull(h) => (Core::Hull(h), 0.0),
             Shape::HalfSpace(_) | Shape::TriMesh(_) => return None,
@@ -177,6 +180,12 @@ impl<'a> ConvexPart<'a> {
                 let radial = Vec2::new(d.x, d.y).normalize_or_zero() * r;
                 Vec3::new(radial.x, radial.y, h * sign(d.z))
             }
+            Core::Cone(h, r) => {
+                // The apex or the base's rim point under `d`, whichever reaches farther (the
+                // apex on a tie).
+                let (apex, rim) = cone_apex_and_rim(h, r, d);
+                if rim.dot(d) > apex.dot(d) { rim } else { apex }
+            }
             Core::Ellipsoid(r) => {
                 // Where the normal r^-2 ⊙ x is parallel to d on (x/r)² = 1.
                 let scaled = r * d;
@@ -225,6 +234,7 @@ impl<'a> ConvexPart<'a> {
             }
             Core::Cuboid(h) => box_face(h, d),
             Core::Cylinder(h, r) => cylinder_feature(h, r, d, len),
+            Core::Cone(h, r) => cone_feature(h, r, d, len),
             Core::Hull(hull) => hull_face(hull, d),
             _ => single(self.local_support(d)),
         }
@@ -238,7 +248,7 @@ fn core_size(core: Core) -> f32 {
         Core::Point => 0.0,
         Core::Segment(h) => h,
         Core::Cuboid(h) => h.max_element(),
-        Core::Cylinder(h, r) => h.max(r),
+        Core::Cylinder(h, r) | Core::Cone(h, r) => h.max(r),
         Core::Ellipsoid(r) => r.max_element(),
         Core::Hull(h) => h.bounding_radius(),
         Core::Triangle([a, b, c]) => (a - b).length().max((b - c).length()),
@@ -306,6 +316,35 @@ fn cylinder_feature(h: f32, r: f32, d: Vec3, len: f32) -> Feature {
         f.push(Vec3::new(rim.x, rim.y, h));
     } else {
         f.push(Vec3::new(rim.x, rim.y, s * h));
+    }
+    f
+}
+
+/// A cone's apex and the point of its base's rim under `d`'s azimuth (any rim point when `d`
+/// is along the axis).
+fn cone_apex_and_rim(h: f32, r: f32, d: Vec3) -> (Vec3, Vec3) {
+    let radial = Vec2::new(d.x, d.y).try_normalize().unwrap_or(Vec2::X) * r;
+    (Vec3::new(0.0, 0.0, h), Vec3::new(radial.x, radial.y, -h))
+}
+
+/// A cone's base (a polygon, as a cylinder's cap) when `d` points down its axis, the side line
+/// from the rim to the apex when `d` is square to that line, else its support point.
+fn cone_feature(h: f32, r: f32, d: Vec3, len: f32) -> Feature {
+    if -d.z >= CAP_FEATURE_COSINE * len {
+        // The bottom cap of a cylinder of the same height and radius.
+        return cylinder_feature(h, r, d, len);
+    }
+    let (apex, rim) = cone_apex_and_rim(h, r, d);
+    let mut f = Feature::new(None);
+    // `d` lies in the plane of its azimuth, as the side line does: the line supports the cone
+    // when `d` is nearly square to it and points out of the cone.
+    let along = (apex - rim).try_normalize().map_or(1.0, |s| s.dot(d).abs());
+    let outward = Vec3::new(rim.x, rim.y, 0.0) * (2.0 * h) + Vec3::Z * (r * r);
+    if along <= LINE_FEATURE_SINE * len && outward.dot(d) > 0.0 {
+        f.push(rim);
+        f.push(apex);
+    } else {
+        f.push(if rim.dot(d) > apex.dot(d) { rim } else { apex });
     }
     f
 }
