@@ -1,0 +1,243 @@
+//! The ECS face: `SpatialQuery` in a Bevy world (hits, filters, entities, nearest, box casts),
+//! the index following steps and spawns, and layers in the step and in continuous collision.
+
+use super::*;
+
+const BALLS: LayerMask = LayerMask(1 << 1);
+
+/// Ground, a static box at x = 5 and a ball in layer [`BALLS`] resting at the origin.
+fn ecs_scene() -> (App, [Entity; 3]) {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    let world = app.world_mut();
+    let ground = world.spawn((Collider::half_space(Vec3::Z), Static)).id();
+    let block = world
+        .spawn((
+            Collider::cuboid(1.0, 1.0, 1.0),
+            Position::new(5.0, 0.0, 1.0),
+            Static,
+        ))
+        .id();
+    let ball = world
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(0.0, 0.0, 0.5),
+            Velocity::default(),
+            CollisionLayers::new(BALLS, LayerMask::ALL),
+        ))
+        .id();
+    urto::step(app.world_mut(), 1).unwrap();
+    (app, [ground, block, ball])
+}
+
+#[test]
+fn spatial_query_hits_filters_and_lists_entities_in_a_bevy_world() {
+    let (mut app, [ground, block, ball]) = ecs_scene();
+    let world = app.world_mut();
+    let top = Vec3::new(0.0, 0.0, 10.0);
+    let results = world
+        .run_system_once(move |q: SpatialQuery| {
+            let all = SpatialQueryFilter::default();
+            let first = q
+                .cast_ray(top, -Vec3::Z, f32::INFINITY, &all)
+                .unwrap()
+                .unwrap();
+            let no_balls = SpatialQueryFilter::from_mask(!BALLS);
+            let past_ball = q
+                .cast_ray(top, -Vec3::Z, 100.0, &no_balls)
+                .unwrap()
+                .unwrap();
+            let excluded = all.clone().with_excluded([first.entity]);
+            let excluding = q
+                .cast_ray(top, -Vec3::Z, 100.0, &excluded)
+                .unwrap()
+                .unwrap();
+            let every = q.cast_ray_all(top, -Vec3::Z, 100.0, &all).unwrap();
+            let side = q
+                .cast_sphere(0.5, Vec3::new(0.0, 0.0, 1.0), Vec3::X, 20.0, &all)
+                .unwrap()
+                .unwrap();
+            let inside = q.containing_point(Vec3::new(5.2, 0.3, 1.5), &all).unwrap();
+            let around = q
+                .overlapping(
+                    &Shape::sphere(1.0),
+                    Isometry::from_translation(Vec3::new(0.0, 0.0, 0.9)),
+                    &all,
+                )
+                .unwrap();
+            let refused = q.cast_ray(Vec3::NAN, Vec3::X, 1.0, &all).is_err()
+                && q.cast_box(Vec3::ONE, Isometry::IDENTITY, Vec3::ZERO, 1.0, &all)
+                    .is_err();
+            (
+                first, past_ball, excluding, every, side, inside, around, refused,
+            )
+        })
+        .unwrap();
+    let (first, past_ball, excluding, every, side, inside, around, refused) = results;
+    assert_eq!(first.entity, ball);
+    // The ball rests with its top at 1 m: the ray travels 9 m.
+    assert!((first.distance - 9.0).abs() < 0.02, "{first:?}");
+    assert!((first.normal - Vec3::Z).length() < 1e-3);
+    assert_eq!(past_ball.entity, ground);
+    assert!((past_ball.distance - 10.0).abs() < 1e-4);
+    assert_eq!(excluding.entity, ground);
+    assert_eq!(
+        every.iter().map(|h| h.entity).collect::<Vec<_>>(),
+        [ball, ground]
+    );
+    // A ball of 0.5 m cast along x from the resting ball's place meets the box's face at 4 m,
+    // 3.5 m on; starting inside the resting ball it hits that at once.
+    assert_eq!(side.entity, ball);
+    assert_eq!(side.distance, 0.0);
+    assert_eq!(inside, [block]);
+    assert!(around.contains(&ball) && around.contains(&ground) && !around.contains(&block));
+    assert!(refused);
+}
+
+#[test]
+fn the_query_index_refits_after_a_step_and_rebuilds_after_a_spawn() {
+    let (mut app, [.., ball]) = ecs_scene();
+    let cast = |app: &mut App| {
+        app.world_mut()
+            .run_system_once(|q: SpatialQuery| {
+                let all = SpatialQueryFilter::default();
+                q.cast_ray(Vec3::new(0.0, 0.0, 10.0), -Vec3::Z, 100.0, &all)
+                    .unwrap()
+                    .map(|h| h.entity)
+            })
+            .unwrap()
+    };
+    assert_eq!(cast(&mut app), Some(ball));
+    let counts = |app: &App| {
+        app.world()
+            .resource::<urto::plugins::SpatialQueryIndex>()
+            .refreshes()
+    };
+    assert_eq!(counts(&app), (1, 0));
+    // Two queries in one step refresh once.
+    cast(&mut app);
+    assert_eq!(counts(&app), (1, 0));
+    urto::step(app.world_mut(), 1).unwrap();
+    cast(&mut app);
+    assert_eq!(counts(&app), (1, 1));
+    // A ball spawned above: seen after the next step (a rebuild).
+    let high = common::ball(&mut app, Vec3::new(0.0, 0.0, 6.0));
+    urto::step(app.world_mut(), 1).unwrap();
+    assert_eq!(cast(&mut app), Some(high));
+    assert_eq!(counts(&app), (2, 1));
+    // A quarantined collider is never hit.
+    app.world_mut().entity_mut(high).insert(Quarantined {
+        reason: "test".into(),
+    });
+    assert_eq!(cast(&mut app), Some(ball));
+}
+
+#[test]
+fn layers_that_do_not_interact_let_bodies_pass_through_the_ground_and_each_other() {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    let world = app.world_mut();
+    world.spawn((Collider::half_space(Vec3::Z), Static));
+    let resting = world
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(-3.0, 0.0, 2.0),
+            Velocity::default(),
+        ))
+        .id();
+    // Filters out the ground's layer (the default one).
+    let ghost = world
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(3.0, 0.0, 2.0),
+            Velocity::default(),
+            CollisionLayers::new(BALLS, BALLS),
+        ))
+        .id();
+    // Two balls thrown at each other, one of which refuses the other's layer.
+    let left = world
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(-2.0, 10.0, 50.0),
+            Velocity(Vec3::new(4.0, 0.0, 0.0)),
+            CollisionLayers::new(BALLS, !BALLS),
+        ))
+        .id();
+    let right = world
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(2.0, 10.0, 50.0),
+            Velocity(Vec3::new(-4.0, 0.0, 0.0)),
+            CollisionLayers::new(BALLS, LayerMask::ALL),
+        ))
+        .id();
+    urto::step(app.world_mut(), 120).unwrap();
+    let z = |app: &App, e| app.world().get::<Position>(e).unwrap().0;
+    assert!(
+        (z(&app, resting).z - 0.5).abs() < 0.02,
+        "{}",
+        z(&app, resting)
+    );
+    assert!(z(&app, ghost).z < -1.0, "{}", z(&app, ghost));
+    // Each kept its x velocity: they crossed.
+    assert!(z(&app, left).x > 1.5 && z(&app, right).x < -1.5);
+}
+
+#[test]
+fn ccd_lets_a_fast_ball_through_a_thin_wall_its_layers_ignore() {
+    let mut app = common::app();
+    let world = app.world_mut();
+    world.spawn((
+        Collider::cuboid(0.05, 5.0, 5.0),
+        Position::new(0.0, 0.0, 0.0),
+        Static,
+    ));
+    let fast = |world: &mut World, y: f32, layers: CollisionLayers| {
+        world
+            .spawn((
+                Collider::sphere(0.1),
+                Position::new(-2.0, y, 0.0),
+                Velocity(Vec3::new(300.0, 0.0, 0.0)),
+                Ccd,
+                layers,
+            ))
+            .id()
+    };
+    let stopped = fast(world, -2.0, CollisionLayers::default());
+    let ghost = fast(world, 2.0, CollisionLayers::new(BALLS, BALLS));
+    urto::step(app.world_mut(), 1).unwrap();
+    let x = |e| app.world().get::<Position>(e).unwrap().0.x;
+    assert!(x(stopped) < 0.0, "{}", x(stopped));
+    assert!(x(ghost) > 2.5, "{}", x(ghost));
+}
+
+#[test]
+fn spatial_query_finds_the_nearest_collider_and_casts_a_box_with_a_filter() {
+    let (mut app, [ground, block, ball]) = ecs_scene();
+    let world = app.world_mut();
+    let (near_ball, past_ball, inside) = world
+        .run_system_once(|q: SpatialQuery| {
+            let all = SpatialQueryFilter::default();
+            let above = Vec3::new(0.0, 0.0, 3.0);
+            let near_ball = q.nearest_point(above, f32::INFINITY, &all).unwrap();
+            let no_balls = SpatialQueryFilter::from_mask(!BALLS);
+            let past_ball = q.nearest_point(above, f32::INFINITY, &no_balls).unwrap();
+            let inside = q
+                .nearest_point(Vec3::new(5.2, 0.3, 1.5), 10.0, &all)
+                .unwrap();
+            (near_ball, past_ball, inside)
+        })
+        .unwrap();
+    let near_ball = near_ball.unwrap();
+    assert_eq!(near_ball.entity, ball);
+    // The ball rests with its top at 1 m.
+    assert!((near_ball.distance - 2.0).abs() < 0.02, "{near_ball:?}");
+    let past_ball = past_ball.unwrap();
+    assert_eq!(past_ball.entity, ground);
+    assert!((past_ball.distance - 3.0).abs() < 1e-5, "{past_ball:?}");
+    let inside = inside.unwrap();
+    assert_eq!(
+        (inside.entity, inside.inside, inside.distance),
+        (block, true, 0.0)
+    );
+}
