@@ -3,9 +3,13 @@
 //! The slides' cure for tunnelling is to split `dt` into substeps (brute force: every body pays).
 //! Here only the bodies that need it pay: those marked [`Ccd`], and — when
 //! [`CcdSettings::auto_speed_ratio`] is set — those moving more than that many times their own
-//! size in one substep. For each, the motion the integrator just produced (start → end position)
-//! is swept against the static scenery its swept volume meets ([`crate::ccd`]: exact time of
-//! impact of the body's bounding sphere against spheres, boxes, planes and meshes). At the first
+//! size in one substep. For each, the motion the integrator just produced (its centre of mass,
+//! start → end) is swept against the static scenery its swept volume meets ([`crate::ccd`]:
+//! exact time of impact of a sphere about the centre of mass holding the body, against spheres,
+//! boxes, planes and meshes). The centre of mass, not the origin, because that is what
+//! [`Velocity`] moves and what the solver turns the body about: sweeping the origin of a
+//! spinning body whose centre is off it (a cone, a compound) and reflecting the velocity there
+//! moved its centre of mass up to 1.17 × its speed bound in a step (the fuzz scenes). At the first
 //! impact the body is moved there, its velocity is reflected with the pair's restitution, and it
 //! spends the rest of the substep from there (up to [`CcdSettings::max_impacts`] impacts). Each
 //! impact also becomes a contact of the substep, so collision messages report it.
@@ -101,12 +105,14 @@ impl Plugin for CcdPlugin {
     }
 }
 
-/// A body to sweep: where it started the substep and the radius of the sphere swept.
+/// A body to sweep: where its centre of mass started the substep, the radius of the sphere
+/// about it that is swept, and the centre's place in the body's frame.
 #[derive(Clone, Copy, Debug)]
 struct SweepStart {
     body: Entity,
     from: Vec3,
     radius: f32,
+    local_center: Vec3,
 }
 
 #[derive(Resource, Default)]
@@ -119,7 +125,7 @@ struct CcdScratch {
 
 type Mover<'a> = (
     Entity,
-    &'a Position,
+    (&'a Position, Option<&'a Rotation>, Option<&'a Inertia>),
     &'a Velocity,
     &'a BoundingVolume,
     Option<&'a Collider>,
@@ -161,18 +167,23 @@ fn record_sweep_starts(
 ) {
     scratch.starts.clear();
     let dt = timestep.substep_dt();
-    for (body, p, v, bv, collider, compound, marked) in &bodies {
+    for (body, (p, r, inertia), v, bv, collider, compound, marked) in &bodies {
         let Some(radius) = sweep_radius(p.0, bv, collider, compound) else {
             continue;
         };
+        let local_center = inertia.map_or(Vec3::ZERO, |i| i.local_center_of_mass);
+        let offset = turn(r) * local_center;
+        // The sphere about the origin holding the body, grown to be about the centre of mass.
+        let radius = radius + offset.length();
         let fast = settings
             .auto_speed_ratio
             .is_some_and(|k| v.0.length() * dt > k * radius);
         if marked || fast {
             scratch.starts.push(SweepStart {
                 body,
-                from: p.0,
+                from: p.0 + offset,
                 radius,
+                local_center,
             });
         }
     }
@@ -188,10 +199,17 @@ type Obstacle<'a> = (
     Has<Sensor>,
 );
 
+type Swept<'a> = (
+    &'a mut Position,
+    Option<&'a Rotation>,
+    &'a mut Velocity,
+    Option<&'a Restitution>,
+);
+
 /// Sweeps each recorded body from its start to where the integrator put it.
 #[allow(clippy::too_many_arguments)]
 fn sweep_fast_bodies(
-    mut bodies: Query<(&mut Position, &mut Velocity, Option<&Restitution>), MovingRoot>,
+    mut bodies: Query<Swept, MovingRoot>,
     obstacles: Query<Obstacle, Without<Quarantined>>,
     index: Option<ResMut<BroadPhaseIndex>>,
     settings: Res<CcdSettings>,
@@ -215,17 +233,26 @@ fn sweep_fast_bodies(
     let dt = timestep.substep_dt();
     let s = &mut *scratch;
     for i in 0..s.starts.len() {
-        let SweepStart { body, from, radius } = s.starts[i];
-        let Ok((mut p, mut v, e_body)) = bodies.get_mut(body) else {
+        let SweepStart {
+            body,
+            from,
+            radius,
+            local_center,
+        } = s.starts[i];
+        let Ok((mut p, r, mut v, e_body)) = bodies.get_mut(body) else {
             continue;
         };
+        // Where the integrator put the centre of mass, the body turned as it ends the substep.
+        let offset = turn(r) * local_center;
+        let to = p.0 + offset;
         let e_body = e_body.map_or(contact_settings.default_restitution, |r| r.0);
         let layers = layers_of(obstacles.get(body).ok().and_then(|o| o.5));
-        if !(p.0 - from).is_finite() {
+        if !(to - from).is_finite() {
             // The integrator overflowed: leave the body where it is, for the refit to quarantine.
             continue;
         }
-        let (mut at, mut velocity, mut motion) = (from, v.0, p.0 - from);
+        let (mut at, mut velocity, mut motion) = (from, v.0, to - from);
+        let mut impacted = false;
         // The share of the step still to move: each impact uses up its sweep's `t` of what was
         // left (a second impact at t = 0 is not handed a fresh step).
         let mut remaining = 1.0f32;
@@ -252,6 +279,7 @@ fn sweep_fast_bodies(
                 e
             };
             at = sweep.position_at(hit.t);
+            impacted = true;
             velocity = reflect(velocity, hit.normal, e);
             remaining *= 1.0 - hit.t;
             motion = velocity * dt * remaining;
@@ -265,15 +293,23 @@ fn sweep_fast_bodies(
                 impact_speed: approach.max(0.0),
             });
         }
-        // Impacts left over (max_impacts reached): stay at the last impact point.
+        // Impacts left over (max_impacts reached): stay at the last impact point. Without an
+        // impact the body stays exactly where the integrator put it (`at − offset` would round).
         let _ = motion;
-        p.set_if_neq(Position(at));
-        v.set_if_neq(Velocity(velocity));
+        if impacted {
+            p.set_if_neq(Position(at - offset));
+            v.set_if_neq(Velocity(velocity));
+        }
     }
     stats.add_counter("ccd/sweeps", s.starts.len() as f64);
     stats.add_counter("ccd/impacts", impacts.contacts.len() as f64);
     stats.add_time(Stage::Integrate, start.elapsed());
     stats.count_run("ccd");
+}
+
+/// A body's orientation (identity without a [`Rotation`]).
+fn turn(r: Option<&Rotation>) -> glam::Quat {
+    r.map_or(glam::Quat::IDENTITY, |r| r.0)
 }
 
 /// Motion into a surface already touched at the start of a sweep, as a fraction of the radius,

@@ -18,7 +18,8 @@
 //! joint carries into a step are held to what the speed bounds allow).
 //!
 //! CI runs [`SCENES`] scenes; `URTO_FUZZ_SCENES=2000 cargo test --release --test bad_input
-//! scene_fuzz -- --nocapture` runs more and prints each seed's fastest body.
+//! scene_fuzz -- --nocapture` runs more and prints each seed's fastest body, and
+//! `URTO_FUZZ_SEED=597` replays one scene.
 
 use crate::common::{self, rng::Rng};
 use bevy_app::App;
@@ -203,11 +204,14 @@ fn speed_bound() -> f32 {
     SoftStepSettings::default().max_linear_speed * 1.001
 }
 
-/// How much further than `speed_bound() · dt` a centre of mass may move in a step. Measured
-/// at most 1.07 (2 of 600 scenes, both bodies at the speed bound); the cause is not found. (CCD
-/// used to hand a body a fresh step's motion after each impact; it now moves the share of the
-/// step left.)
-const MOTION_SLACK: f32 = 1.1;
+/// How much further than `speed_bound() · dt` a centre of mass may move in a step: the solver's
+/// push out of overlaps (at most `max_push_out · dt`, 5 cm) rides on top of the velocity. Up to
+/// 1.17 was measured (1 to 2 in 600 scenes) while continuous collision swept a body's origin
+/// and reflected its velocity there: a spinning body whose centre of mass is off its origin (a
+/// cone, a compound) had its centre carried further. It now sweeps the centre of mass, and 600
+/// scenes pass. (Before that, CCD handed a body a fresh step's motion after each impact; it
+/// moves the share of the step left.)
+const MOTION_SLACK: f32 = 1.01;
 
 /// Where a body's centre of mass is (its origin swings about it as the body turns).
 fn center_of_mass(app: &App, e: Entity) -> Vec3 {
@@ -248,7 +252,8 @@ fn check(app: &App, bodies: &[Entity], before: &[Option<Vec3>]) -> Result<f32, S
         // motion is not measured.
         let moved = start.map_or(0.0, |s| center_of_mass(app, e).distance(s));
         if v.length() > speed_bound() || moved * 60.0 > speed_bound() * MOTION_SLACK {
-            return Err(format!("{e} flung: v {v}, moved {moved} m"));
+            let shape = world.get::<Collider>(e).map(|c| c.shape.clone());
+            return Err(format!("{e} flung: v {v}, moved {moved} m; {shape:?}"));
         }
         fastest = fastest.max(v.length());
     }
@@ -257,12 +262,13 @@ fn check(app: &App, bodies: &[Entity], before: &[Option<Vec3>]) -> Result<f32, S
 
 #[test]
 fn random_extreme_scenes_step_90_times_with_no_quarantine_no_nan_and_no_body_above_400_m_per_s() {
-    let scenes = std::env::var("URTO_FUZZ_SCENES")
-        .ok()
-        .and_then(|n| n.parse().ok())
-        .unwrap_or(SCENES);
+    let var = |name: &str| std::env::var(name).ok().and_then(|n| n.parse::<u64>().ok());
+    let seeds = match var("URTO_FUZZ_SEED") {
+        Some(seed) => seed..seed + 1,
+        None => 0..var("URTO_FUZZ_SCENES").unwrap_or(SCENES),
+    };
     let mut failures = Vec::new();
-    for seed in 0..scenes {
+    for seed in seeds {
         let (mut app, bodies) = random_scene(seed);
         let mut fastest = 0.0f32;
         for step in 0..STEPS {
