@@ -3,9 +3,11 @@
 //! One run of [`PhysicsSchedule`] is one fixed step `dt` (the slides' `simulate(dt)`):
 //!
 //! 1. [`PhysicsSet::Prepare`] — validate new or changed bodies (quarantine NaN, bad mass, bad
-//!    shapes), propagate poses down body hierarchies.
-//! 2. [`PhysicsSet::Forces`] — gather gravity, user forces, drag and springs into the step's
-//!    force model (each only when the world has it).
+//!    shapes), compute the mass and inertia of changed bodies, propagate poses down body
+//!    hierarchies.
+//! 2. [`PhysicsSet::Forces`] — gather gravity (scaled per body), user forces, drag and springs
+//!    into the step's force model (each only when the world has it), and apply impulses to
+//!    velocities at once.
 //! 3. [`PhysicsSet::Substeps`] — run [`SubstepSchedule`] `substeps` times with `dt / substeps`
 //!    (the slides' brute-force cure for late contacts and tunnelling):
 //!    1. [`SubstepSet::Integrate`] — advance positions and velocities, then orientations and

@@ -31,7 +31,6 @@ fn body_rates(app: &App, e: Entity) -> Vec3 {
     r.inverse() * get::<AngularVelocity>(app, e).0
 }
 
-/// A 1 kg ball of radius 0.5 at `at`.
 /// A 1 kg ball of radius 0.5 (I = 0.1 kg m²), whatever its volume would weigh.
 fn ball(app: &mut App, at: Vec3) -> Entity {
     let body = (Collider::sphere(0.5), Position(at), Velocity::default());

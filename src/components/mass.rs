@@ -6,7 +6,9 @@
 //! component could not tell a mass the game chose from the default, so the one the game chooses
 //! is optional and the derived one is required.
 
+use bevy_ecs::lifecycle::HookContext;
 use bevy_ecs::prelude::*;
+use bevy_ecs::world::DeferredWorld;
 
 /// The density (kg/m³) of a body without a [`Density`]: Avian's and rapier's default, so a
 /// 1 m cube weighs 1 kg and a ball of radius 0.5 m about 0.52 kg.
@@ -15,8 +17,26 @@ pub const DEFAULT_DENSITY: f32 = 1.0;
 /// A mass (kg) the game sets, overriding the one from the colliders' volume: finite and `> 0`
 /// for dynamic bodies, [`Mass::INFINITE`] for kinematic ones. Zero, negative, subnormal or NaN
 /// mass quarantines the body. Removing it brings back the mass from the volume.
+///
+/// Inserting one takes effect at once (a hook writes the body's [`ComputedMass`]), so a body
+/// made kinematic or heavier by a game, even while a step runs or without the mass-properties
+/// plugin, is never solved with its old mass; its inertia follows at the next step's Prepare.
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
+#[component(on_insert = take_mass_at_once)]
 pub struct Mass(pub f32);
+
+/// [`Mass`]'s insert hook: a valid mass becomes the body's [`ComputedMass`] now (an invalid
+/// one is left to validation, which quarantines the body).
+fn take_mass_at_once(mut world: DeferredWorld, ctx: HookContext) {
+    let Some(&mass) = world.get::<Mass>(ctx.entity) else {
+        return;
+    };
+    if let Some(mut computed) = world.get_mut::<ComputedMass>(ctx.entity)
+        && mass.is_valid()
+    {
+        computed.0 = mass.0;
+    }
+}
 
 impl Mass {
     /// A body no force or impulse can move.

@@ -26,10 +26,12 @@ pub struct ContactData {
     /// body the solver stopped at the surface keeps its speculative points (still apart by up
     /// to the step's motion at detection, negative depth): they are where it met the surface.
     pub manifold: ContactManifold,
-    /// The largest normal impulse (N·s) the solver applied at one point in one substep of the
-    /// step: 0 for a contact that only touched (a graze, or continuous collision's impacts).
+    /// The largest normal impulse (N·s) the rigid-body solver applied at one point in one
+    /// substep of the step: 0 for a contact that only touched (a graze, or continuous
+    /// collision's impacts), and always 0 on the lecture's pipeline (`SoftStepPlugin` disabled).
     pub normal_impulse: f32,
-    /// The speed (m/s) at which the bodies met along the normal (≥ 0).
+    /// The speed (m/s) at which the bodies met along the normal (≥ 0), from the rigid-body
+    /// solver or a continuous-collision impact; 0 on the lecture's pipeline.
     pub impact_speed: f32,
 }
 

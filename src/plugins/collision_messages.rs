@@ -31,6 +31,15 @@ pub struct CollisionStarted {
     pub contact: Option<ContactData>,
 }
 
+impl CollisionStarted {
+    /// The contact seen from `entity` (normal towards the other body, `entity`'s collider
+    /// first); `None` for a sensor's overlap. `entity` is one of the pair: `b` sees it flipped.
+    pub fn contact_from(&self, entity: Entity) -> Option<ContactData> {
+        self.contact
+            .map(|c| if entity == self.a { c } else { c.flipped() })
+    }
+}
+
 /// Two bodies stopped touching this step (`a < b`).
 #[derive(Message, Debug, Clone, Copy, PartialEq, Eq)]
 pub struct CollisionEnded {
@@ -222,10 +231,14 @@ fn touching_now(contacts: &Contacts, fresh: &mut Vec<Touch>) {
             .map(|(c, i)| ((c.a.min(c.b), c.a.max(c.b)), i)),
     );
     fresh.sort_unstable();
-    let impulse = |i: u32| contacts.pairs[i as usize].normal_impulse;
+    // The strongest push, then (ties, as without the rigid-body solver) the fastest approach.
+    let strength = |i: u32| {
+        let c = &contacts.pairs[i as usize];
+        (c.normal_impulse, c.impact_speed)
+    };
     fresh.dedup_by(|later, kept| {
         let same = later.0 == kept.0;
-        if same && impulse(later.1) > impulse(kept.1) {
+        if same && strength(later.1) > strength(kept.1) {
             kept.1 = later.1;
         }
         same
@@ -288,13 +301,10 @@ pub(crate) fn trigger_collision_events(
     for m in started.read() {
         for (entity, other) in sides(m.a, m.b) {
             if enabled.contains(entity) {
-                let contact = m
-                    .contact
-                    .map(|c| if entity == m.a { c } else { c.flipped() });
                 commands.trigger(CollisionStart {
                     entity,
                     other,
-                    contact,
+                    contact: m.contact_from(entity),
                 });
             }
         }

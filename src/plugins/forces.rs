@@ -205,7 +205,10 @@ type Kicked<'a> = (
 
 /// Consumes every [`Impulse`]: `Δv = J / m`, `Δω = I⁻¹ L` about the centre of mass (in world
 /// axes, locked axes left alone), before the step integrates. Kinematic bodies ignore it.
-fn apply_impulses(mut bodies: Query<Kicked, Active>, mut stats: ResMut<PhysicsStats>) {
+fn apply_impulses(
+    mut bodies: Query<Kicked, (Active, Changed<Impulse>)>,
+    mut stats: ResMut<PhysicsStats>,
+) {
     stats.time(Stage::Forces, "forces/impulses", || {
         for (mut impulse, mut v, w, mass, (p, r), inertia, locked) in &mut bodies {
             if impulse.is_empty() {
@@ -218,7 +221,10 @@ fn apply_impulses(mut bodies: Query<Kicked, Active>, mut stats: ResMut<PhysicsSt
                     let turn = r.map_or(Quat::IDENTITY, |r| r.0);
                     let center = p.0 + turn * inertia.local_center_of_mass;
                     let spin = inertia.inverse_world_times(turn, impulse.angular_about(center));
-                    w.0 += spin * locked.map_or(Vec3::ONE, |l| l.free_rotation_axes());
+                    let spin = spin * locked.map_or(Vec3::ONE, |l| l.free_rotation_axes());
+                    if spin != Vec3::ZERO {
+                        w.0 += spin;
+                    }
                 }
             }
             *impulse = Impulse::default();

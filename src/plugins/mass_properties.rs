@@ -6,7 +6,8 @@
 //! stage: a scene that does not change its bodies pays a change-tick scan.
 //!
 //! Its own plugin, apart from rotation, so that a scene without turning still gets the masses
-//! its game set; without it every body weighs the default 1 kg and cannot turn.
+//! its game set. Without it a body weighs the [`Mass`] it was given (the insert hook writes it)
+//! or the default 1 kg, and its inertia stays the default.
 
 use crate::components::*;
 use crate::geometry::{Isometry, MassProperties};
@@ -90,13 +91,14 @@ type PartData<'a> = (
 );
 
 /// Recomputes the computed mass and inertia of bodies whose collider, mass, density or parts
-/// changed (or whose [`Mass`] or [`Density`] was removed).
+/// changed (or whose [`Mass`], [`Density`] or [`Quarantined`] marker was removed).
 #[allow(clippy::too_many_arguments)]
 fn compute_mass_properties(
     mut root_queries: ParamSet<(ChangedRoots, Roots)>,
     changed_parts: Query<Entity, ChangedPart>,
     mut unset_mass: RemovedComponents<Mass>,
     mut unset_density: RemovedComponents<Density>,
+    mut released: RemovedComponents<Quarantined>,
     parents: Query<&ChildOf>,
     parts: Query<PartData>,
     mut buffers: ResMut<MassBuffers>,
@@ -105,8 +107,9 @@ fn compute_mass_properties(
     let b = &mut *buffers;
     b.dirty.clear();
     b.dirty.extend(&root_queries.p0());
-    b.dirty
-        .extend(unset_mass.read().chain(unset_density.read()));
+    // A body let out of quarantine may have been fixed while it was left out.
+    let unset = unset_mass.read().chain(unset_density.read());
+    b.dirty.extend(unset.chain(released.read()));
     if !changed_parts.is_empty() {
         b.roots.clear();
         for part in &changed_parts {
@@ -150,7 +153,6 @@ fn compute_mass_properties(
     });
 }
 
-/// The topmost ancestor of `e`, at most `longest_chain` steps up.
 /// The topmost ancestor of `e`. `roots` remembers the root of every node climbed through, and
 /// a climb stops at the first remembered node ([`climb`]), so the parts of one deep chain cost
 /// linear time together, not quadratic.

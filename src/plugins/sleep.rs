@@ -15,8 +15,9 @@
 //!
 //! A body wakes when an awake body's contact moves it faster than the sleep speed (see the
 //! response and the solver), when game code moves or turns it, sets its velocity or angular
-//! velocity, pushes it with a [`Force`], [`Torque`] or [`ForceAtPoint`], changes its collider or
-//! removes its [`Sleeping`] marker, when gravity changes, or when a contact of it ends (a body it
+//! velocity, pushes it with a [`Force`], [`Torque`], [`ForceAtPoint`] or [`Impulse`], writes or
+//! removes its [`Mass`], [`Density`] or [`GravityScale`], changes its collider or removes its
+//! [`Sleeping`] marker, when gravity changes, or when a contact of it ends (a body it
 //! touched moved away or disappeared); its whole island wakes with it (members are kept per
 //! island in [`SleepingIslands`], as Box2D v3's `island.c` keeps them), before the next step
 //! simulates anything.
@@ -188,6 +189,11 @@ fn wake_on_game_changes(
         Query<(Entity, &mut SleepState), With<Sleeping>>,
     )>,
     gravity: Option<Res<Gravity>>,
+    mut unset: (
+        RemovedComponents<Mass>,
+        RemovedComponents<Density>,
+        RemovedComponents<GravityScale>,
+    ),
     mut waker: Waker,
 ) {
     if gravity.is_some_and(|g| g.is_changed()) {
@@ -195,6 +201,18 @@ fn wake_on_game_changes(
             waker.wake(e, Some(&mut sleep));
         }
         return;
+    }
+    // A removed mass, density or gravity scale changes what the body weighs or feels.
+    let (mass, density, scale) = &mut unset;
+    let removed: Vec<Entity> = mass
+        .read()
+        .chain(density.read())
+        .chain(scale.read())
+        .collect();
+    for e in removed {
+        if let Ok((e, mut sleep)) = sleepers.p1().get_mut(e) {
+            waker.wake(e, Some(&mut sleep));
+        }
     }
     for (e, mut sleep, (p, r, v), w, pushes, settings) in &mut sleepers.p0() {
         let (force, torque, at_point, impulse) = pushes;

@@ -2,8 +2,8 @@
 //!
 //! A body whose state is unusable — a NaN or infinite position, velocity, force, rotation,
 //! angular velocity or torque, a negative angular drag, an inertia that is not positive, a
-//! zero, negative or NaN mass, a shape with impossible numbers, a part of a compound body with a
-//! velocity of its own — gets a
+//! zero, negative, subnormal or NaN mass, a non-finite impulse or gravity scale, a shape with
+//! impossible numbers, a part of a compound body with a velocity of its own — gets a
 //! [`Quarantined`] marker and a logged warning. Every other stage filters quarantined
 //! entities out, so their NaN never reaches a neighbour through a contact or a spring. Only
 //! added or changed components are checked, so a scene at rest costs nothing here.
