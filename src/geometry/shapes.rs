@@ -220,36 +220,12 @@ impl Shape {
     /// when they are built, so they always pass.
     pub fn validate(&self) -> Result<(), ShapeError> {
         match self {
-            Self::Sphere(Sphere { radius })
-            | Self::Capsule(Capsule { radius, .. })
-            | Self::Cylinder(Cylinder { radius, .. })
-            | Self::Cone(Cone { radius, .. })
-                if !(radius.is_finite() && *radius >= 0.0) =>
-            {
+            Self::Sphere(Sphere { radius }) if !(radius.is_finite() && *radius >= 0.0) => {
                 Err(ShapeError::BadRadius(*radius))
             }
-            Self::Capsule(c) if !(c.half_length.is_finite() && c.half_length >= 0.0) => {
-                Err(ShapeError::BadLength(c.half_length))
-            }
-            Self::Capsule(c) if c.half_length.max(c.radius) > MAX_SHAPE_EXTENT => {
-                Err(ShapeError::TooLarge(c.half_length.max(c.radius)))
-            }
-            Self::Cylinder(Cylinder {
-                half_height: h,
-                radius: r,
-            })
-            | Self::Cone(Cone {
-                half_height: h,
-                radius: r,
-            }) if !(h.is_finite() && *h >= 0.0) => Err(ShapeError::BadLength(*h)),
-            Self::Cylinder(Cylinder {
-                half_height: h,
-                radius: r,
-            })
-            | Self::Cone(Cone {
-                half_height: h,
-                radius: r,
-            }) if h.max(*r) > MAX_SHAPE_EXTENT => Err(ShapeError::TooLarge(h.max(*r))),
+            Self::Capsule(c) => check_axial(c.half_length, c.radius),
+            Self::Cylinder(c) => check_axial(c.half_height, c.radius),
+            Self::Cone(c) => check_axial(c.half_height, c.radius),
             Self::Ellipsoid(e) if !(e.radii.is_finite() && e.radii.cmpge(Vec3::ZERO).all()) => {
                 Err(ShapeError::BadRadii(e.radii))
             }
@@ -352,6 +328,22 @@ impl Shape {
             Self::TriMesh(m) => m.bounding_radius(),
         }
     }
+}
+
+/// The two numbers of a capsule, cylinder or cone: a radius and a half length, each finite and
+/// `>= 0` (radius first), neither above [`MAX_SHAPE_EXTENT`].
+fn check_axial(half_length: f32, radius: f32) -> Result<(), ShapeError> {
+    if !(radius.is_finite() && radius >= 0.0) {
+        return Err(ShapeError::BadRadius(radius));
+    }
+    if !(half_length.is_finite() && half_length >= 0.0) {
+        return Err(ShapeError::BadLength(half_length));
+    }
+    let largest = half_length.max(radius);
+    if largest > MAX_SHAPE_EXTENT {
+        return Err(ShapeError::TooLarge(largest));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

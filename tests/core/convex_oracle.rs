@@ -253,51 +253,42 @@ fn compare(kind_a: &str, kind_b: &str, seed: u64) -> Stats {
     stats
 }
 
-#[test]
-fn cylinder_pairs_agree_with_parry_within_1e_4_of_the_size_on_10000_pairs_each() {
-    for (k, other) in ["sphere", "box", "capsule", "cylinder"].iter().enumerate() {
-        let s = compare("cylinder", other, 11 + k as u64);
-        assert_eq!(s.beyond_tolerance, 0, "cylinder-{other}: {s:?}");
-        assert!(s.parry_off < SAMPLES / 10, "cylinder-{other}: {s:?}");
+/// Every pair of `kind` with each of `others` agrees with parry within the tolerance, parry is
+/// off on fewer than `parry_off_cap` of the pairs, and enough of them overlap and lie apart.
+fn pairs_agree(kind: &str, others: &[&str], first_seed: u64, parry_off_cap: usize) {
+    for (k, other) in others.iter().enumerate() {
+        let s = compare(kind, other, first_seed + k as u64);
+        assert_eq!(s.beyond_tolerance, 0, "{kind}-{other}: {s:?}");
+        assert!(s.parry_off < parry_off_cap, "{kind}-{other}: {s:?}");
         assert!(
             s.overlapping > SAMPLES / 10 && s.apart > SAMPLES / 10,
             "{s:?}"
         );
     }
+}
+
+#[test]
+fn cylinder_pairs_agree_with_parry_within_1e_4_of_the_size_on_10000_pairs_each() {
+    pairs_agree(
+        "cylinder",
+        &["sphere", "box", "capsule", "cylinder"],
+        11,
+        SAMPLES / 10,
+    );
 }
 
 #[test]
 fn cone_pairs_agree_with_parry_within_1e_4_of_the_size_on_10000_pairs_each() {
-    for (k, other) in ["sphere", "box", "capsule", "cylinder", "cone", "hull"]
-        .iter()
-        .enumerate()
-    {
-        let s = compare("cone", other, 41 + k as u64);
-        assert_eq!(s.beyond_tolerance, 0, "cone-{other}: {s:?}");
-        // Against a capsule parry stops early on 11 % of the pairs (by up to 6.5 mm): ours
-        // lies below it there, and ours is an upper bound of the truth, so parry is off.
-        assert!(s.parry_off < SAMPLES / 5, "cone-{other}: {s:?}");
-        assert!(
-            s.overlapping > SAMPLES / 10 && s.apart > SAMPLES / 10,
-            "{s:?}"
-        );
-    }
+    // Against a capsule parry stops early on 11 % of the pairs (by up to 6.5 mm): ours lies
+    // below it there, and ours is an upper bound of the truth, so parry is off.
+    let others = ["sphere", "box", "capsule", "cylinder", "cone", "hull"];
+    pairs_agree("cone", &others, 41, SAMPLES / 5);
 }
 
 #[test]
 fn hull_pairs_agree_with_parry_within_1e_4_of_the_size_on_10000_pairs_each() {
-    for (k, other) in ["sphere", "box", "capsule", "cylinder", "hull"]
-        .iter()
-        .enumerate()
-    {
-        let s = compare("hull", other, 21 + k as u64);
-        assert_eq!(s.beyond_tolerance, 0, "hull-{other}: {s:?}");
-        assert!(s.parry_off < SAMPLES / 10, "hull-{other}: {s:?}");
-        assert!(
-            s.overlapping > SAMPLES / 10 && s.apart > SAMPLES / 10,
-            "{s:?}"
-        );
-    }
+    let others = ["sphere", "box", "capsule", "cylinder", "hull"];
+    pairs_agree("hull", &others, 21, SAMPLES / 10);
 }
 
 /// `x/r` squared summed: 1 on the ellipsoid's surface.
