@@ -6,6 +6,7 @@
 //! [`AngularVelocity`] and an [`Inertia`] computed from the collider (scaled to the body's
 //! [`ComputedMass`](super::ComputedMass)). [`LockedAxes::ROTATION_LOCKED`] keeps a body upright.
 
+use super::point_sum::PointSum;
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
 
@@ -39,31 +40,29 @@ pub struct Torque(pub Vec3);
 /// ```
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 pub struct ForceAtPoint {
-    force: Vec3,
-    /// `Σ p × F` about the world origin; the torque about any centre `c` is this minus `c × ΣF`.
-    moment_about_origin: Vec3,
+    /// The forces and their moment (about the first point, exact far from the origin).
+    sum: PointSum,
 }
 
 impl ForceAtPoint {
     /// Adds `force` (N) acting at the world `point`.
     pub fn add(&mut self, force: Vec3, point: Vec3) {
-        self.force += force;
-        self.moment_about_origin += point.cross(force);
+        self.sum.add(force, point);
     }
 
     /// The sum of the forces.
     pub fn force(&self) -> Vec3 {
-        self.force
+        self.sum.total()
     }
 
     /// Their torque about the world point `center`.
     pub fn torque_about(&self, center: Vec3) -> Vec3 {
-        self.moment_about_origin - center.cross(self.force)
+        self.sum.moment_about(center)
     }
 
     /// True when nothing was added.
     pub fn is_empty(&self) -> bool {
-        self.force == Vec3::ZERO && self.moment_about_origin == Vec3::ZERO
+        *self == Self::default()
     }
 }
 

@@ -3,6 +3,7 @@
 //! floating power-up), as Avian's `ExternalImpulse` / `GravityScale` and rapier's
 //! `apply_impulse` / `gravity_scale` give.
 
+use super::point_sum::PointSum;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 
@@ -23,10 +24,8 @@ use glam::Vec3;
 pub struct Impulse {
     /// Impulses through the centre of mass.
     through_center: Vec3,
-    /// Impulses at points (their sum).
-    at_points: Vec3,
-    /// `Σ p × J` of the impulses at points, about the world origin.
-    moment: Vec3,
+    /// Impulses at points and their moment (exact far from the origin).
+    at_points: PointSum,
     /// Angular impulses (N·m·s, world axes).
     angular: Vec3,
 }
@@ -48,8 +47,7 @@ impl Impulse {
     /// Adds a linear impulse at the world `point`: it also turns the body about its centre of
     /// mass (where that is at the step's start).
     pub fn add_at_point(&mut self, impulse: Vec3, point: Vec3) {
-        self.at_points += impulse;
-        self.moment += point.cross(impulse);
+        self.at_points.add(impulse, point);
     }
 
     /// Adds an angular impulse (N·m·s about world axes).
@@ -59,13 +57,13 @@ impl Impulse {
 
     /// The sum of the linear impulses.
     pub fn linear(&self) -> Vec3 {
-        self.through_center + self.at_points
+        self.through_center + self.at_points.total()
     }
 
     /// The angular impulse about the world point `center`: the angular impulses plus the
     /// moments of the impulses at points.
     pub fn angular_about(&self, center: Vec3) -> Vec3 {
-        self.angular + self.moment - center.cross(self.at_points)
+        self.angular + self.at_points.moment_about(center)
     }
 
     /// True when nothing was added.
@@ -75,14 +73,7 @@ impl Impulse {
 
     /// True when every sum is finite.
     pub fn is_finite(&self) -> bool {
-        [
-            self.through_center,
-            self.at_points,
-            self.moment,
-            self.angular,
-        ]
-        .iter()
-        .all(|v| v.is_finite())
+        self.through_center.is_finite() && self.angular.is_finite() && self.at_points.is_finite()
     }
 }
 

@@ -30,6 +30,7 @@ mod angular;
 mod impulse;
 mod joint;
 mod mass;
+mod point_sum;
 mod sleeping;
 
 pub use angular::{AngularDrag, AngularVelocity, ForceAtPoint, Inertia, LockedAxes, Torque};
