@@ -299,14 +299,7 @@ fn a_body_spawned_mid_game_or_given_mass_while_asleep_or_without_the_plugin_weig
         .spawn((Collider::half_space(Vec3::Z), Static));
     urto::step(app.world_mut(), 5).unwrap();
     // Spawned after steps ran: its volume's mass at the next step.
-    let late = app
-        .world_mut()
-        .spawn((
-            Collider::sphere(0.5),
-            Position::new(0.0, 0.0, 0.5),
-            Velocity::default(),
-        ))
-        .id();
+    let late = common::ball(&mut app, Vec3::new(0.0, 0.0, 0.5));
     let heavy = ball(&mut app, Vec3::new(3.0, 0.0, 0.5), 2.0);
     urto::step(app.world_mut(), 120).unwrap();
     let ball_mass = DEFAULT_DENSITY * 4.0 / 3.0 * std::f32::consts::PI * 0.125;

@@ -437,31 +437,36 @@ fn relative_scalar(ours: f32, theirs: f32) -> f32 {
     (ours - theirs).abs() / ours.abs().max(theirs.abs()).max(f32::MIN_POSITIVE)
 }
 
+/// Our shape along z against parry's along y: the same mass and, y and z swapped, the same
+/// principal moments and centre of mass, within 1e-5 relative (the centre within 1e-6 of `size`).
+fn assert_axial_matches_parry(ours: &MassProperties, parry: &ParryMass, size: f32, what: &str) {
+    let (p, c) = (parry.principal_inertia(), parry.local_com);
+    let i = &ours.inertia;
+    let d = Vec3::new(i.x_axis.x, i.y_axis.y, i.z_axis.z);
+    assert!(
+        relative_scalar(ours.mass, parry.mass()) < 1e-5,
+        "{what}: mass"
+    );
+    let com = ours.local_center_of_mass;
+    let theirs = Vec3::new(c.x, c.z, c.y);
+    assert!(
+        (com - theirs).length() < 1e-6 * size,
+        "{what}: {com} vs {c:?}"
+    );
+    for (a, b) in [(d.x, p.x), (d.y, p.z), (d.z, p.y)] {
+        assert!(relative_scalar(a, b) < 1e-5, "{what}: {d} vs {p:?}");
+    }
+}
+
 #[test]
 fn cones_match_parry_within_1e_5_relative_their_centre_a_quarter_up_from_the_base() {
     for (h, r, density) in [(0.5, 0.25, 1000.0), (0.01, 1.0, 1.0), (3.0, 0.05, 7800.0)] {
         let ours = Shape::cone(h, r).mass_properties(density);
-        let parry = parry3d::shape::Cone::new(h, r).mass_properties(density);
         // parry's cone runs along y (apex up), ours along z.
-        let (p, c) = (parry.principal_inertia(), parry.local_com);
-        let d = Vec3::new(
-            ours.inertia.x_axis.x,
-            ours.inertia.y_axis.y,
-            ours.inertia.z_axis.z,
-        );
-        assert!(
-            relative_scalar(ours.mass, parry.mass()) < 1e-5,
-            "mass {h} {r}"
-        );
+        let parry = parry3d::shape::Cone::new(h, r).mass_properties(density);
+        assert_axial_matches_parry(&ours, &parry, h, &format!("cone {h} {r}"));
         let com = ours.local_center_of_mass;
-        assert!(
-            (com - Vec3::new(c.x, c.z, c.y)).length() < 1e-6 * h,
-            "{com} vs {c:?}"
-        );
         assert!((com.z + h / 2.0).abs() < 1e-6 * h, "{com}");
-        for (a, b) in [(d.x, p.x), (d.y, p.z), (d.z, p.y)] {
-            assert!(relative_scalar(a, b) < 1e-5, "cone {h} {r}: {d} vs {p:?}");
-        }
     }
 }
 
@@ -469,24 +474,9 @@ fn cones_match_parry_within_1e_5_relative_their_centre_a_quarter_up_from_the_bas
 fn cylinders_and_convex_hulls_match_parry_within_1e_5_relative_and_hull_moments_within_1e_4() {
     for (h, r, density) in [(0.5, 0.25, 1000.0), (0.01, 1.0, 1.0), (3.0, 0.05, 7800.0)] {
         let ours = Shape::cylinder(h, r).mass_properties(density);
-        let parry = parry3d::shape::Cylinder::new(h, r).mass_properties(density);
         // parry's cylinder runs along y, ours along z.
-        let p = parry.principal_inertia();
-        let d = Vec3::new(
-            ours.inertia.x_axis.x,
-            ours.inertia.y_axis.y,
-            ours.inertia.z_axis.z,
-        );
-        assert!(
-            relative_scalar(ours.mass, parry.mass()) < 1e-5,
-            "mass {h} {r}"
-        );
-        for (a, b) in [(d.x, p.x), (d.y, p.z), (d.z, p.y)] {
-            assert!(
-                relative_scalar(a, b) < 1e-5,
-                "cylinder {h} {r}: {d} vs {p:?}"
-            );
-        }
+        let parry = parry3d::shape::Cylinder::new(h, r).mass_properties(density);
+        assert_axial_matches_parry(&ours, &parry, h, &format!("cylinder {h} {r}"));
     }
     let mut points = Vec::new();
     for k in 0..40u32 {
