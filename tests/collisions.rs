@@ -474,6 +474,8 @@ fn a_dropped_ball_reports_its_impact_speed_within_2_percent_and_its_normal_withi
     let c = starts[0]
         .contact_from(b)
         .expect("a contact, not a sensor overlap");
+    let stranger = starts[0].contact_from(Entity::PLACEHOLDER);
+    assert!(stranger.is_none(), "not one of the pair");
     let v = (2.0 * g * h).sqrt();
     assert_eq!((c.collider, c.other_collider), (b, ground));
     // Restitution 0: the one point's push in the first substep stops the ball (m v).

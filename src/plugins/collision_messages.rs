@@ -33,10 +33,15 @@ pub struct CollisionStarted {
 
 impl CollisionStarted {
     /// The contact seen from `entity` (normal towards the other body, `entity`'s collider
-    /// first); `None` for a sensor's overlap. `entity` is one of the pair: `b` sees it flipped.
+    /// first): as stored for `a`, flipped for `b`; `None` for a sensor's overlap or an entity
+    /// that is not one of the pair.
     pub fn contact_from(&self, entity: Entity) -> Option<ContactData> {
-        self.contact
-            .map(|c| if entity == self.a { c } else { c.flipped() })
+        let c = self.contact?;
+        match entity {
+            e if e == self.a => Some(c),
+            e if e == self.b => Some(c.flipped()),
+            _ => None,
+        }
     }
 }
 

@@ -52,9 +52,10 @@ fn nan_and_infinite_state_is_quarantined_and_neighbours_stay_finite() {
 }
 
 #[test]
-fn zero_negative_and_nan_masses_are_quarantined() {
+fn zero_negative_subnormal_and_nan_masses_are_quarantined() {
     let mut app = common::app();
-    let masses = [0.0, -1.0, f32::NAN];
+    // 1e-40 is subnormal: `1/m` overflows to infinity.
+    let masses = [0.0, -1.0, 1e-40, f32::NAN];
     let bad: Vec<_> = masses
         .iter()
         .map(|&m| app.world_mut().spawn((Velocity::default(), Mass(m))).id())
