@@ -71,6 +71,13 @@ impl Position {
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 pub struct Rotation(pub Quat);
 
+impl Rotation {
+    /// The orientation of a body that may have no `Rotation` (the identity then).
+    pub fn of(rotation: Option<&Rotation>) -> Quat {
+        rotation.map_or(Quat::IDENTITY, |r| r.0)
+    }
+}
+
 /// Linear velocity of the centre of mass (m/s). Brings what a dynamic body needs, including an
 /// [`AngularVelocity`] and a computed [`Inertia`]: dynamic bodies turn by default.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
@@ -339,5 +346,16 @@ pub struct Quarantined {
 
 /// The pose of a body as an [`Isometry`].
 pub fn pose(position: &Position, rotation: Option<&Rotation>) -> Isometry {
-    Isometry::new(position.0, rotation.map_or(Quat::IDENTITY, |r| r.0))
+    Isometry::new(position.0, Rotation::of(rotation))
+}
+
+/// Where a body's centre of mass is in its parent's frame: its [`Inertia`]'s centre carried by
+/// its pose (the body's origin without an `Inertia`).
+pub fn center_of_mass(
+    position: &Position,
+    rotation: Option<&Rotation>,
+    inertia: Option<&Inertia>,
+) -> Vec3 {
+    let local = inertia.map_or(Vec3::ZERO, |i| i.local_center_of_mass);
+    position.0 + Rotation::of(rotation) * local
 }

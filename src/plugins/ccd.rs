@@ -172,7 +172,7 @@ fn record_sweep_starts(
             continue;
         };
         let local_center = inertia.map_or(Vec3::ZERO, |i| i.local_center_of_mass);
-        let offset = turn(r) * local_center;
+        let offset = Rotation::of(r) * local_center;
         // The sphere about the origin holding the body, grown to be about the centre of mass.
         let radius = radius + offset.length();
         let fast = settings
@@ -243,7 +243,7 @@ fn sweep_fast_bodies(
             continue;
         };
         // Where the integrator put the centre of mass, the body turned as it ends the substep.
-        let offset = turn(r) * local_center;
+        let offset = Rotation::of(r) * local_center;
         let to = p.0 + offset;
         let e_body = e_body.map_or(contact_settings.default_restitution, |r| r.0);
         let layers = layers_of(obstacles.get(body).ok().and_then(|o| o.5));
@@ -305,11 +305,6 @@ fn sweep_fast_bodies(
     stats.add_counter("ccd/impacts", impacts.contacts.len() as f64);
     stats.add_time(Stage::Integrate, start.elapsed());
     stats.count_run("ccd");
-}
-
-/// A body's orientation (identity without a [`Rotation`]).
-fn turn(r: Option<&Rotation>) -> glam::Quat {
-    r.map_or(glam::Quat::IDENTITY, |r| r.0)
 }
 
 /// Motion into a surface already touched at the start of a sweep, as a fraction of the radius,

@@ -10,7 +10,7 @@ use crate::settings::Gravity;
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
-use glam::{Quat, Vec3};
+use glam::Vec3;
 
 /// Gathers gravity, user forces, drag and springs.
 #[derive(Debug, Clone, Default)]
@@ -162,8 +162,7 @@ fn gather_point_forces(
             if at_point.is_empty() {
                 continue;
             }
-            let offset = inertia.map_or(Vec3::ZERO, |i| i.local_center_of_mass);
-            let center = p.0 + r.map_or(offset, |r| r.0 * offset);
+            let center = center_of_mass(p, r, inertia);
             gathered.forces.push((entity, at_point.force()));
             gathered
                 .torques
@@ -218,9 +217,9 @@ fn apply_impulses(
             if inverse_mass > 0.0 {
                 v.0 += impulse.linear() * inverse_mass;
                 if let (Some(mut w), Some(inertia)) = (w, inertia) {
-                    let turn = r.map_or(Quat::IDENTITY, |r| r.0);
-                    let center = p.0 + turn * inertia.local_center_of_mass;
-                    let spin = inertia.inverse_world_times(turn, impulse.angular_about(center));
+                    let center = center_of_mass(p, r, Some(inertia));
+                    let moment = impulse.angular_about(center);
+                    let spin = inertia.inverse_world_times(Rotation::of(r), moment);
                     let spin = spin * locked.map_or(Vec3::ONE, |l| l.free_rotation_axes());
                     if spin != Vec3::ZERO {
                         w.0 += spin;

@@ -59,7 +59,7 @@ fn record_previous_poses(
     mut bodies: Query<(&Position, Option<&Rotation>, &mut PreviousPose), Without<Quarantined>>,
 ) {
     for (p, r, mut previous) in &mut bodies {
-        let rotation = r.map_or(Quat::IDENTITY, |r| r.0);
+        let rotation = Rotation::of(r);
         previous.set_if_neq(PreviousPose(Some((p.0, rotation))));
     }
 }
@@ -82,7 +82,7 @@ fn interpolate_transforms(
     // steps: draw the current pose.
     let alpha = fixed.map_or(1.0, |t| t.overstep_fraction().clamp(0.0, 1.0));
     for (e, mut p, r, mut previous, mut t, written) in &mut bodies {
-        let mut current = (p.0, r.as_ref().map_or(Quat::IDENTITY, |r| r.0));
+        let mut current = (p.0, Rotation::of(r.as_deref()));
         if written.as_ref().is_some_and(|w| !w.holds(&t)) {
             // The game moved the body since the last frame: that is its pose now, drawn as is.
             current = (t.translation, t.rotation);

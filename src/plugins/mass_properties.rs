@@ -19,7 +19,7 @@ use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
 use bevy_ecs::entity::{EntityHashMap, EntityHashSet};
 use bevy_ecs::prelude::*;
-use glam::{Quat, Vec3};
+use glam::Vec3;
 
 /// Computes bodies' mass and inertia from their colliders.
 #[derive(Debug, Clone, Default)]
@@ -196,15 +196,10 @@ fn gather_compound(
         }
         for &child in children.into_iter().flatten() {
             if let Ok((_, _, p, r)) = parts.get(child) {
-                stack.push((child, pose * pose_of(p, r)));
+                stack.push((child, pose * crate::components::pose(p, r)));
             }
         }
     }
-}
-
-/// The local pose of a part.
-fn pose_of(p: &Position, r: Option<&Rotation>) -> Isometry {
-    Isometry::new(p.0, r.map_or(Quat::IDENTITY, |r| r.0))
 }
 
 /// Unit-density mass properties scaled to the body's mass, as a computed [`Inertia`]. Without

@@ -204,12 +204,7 @@ fn wake_on_game_changes(
     }
     // A removed mass, density or gravity scale changes what the body weighs or feels.
     let (mass, density, scale) = &mut unset;
-    let removed: Vec<Entity> = mass
-        .read()
-        .chain(density.read())
-        .chain(scale.read())
-        .collect();
-    for e in removed {
+    for e in mass.read().chain(density.read()).chain(scale.read()) {
         if let Ok((e, mut sleep)) = sleepers.p1().get_mut(e) {
             waker.wake(e, Some(&mut sleep));
         }

@@ -150,7 +150,7 @@ type Drawn<'a> = (
 
 fn sync_transforms(mut bodies: Query<Drawn, Moved>, mut commands: Commands) {
     for (e, p, r, mut t, written) in &mut bodies {
-        let rotation = r.map_or(Quat::IDENTITY, |r| r.0);
+        let rotation = Rotation::of(r);
         if let Some(first) =
             TransformWritten::write(written.map(Mut::into_inner), &mut t, p.0, rotation)
         {
