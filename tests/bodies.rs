@@ -335,3 +335,68 @@ fn a_body_spawned_mid_game_or_given_mass_while_asleep_or_without_the_plugin_weig
     assert_eq!(get::<Velocity>(&bare, kinematic).0, Vec3::X);
     assert_eq!(get::<Position>(&bare, kinematic).0.z, 5.0);
 }
+
+#[test]
+fn translation_locks_hold_a_body_on_its_axes_bit_for_bit_and_removing_them_frees_it() {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    app.world_mut()
+        .spawn((Collider::half_space(Vec3::Z), Static));
+    // Locked along gravity's axis, with a game-written upward speed: it hangs where it is.
+    let hanging = ball(&mut app, Vec3::new(0.0, 0.0, 5.0), 1.0);
+    // A 2.5D body (gravity along −z, locked along y), kicked partly out of its plane.
+    let planar = ball(&mut app, Vec3::new(5.0, 0.0, 0.5), 2.0);
+    // A wall that slides along y only, struck head-on along x by a free ball.
+    let wall = app
+        .world_mut()
+        .spawn((
+            Collider::cuboid(0.5, 2.0, 2.0),
+            Position(Vec3::new(12.0, 0.0, 2.0)),
+            Velocity::default(),
+            Mass(5.0),
+            LockedAxes::new().lock_translation_x().lock_translation_z(),
+        ))
+        .id();
+    let thrown = ball(&mut app, Vec3::new(10.0, 0.0, 2.0), 1.0);
+    let world = app.world_mut();
+    world.entity_mut(hanging).insert((
+        LockedAxes::new().lock_translation_z(),
+        Velocity(Vec3::new(0.0, 0.0, 3.0)),
+    ));
+    world.entity_mut(planar).insert((
+        LockedAxes::new()
+            .lock_translation_y()
+            .lock_rotation_x()
+            .lock_rotation_z(),
+        Impulse::new(Vec3::new(4.0, 6.0, 0.0)),
+    ));
+    world.entity_mut(thrown).insert((
+        Velocity(Vec3::new(6.0, 0.0, 0.0)),
+        Restitution(1.0),
+        GravityScale(0.0),
+    ));
+    world
+        .entity_mut(wall)
+        .insert((GravityScale(0.0), Restitution(1.0)));
+    urto::step(app.world_mut(), 60).unwrap();
+    let p = |app: &App, e| get::<Position>(app, e).0;
+    let v = |app: &App, e| get::<Velocity>(app, e).0;
+    assert_eq!(p(&app, hanging).z, 5.0, "the z-locked ball fell or rose");
+    assert_eq!(v(&app, hanging), Vec3::ZERO);
+    assert_eq!(p(&app, planar).y, 0.0, "the y-locked ball left its plane");
+    // 4 N·s on 2 kg: 2 m/s along x, then rolling on the ground (friction slows the slide).
+    assert!(p(&app, planar).x > 5.5 && v(&app, planar).y == 0.0);
+    // Head-on against a body immovable along x: the ball bounces back at its own speed
+    // (e = 1), the wall has not moved at all.
+    assert_eq!(p(&app, wall), Vec3::new(12.0, 0.0, 2.0));
+    assert!(
+        (v(&app, thrown).x + 6.0).abs() < 0.06,
+        "the ball came back at {}",
+        v(&app, thrown)
+    );
+    // Unlocked, the hanging ball falls (it slept while hanging; the removal wakes it).
+    assert!(app.world().get::<Sleeping>(hanging).is_some());
+    app.world_mut().entity_mut(hanging).remove::<LockedAxes>();
+    urto::step(app.world_mut(), 30).unwrap();
+    assert!(p(&app, hanging).z < 4.0, "still at {}", p(&app, hanging));
+}

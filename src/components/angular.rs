@@ -71,8 +71,15 @@ impl ForceAtPoint {
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 pub struct AngularDrag(pub f32);
 
-/// World axes a body may not turn about: its angular velocity along them stays zero and
-/// torques and contacts do not turn it there.
+/// World axes a body may not turn about or move along (Avian's and rapier's `LockedAxes`):
+/// its velocity along them stays zero, and no force, torque, contact, joint or impulse moves
+/// it there. A 2.5D game locks translation along z and rotation about x and y.
+///
+/// The solver gives a locked body `1/m = 0` along each locked translation axis (a per-axis
+/// effective mass, as Avian and rapier), so a contact pushing it there treats it as immovable
+/// along that axis, not as a body whose motion is cut afterwards. Kinematic and static bodies
+/// ignore the locks. On the lecture's pipeline (`SoftStepPlugin` disabled) only the rotation
+/// locks and impulses honour them.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct LockedAxes(u8);
 
@@ -80,7 +87,16 @@ impl LockedAxes {
     /// Nothing locked.
     pub const NONE: Self = Self(0);
     /// Rotation locked about every axis: the body only translates.
-    pub const ROTATION_LOCKED: Self = Self(0b111);
+    pub const ROTATION_LOCKED: Self = Self(0b000_111);
+    /// Translation locked along every axis: the body only turns, about its centre of mass.
+    pub const TRANSLATION_LOCKED: Self = Self(0b111_000);
+    /// Everything locked: a dynamic body that neither moves nor turns.
+    pub const ALL_LOCKED: Self = Self(0b111_111);
+
+    /// Nothing locked (the same as [`Self::NONE`]), to chain `lock_*` calls on.
+    pub const fn new() -> Self {
+        Self::NONE
+    }
 
     /// Also locks rotation about world x.
     #[must_use]
@@ -100,15 +116,54 @@ impl LockedAxes {
         Self(self.0 | 4)
     }
 
+    /// Also locks translation along world x.
+    #[must_use]
+    pub const fn lock_translation_x(self) -> Self {
+        Self(self.0 | 8)
+    }
+
+    /// Also locks translation along world y.
+    #[must_use]
+    pub const fn lock_translation_y(self) -> Self {
+        Self(self.0 | 16)
+    }
+
+    /// Also locks translation along world z.
+    #[must_use]
+    pub const fn lock_translation_z(self) -> Self {
+        Self(self.0 | 32)
+    }
+
     /// True when rotation about every axis is locked.
     pub const fn is_rotation_locked(self) -> bool {
         self.0 & 0b111 == 0b111
     }
 
+    /// True when translation along every axis is locked.
+    pub const fn is_translation_locked(self) -> bool {
+        self.0 & 0b111_000 == 0b111_000
+    }
+
     /// 1 for each world axis the body may turn about, 0 for a locked one.
     pub fn free_rotation_axes(self) -> Vec3 {
-        let free = |bit: u8| if self.0 & bit == 0 { 1.0 } else { 0.0 };
-        Vec3::new(free(1), free(2), free(4))
+        self.free(0)
+    }
+
+    /// 1 for each world axis the body may move along, 0 for a locked one.
+    pub fn free_translation_axes(self) -> Vec3 {
+        self.free(3)
+    }
+
+    /// The three bits from `shift` as 1 (free) or 0 (locked).
+    fn free(self, shift: u8) -> Vec3 {
+        let free = |axis: u8| {
+            if self.0 & (1 << (shift + axis)) == 0 {
+                1.0
+            } else {
+                0.0
+            }
+        };
+        Vec3::new(free(0), free(1), free(2))
     }
 }
 

@@ -203,7 +203,7 @@ type Kicked<'a> = (
 );
 
 /// Consumes every [`Impulse`]: `Δv = J / m`, `Δω = I⁻¹ L` about the centre of mass (in world
-/// axes, locked axes left alone), before the step integrates. Kinematic bodies ignore it.
+/// axes, locked axes, translation and rotation, left alone), before the step integrates. Kinematic bodies ignore it.
 fn apply_impulses(
     mut bodies: Query<Kicked, (Active, Changed<Impulse>)>,
     mut stats: ResMut<PhysicsStats>,
@@ -215,7 +215,8 @@ fn apply_impulses(
             }
             let inverse_mass = mass.inverse();
             if inverse_mass > 0.0 {
-                v.0 += impulse.linear() * inverse_mass;
+                let free = locked.map_or(Vec3::ONE, |l| l.free_translation_axes());
+                v.0 += impulse.linear() * inverse_mass * free;
                 if let (Some(mut w), Some(inertia)) = (w, inertia) {
                     let center = center_of_mass(p, r, Some(inertia));
                     let moment = impulse.angular_about(center);

@@ -140,6 +140,7 @@ type Sleeper<'a> = (
             Option<Ref<'a, Mass>>,
             Option<Ref<'a, Density>>,
             Option<Ref<'a, GravityScale>>,
+            Option<Ref<'a, LockedAxes>>,
         ),
         Option<Ref<'a, Collider>>,
         Option<Ref<'a, Inertia>>,
@@ -170,6 +171,7 @@ type Pushed = Or<(
 type Reshaped = Or<(
     Changed<Mass>,
     Changed<Density>,
+    Changed<LockedAxes>,
     Changed<Collider>,
     Changed<Inertia>,
     Changed<LinearDrag>,
@@ -193,6 +195,7 @@ fn wake_on_game_changes(
         RemovedComponents<Mass>,
         RemovedComponents<Density>,
         RemovedComponents<GravityScale>,
+        RemovedComponents<LockedAxes>,
     ),
     mut waker: Waker,
 ) {
@@ -202,9 +205,11 @@ fn wake_on_game_changes(
         }
         return;
     }
-    // A removed mass, density or gravity scale changes what the body weighs or feels.
-    let (mass, density, scale) = &mut unset;
-    for e in mass.read().chain(density.read()).chain(scale.read()) {
+    // A removed mass, density, gravity scale or lock changes what the body weighs or feels,
+    // or how it may move.
+    let (mass, density, scale, locks) = &mut unset;
+    let removed = mass.read().chain(density.read()).chain(scale.read());
+    for e in removed.chain(locks.read()) {
         if let Ok((e, mut sleep)) = sleepers.p1().get_mut(e) {
             waker.wake(e, Some(&mut sleep));
         }
@@ -218,7 +223,7 @@ fn wake_on_game_changes(
         let spun = w.is_some_and(|w| w.0 != Vec3::ZERO);
         let moved = p.0 != sleep.at || r.0 != sleep.orientation || v.0 != Vec3::ZERO;
         let (
-            (mass, density, gravity_scale),
+            (mass, density, gravity_scale, locks),
             collider,
             inertia,
             drag,
@@ -229,6 +234,7 @@ fn wake_on_game_changes(
         let rebuilt = written(mass)
             || written(density)
             || written(gravity_scale)
+            || written(locks)
             || written(collider)
             || written(inertia)
             || written(drag)

@@ -146,7 +146,11 @@ impl ContactBatch {
         self.normal = vectors(|c| c.normal);
         self.tangents = [vectors(|c| c.tangents[0]), vectors(|c| c.tangents[1])];
         self.friction = each(|c| c.friction);
-        self.inverse_mass = [each(|c| c.inverse_mass[0]), each(|c| c.inverse_mass[1])];
+        debug_assert!(
+            lanes.iter().flatten().all(|c| !c.translation_locked),
+            "contacts of a body with a locked translation axis are solved one at a time"
+        );
+        self.inverse_mass = [each(|c| c.inverse_mass[0].x), each(|c| c.inverse_mass[1].x)];
         self.softness = [
             each(|c| c.softness.mass_scale * c.softness.bias_rate),
             each(|c| c.softness.mass_scale),

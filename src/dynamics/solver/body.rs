@@ -33,8 +33,10 @@ impl Default for BodyState {
 /// accelerations of the step's external forces.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BodyParams {
-    /// `1/m`; 0 for static and kinematic bodies.
-    pub inverse_mass: f32,
+    /// `1/m` along each world axis: 0 for static and kinematic bodies and along a locked
+    /// translation axis (Avian's and rapier's per-axis effective inverse mass), so no impulse
+    /// moves the body there.
+    pub inverse_mass: Vec3,
     /// World inverse inertia `R I⁻¹ Rᵀ` at the step's start, locked axes zeroed.
     pub inverse_inertia: Mat3,
     /// Gravity plus force over mass (m/s²).
@@ -80,6 +82,8 @@ pub struct BodyInput {
     pub angular_damping: f32,
     /// 1 per world axis the body may turn about, 0 where locked.
     pub free_axes: Vec3,
+    /// 1 per world axis the body may move along, 0 where locked.
+    pub free_translation: Vec3,
     /// Turn with the gyroscopic term `−ω × Iω` (Dzhanibekov's flip, a spinning top's
     /// precession); honoured for dynamic bodies with every axis free and finite inertia.
     pub gyroscopic: bool,
@@ -101,6 +105,7 @@ impl Default for BodyInput {
             linear_damping: 0.0,
             angular_damping: 0.0,
             free_axes: Vec3::ONE,
+            free_translation: Vec3::ONE,
             gyroscopic: false,
         }
     }
@@ -155,16 +160,21 @@ impl SolverBodies {
         let inverse_inertia =
             lock * r * Mat3::from_diagonal(b.inverse_principal_inertia) * r.transpose() * lock;
         let dynamic = b.inverse_mass > 0.0;
+        let linear_mask = if dynamic {
+            b.free_translation
+        } else {
+            Vec3::ONE
+        };
         self.states.push(BodyState {
-            linear_velocity: b.linear_velocity,
+            linear_velocity: b.linear_velocity * linear_mask,
             angular_velocity: b.angular_velocity * b.free_axes,
             ..Default::default()
         });
         self.params.push(BodyParams {
-            inverse_mass: b.inverse_mass,
+            inverse_mass: Vec3::splat(b.inverse_mass) * b.free_translation,
             inverse_inertia: if dynamic { inverse_inertia } else { Mat3::ZERO },
             linear_acceleration: if dynamic {
-                b.linear_acceleration
+                b.linear_acceleration * b.free_translation
             } else {
                 Vec3::ZERO
             },

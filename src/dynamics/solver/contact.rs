@@ -121,8 +121,13 @@ pub struct ContactConstraint {
     pub key: u128,
     /// Solve the points backwards this substep (flipped every substep).
     pub flip: bool,
-    /// `1/m` of A and B, copied so the passes touch only the velocities.
-    pub inverse_mass: [f32; 2],
+    /// `1/m` of A and B per world axis (0 along a locked one), copied so the passes touch
+    /// only the velocities.
+    pub inverse_mass: [Vec3; 2],
+    /// Whether a body has a locked translation axis: its `1/m` differs between axes, which
+    /// the batches' one-number-per-body lanes cannot carry (such contacts are solved one at a
+    /// time, so a scene without locks pays nothing for them).
+    pub translation_locked: bool,
     /// Whether A and B may be moved (kinematic and static bodies keep their velocities).
     pub dynamic: [bool; 2],
     /// The rolling-resistance rows (none unless the pair has a lever arm).
@@ -143,15 +148,24 @@ pub struct RowPart {
     pub arm: [Vec3; 2],
     /// `I_a⁻¹ (r_a × d)`, `I_b⁻¹ (r_b × d)`.
     pub turn: [Vec3; 2],
-    /// `1/K`, `K = 1/m_a + 1/m_b + (r_a×d)·I_a⁻¹(r_a×d) + (r_b×d)·I_b⁻¹(r_b×d)` (0 if immovable).
+    /// `1/K`, `K = d·W_a d + d·W_b d + (r_a×d)·I_a⁻¹(r_a×d) + (r_b×d)·I_b⁻¹(r_b×d)` with
+    /// `W = diag(1/m per axis)` (`1/m_a + 1/m_b` for unit `d` without locks; 0 if immovable).
     pub mass: f32,
 }
 
 impl RowPart {
-    fn new(pa: &BodyParams, pb: &BodyParams, ra: Vec3, rb: Vec3, dir: Vec3) -> Self {
+    /// The row along `dir` at anchors `ra`, `rb`; `linear` is its translational part
+    /// `d·W_a d + d·W_b d` (the same for every point of a contact, so computed once).
+    fn new(
+        pa: &BodyParams,
+        pb: &BodyParams,
+        ra: Vec3,
+        rb: Vec3,
+        (dir, linear): (Vec3, f32),
+    ) -> Self {
         let arm = [ra.cross(dir), rb.cross(dir)];
         let turn = [pa.inverse_inertia * arm[0], pb.inverse_inertia * arm[1]];
-        let k = pa.inverse_mass + pb.inverse_mass + arm[0].dot(turn[0]) + arm[1].dot(turn[1]);
+        let k = linear + arm[0].dot(turn[0]) + arm[1].dot(turn[1]);
         let mass = if k > 0.0 && k.is_finite() {
             1.0 / k
         } else {
@@ -209,6 +223,12 @@ impl ContactConstraint {
             let (t1, t2) = n.any_orthonormal_pair();
             [t1, t2]
         };
+        // `d·W d` for unit `d`: `1/m_a + 1/m_b` itself without locks (bit for bit what the
+        // solver computed before it had per-axis masses).
+        let w = pa.inverse_mass + pb.inverse_mass;
+        let uniform = w.min_element() == w.max_element();
+        let along = |d: Vec3| (d, if uniform { w.x } else { w.dot(d * d) });
+        let (normal, sides) = (along(n), tangents.map(along));
         let mut points = [ConstraintPoint::default(); MAX_MANIFOLD_POINTS];
         for (cp, p) in points.iter_mut().zip(&input.points[..input.count as usize]) {
             let ra = p.point - centers[ia];
@@ -218,8 +238,8 @@ impl ContactConstraint {
                 anchor_a: ra,
                 anchor_b: rb,
                 base_separation: p.separation - (rb - ra).dot(n),
-                normal_row: RowPart::new(pa, pb, ra, rb, n),
-                tangent_rows: tangents.map(|t| RowPart::new(pa, pb, ra, rb, t)),
+                normal_row: RowPart::new(pa, pb, ra, rb, normal),
+                tangent_rows: sides.map(|t| RowPart::new(pa, pb, ra, rb, t)),
                 relative_velocity: relative.dot(n),
                 ..Default::default()
             };
@@ -237,6 +257,10 @@ impl ContactConstraint {
             key: input.key,
             flip: false,
             inverse_mass: [pa.inverse_mass, pb.inverse_mass],
+            translation_locked: [pa, pb].iter().any(|p| {
+                let w = p.inverse_mass;
+                w.min_element() != w.max_element()
+            }),
             dynamic: [pa.dynamic, pb.dynamic],
             closing_acceleration: (pb.linear_acceleration - pa.linear_acceleration).dot(n),
             rolling: RollingRows::new(
@@ -409,11 +433,12 @@ impl Pair {
         self.push_with(c.inverse_mass, dir, row, lambda);
     }
 
-    /// [`Self::push`] with the two inverse masses given.
-    fn push_with(&mut self, inverse_mass: [f32; 2], dir: Vec3, row: &RowPart, lambda: f32) {
-        self.va -= dir * (lambda * inverse_mass[0]);
+    /// [`Self::push`] with the two per-axis inverse masses given.
+    fn push_with(&mut self, inverse_mass: [Vec3; 2], dir: Vec3, row: &RowPart, lambda: f32) {
+        let linear = dir * lambda;
+        self.va -= linear * inverse_mass[0];
         self.wa -= row.turn[0] * lambda;
-        self.vb += dir * (lambda * inverse_mass[1]);
+        self.vb += linear * inverse_mass[1];
         self.wb += row.turn[1] * lambda;
     }
 

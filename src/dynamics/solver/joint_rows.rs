@@ -4,7 +4,9 @@
 //! `PointConstraintPart` and `RotationEulerConstraintPart`).
 //!
 //! Every row works on the velocities `V = (v_a, ω_a, v_b, ω_b)` of two bodies with inverse
-//! masses `m_a⁻¹`, `m_b⁻¹` and world inverse inertias `I_a⁻¹`, `I_b⁻¹`. A row with Jacobian
+//! masses `m_a⁻¹`, `m_b⁻¹` and world inverse inertias `I_a⁻¹`, `I_b⁻¹`. A body with locked
+//! translation axes has the diagonal `W = diag(m⁻¹ per axis)`, 0 along a locked one, in place
+//! of `m⁻¹ 1` wherever it appears below. A row with Jacobian
 //! `J` has the velocity error `Ċ = J V`, the effective mass `K⁻¹` with `K = J M⁻¹ Jᵀ`, and an
 //! impulse `λ` changes the velocities by `M⁻¹ Jᵀ λ`. The soft form of the impulse
 //! (`λ = −mass_scale K⁻¹ (Ċ + bias) − impulse_scale λ_acc`) is [`Softness`]'s.
@@ -27,8 +29,8 @@ use glam::{Mat3, Vec3};
 /// The two bodies of a joint as its rows see them: masses and world inverse inertias.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PairMasses {
-    /// `m_a⁻¹`, `m_b⁻¹`.
-    pub inverse_mass: [f32; 2],
+    /// `m_a⁻¹`, `m_b⁻¹` per world axis (0 along a locked translation axis).
+    pub inverse_mass: [Vec3; 2],
     /// `I_a⁻¹`, `I_b⁻¹` (world, at the step's start).
     pub inverse_inertia: [Mat3; 2],
     /// Whether the solver may change each body's velocities.
@@ -47,7 +49,8 @@ impl PairMasses {
     }
 
     /// Applies the impulse `λ` of a row, linear part `l λ`, angular parts `u_a λ`, `u_b λ`:
-    /// `v_a −= m_a⁻¹ l λ`, `ω_a −= I_a⁻¹ u_a λ`, and the opposite signs for B.
+    /// `v_a −= W_a l λ` (`W` the per-axis `1/m`), `ω_a −= I_a⁻¹ u_a λ`, and the opposite
+    /// signs for B.
     pub fn apply(
         &self,
         states: &mut [BodyState],
@@ -181,7 +184,7 @@ impl AxisRow {
             return p.k;
         }
         let [ia, ib] = m.inverse_inertia;
-        (m.inverse_mass[0] + m.inverse_mass[1]) * self.linear.length_squared()
+        (m.inverse_mass[0] + m.inverse_mass[1]).dot(self.linear * self.linear)
             + self.angular_a.dot(ia * self.angular_a)
             + self.angular_b.dot(ib * self.angular_b)
     }
@@ -244,9 +247,7 @@ pub fn skew(v: Vec3) -> Mat3 {
 pub fn point_mass(m: &PairMasses, r_a: Vec3, r_b: Vec3) -> Mat3 {
     let (sa, sb) = (skew(r_a), skew(r_b));
     let [ia, ib] = m.inverse_inertia;
-    Mat3::from_diagonal(Vec3::splat(m.inverse_mass[0] + m.inverse_mass[1]))
-        - sa * ia * sa
-        - sb * ib * sb
+    Mat3::from_diagonal(m.inverse_mass[0] + m.inverse_mass[1]) - sa * ia * sa - sb * ib * sb
 }
 
 /// Solves the point rows: anchors `r_a`, `r_b` (world, now), position error `c` (`None` in a
@@ -387,7 +388,7 @@ mod tests {
 
     fn masses(ma: f32, mb: f32) -> PairMasses {
         PairMasses {
-            inverse_mass: [1.0 / ma, 1.0 / mb],
+            inverse_mass: [Vec3::splat(1.0 / ma), Vec3::splat(1.0 / mb)],
             inverse_inertia: [
                 Mat3::from_diagonal(Vec3::new(1.0, 2.0, 3.0)),
                 Mat3::from_diagonal(Vec3::new(0.5, 0.25, 4.0)),
@@ -474,7 +475,7 @@ mod tests {
     fn a_row_held_at_the_anchors_stops_the_turn_and_leaves_the_anchor_still_within_1e_5() {
         // A bar's end pinned to an immovable body: stop its turn about y in one solve.
         let mut m = masses(1.0, 1.0);
-        m.inverse_mass[0] = 0.0;
+        m.inverse_mass[0] = Vec3::ZERO;
         m.inverse_inertia[0] = Mat3::ZERO;
         m.dynamic[0] = false;
         m.inverse_inertia[1] = Mat3::from_diagonal(Vec3::new(12.0, 12.0, 600.0));

@@ -399,7 +399,9 @@ impl Solver {
         self.stable_springs.clear();
         self.clamped_springs = 0;
         let n = bodies.params.len();
-        let inverse_mass = |i: usize| (i < n).then(|| bodies.params[i].inverse_mass);
+        // The largest `1/m` of any free axis: the bound is the stiffest the spring may be
+        // along any direction it can pull.
+        let inverse_mass = |i: usize| (i < n).then(|| bodies.params[i].inverse_mass.max_element());
         for spring in springs {
             let other = match spring.other {
                 SpringEnd::Body(j) => inverse_mass(j),

@@ -16,6 +16,7 @@ mod capsules;
 mod convex;
 mod ghost_edges;
 mod joints;
+mod locked_axes;
 
 struct Body {
     shape: Shape,
@@ -28,6 +29,10 @@ struct Body {
     frame: Quat,
     friction: f32,
     restitution: f32,
+    /// 1 per world axis the body may move along (0: locked).
+    free_translation: Vec3,
+    /// 1 per world axis the body may turn about (0: locked).
+    free_rotation: Vec3,
 }
 
 #[derive(Default)]
@@ -62,6 +67,8 @@ impl Scene {
             frame,
             friction: 0.6,
             restitution: 0.0,
+            free_translation: Vec3::ONE,
+            free_rotation: Vec3::ONE,
         });
         self.bodies.len() - 1
     }
@@ -130,6 +137,8 @@ impl Scene {
                 inverse_principal_inertia: b.inverse_inertia,
                 inertia_frame: b.frame,
                 linear_acceleration: if b.inverse_mass > 0.0 { G } else { Vec3::ZERO },
+                free_translation: b.free_translation,
+                free_axes: b.free_rotation,
                 ..Default::default()
             });
         }

@@ -376,6 +376,7 @@ fn body_input(
         linear_damping: drag.map_or(0.0, |d| d.0 * inverse_mass),
         angular_damping: angular_drag.map_or(0.0, |d| d.0),
         free_axes: locked.map_or(Vec3::ONE, |l| l.free_rotation_axes()),
+        free_translation: locked.map_or(Vec3::ONE, |l| l.free_translation_axes()),
         gyroscopic,
     }
 }

@@ -58,13 +58,15 @@ fn period(xs: &[f32]) -> f32 {
 }
 
 /// A ball of radius 0.1 on a joint of `kind` 1 m below a fixed pivot, released at 3°: its
-/// period, and the physical pendulum's `2π √((L² + 2/5 r²) / (g L))`.
-fn pendulum_period(kind: JointKind) -> (f32, f32) {
+/// period, and the physical pendulum's `2π √((L² + 2/5 r²) / (g L))`; `prepare` sets the bob
+/// up before the release. Also how far the bob strayed from the swing's plane (y = 0).
+fn pendulum_period(kind: JointKind, prepare: fn(&mut Body)) -> (f32, f32, f32) {
     let (length, radius, start) = (1.0f32, 0.1f32, 3f32.to_radians());
     let mut scene = Scene::default();
     let pivot = anchor(&mut scene, Vec3::ZERO);
     let offset = Vec3::new(start.sin(), 0.0, -start.cos()) * length;
     let bob = scene.add(Shape::sphere(radius), offset, Quat::IDENTITY, 1.0);
+    prepare(&mut scene.bodies[bob]);
     join(
         &mut scene,
         (pivot, bob),
@@ -72,20 +74,36 @@ fn pendulum_period(kind: JointKind) -> (f32, f32) {
         Vec3::Y,
         kind,
     );
-    let mut xs = Vec::new();
+    let (mut xs, mut off_plane) = (Vec::new(), 0.0f32);
     for _ in 0..(8.0 / DT) as usize {
         scene.step();
         xs.push(scene.bodies[bob].center.x);
+        off_plane = off_plane.max(scene.bodies[bob].center.y.abs());
     }
     let g = G.length();
     let expected =
         std::f32::consts::TAU * ((length * length + 0.4 * radius * radius) / (g * length)).sqrt();
-    (period(&xs), expected)
+    (period(&xs), expected, off_plane)
+}
+
+#[test]
+fn a_ball_joint_bob_locked_along_y_and_pushed_sideways_swings_in_its_plane_within_1_percent() {
+    // Free, a push along y would swing the bob round a cone; locked along y it cannot leave the
+    // xz plane, and the joint's rows see its infinite mass there (`W` of `joint_rows`).
+    let (t, expected, off_plane) = pendulum_period(BALL, |bob| {
+        bob.v = Vec3::new(0.0, 0.5, 0.0);
+        bob.free_translation = Vec3::new(1.0, 0.0, 1.0);
+    });
+    assert_eq!(off_plane, 0.0, "the bob left the xz plane");
+    assert!(
+        (t / expected - 1.0).abs() < 0.01,
+        "{t} s against {expected} s"
+    );
 }
 
 #[test]
 fn a_pendulum_on_a_ball_joint_swings_with_the_analytic_period_within_1_percent() {
-    let (t, expected) = pendulum_period(BALL);
+    let (t, expected, _) = pendulum_period(BALL, |_| {});
     assert!(
         (t / expected - 1.0).abs() < 0.01,
         "{t} s against {expected} s"
@@ -103,7 +121,7 @@ fn a_pendulum_on_a_hinge_swings_with_the_analytic_period_within_1_percent() {
         limit: None,
         motor: None,
     };
-    let (t, expected) = pendulum_period(hinge);
+    let (t, expected, _) = pendulum_period(hinge, |_| {});
     assert!(
         (t / expected - 1.0).abs() < 0.01,
         "{t} s against {expected} s"
