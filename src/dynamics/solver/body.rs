@@ -111,6 +111,12 @@ impl Default for BodyInput {
     }
 }
 
+/// Whether a per-axis `1/m` is one number on every axis (no translation lock): then the rows
+/// take their one-number form, bit for bit what they were before locks existed.
+pub fn same_on_every_axis(inverse_mass: Vec3) -> bool {
+    inverse_mass.min_element() == inverse_mass.max_element()
+}
+
 /// The solver's bodies, one slot each, in the caller's (stable) order.
 #[derive(Clone, Debug, Default)]
 pub struct SolverBodies {

@@ -29,7 +29,7 @@
 //! pass only, as Box2D does: friction in the biased pass fights the push-out and lets stacks
 //! creep.
 
-use super::body::{BodyParams, BodyState};
+use super::body::{BodyParams, BodyState, same_on_every_axis};
 use super::rolling::RollingRows;
 use super::softness::Softness;
 use crate::geometry::MAX_MANIFOLD_POINTS;
@@ -226,7 +226,7 @@ impl ContactConstraint {
         // `d·W d` for unit `d`: `1/m_a + 1/m_b` itself without locks (bit for bit what the
         // solver computed before it had per-axis masses).
         let w = pa.inverse_mass + pb.inverse_mass;
-        let uniform = w.min_element() == w.max_element();
+        let uniform = same_on_every_axis(w);
         let along = |d: Vec3| (d, if uniform { w.x } else { w.dot(d * d) });
         let (normal, sides) = (along(n), tangents.map(along));
         let mut points = [ConstraintPoint::default(); MAX_MANIFOLD_POINTS];
@@ -257,10 +257,8 @@ impl ContactConstraint {
             key: input.key,
             flip: false,
             inverse_mass: [pa.inverse_mass, pb.inverse_mass],
-            translation_locked: [pa, pb].iter().any(|p| {
-                let w = p.inverse_mass;
-                w.min_element() != w.max_element()
-            }),
+            translation_locked: !same_on_every_axis(pa.inverse_mass)
+                || !same_on_every_axis(pb.inverse_mass),
             dynamic: [pa.dynamic, pb.dynamic],
             closing_acceleration: (pb.linear_acceleration - pa.linear_acceleration).dot(n),
             rolling: RollingRows::new(
@@ -435,10 +433,10 @@ impl Pair {
 
     /// [`Self::push`] with the two per-axis inverse masses given.
     fn push_with(&mut self, inverse_mass: [Vec3; 2], dir: Vec3, row: &RowPart, lambda: f32) {
-        let linear = dir * lambda;
-        self.va -= linear * inverse_mass[0];
+        // `d (W λ)` per component: with one `1/m` per body exactly the old `d (λ/m)`.
+        self.va -= dir * (inverse_mass[0] * lambda);
         self.wa -= row.turn[0] * lambda;
-        self.vb += linear * inverse_mass[1];
+        self.vb += dir * (inverse_mass[1] * lambda);
         self.wb += row.turn[1] * lambda;
     }
 

@@ -22,7 +22,7 @@
 //!   (a weld's lock: `u` the world axes; a hinge's alignment: two directions, see
 //!   [`hinge_directions`]).
 
-use super::body::{BodyParams, BodyState};
+use super::body::{BodyParams, BodyState, same_on_every_axis};
 use super::softness::Softness;
 use glam::{Mat3, Vec3};
 
@@ -184,9 +184,13 @@ impl AxisRow {
             return p.k;
         }
         let [ia, ib] = m.inverse_inertia;
-        (m.inverse_mass[0] + m.inverse_mass[1]).dot(self.linear * self.linear)
-            + self.angular_a.dot(ia * self.angular_a)
-            + self.angular_b.dot(ib * self.angular_b)
+        let w = m.inverse_mass[0] + m.inverse_mass[1];
+        let linear = if same_on_every_axis(w) {
+            w.x * self.linear.length_squared()
+        } else {
+            w.dot(self.linear * self.linear)
+        };
+        linear + self.angular_a.dot(ia * self.angular_a) + self.angular_b.dot(ib * self.angular_b)
     }
 
     /// Applies `λ` along the row.
