@@ -26,23 +26,28 @@
 //! let touch = contact(&crate_, &Isometry::default(), &ball, &tilted).expect("they overlap");
 //! assert!(touch.max_depth() > 0.0 && touch.normal.z > 0.9);
 //! ```
-//!
-//! ```
-//! use bevy_app::App;
-//! use urto::prelude::*;
-//!
-//! let mut app = App::new();
-//! app.add_plugins(UrtoPlugins::default()).insert_resource(Gravity::EARTH_Z_UP);
-//! app.world_mut().spawn((Collider::half_space(glam::Vec3::Z), Static));
-//! let ball = app
-//!     .world_mut()
-//!     .spawn((Collider::sphere(0.5), Position::new(0.0, 0.0, 2.0), Velocity::default()))
-//!     .id();
-//! urto::step(app.world_mut(), 120).unwrap();
-//! let z = app.world().get::<Position>(ball).unwrap().0.z;
-//! assert!(z > 0.4 && z < 2.0);
-//! ```
+#![cfg_attr(
+    feature = "ecs",
+    doc = r#"
+The ECS layer (the `ecs` feature), a ball dropped on a floor:
 
+```
+use bevy_app::App;
+use urto::prelude::*;
+
+let mut app = App::new();
+app.add_plugins(UrtoPlugins::default()).insert_resource(Gravity::EARTH_Z_UP);
+app.world_mut().spawn((Collider::half_space(glam::Vec3::Z), Static));
+let ball = app
+    .world_mut()
+    .spawn((Collider::sphere(0.5), Position::new(0.0, 0.0, 2.0), Velocity::default()))
+    .id();
+urto::step(app.world_mut(), 120).unwrap();
+let z = app.world().get::<Position>(ball).unwrap().0.z;
+assert!(z > 0.4 && z < 2.0);
+```
+"#
+)]
 // Every public item says what it is (the public-surface audit of issue 11); clippy's
 // `-D warnings` in CI turns a missing doc into an error.
 #![warn(missing_docs)]

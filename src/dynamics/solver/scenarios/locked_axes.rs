@@ -130,7 +130,12 @@ fn a_pile_locked_to_the_xz_plane_stays_in_it_bit_for_bit_and_comes_to_rest_under
     for (k, y) in movers {
         let b = &scene.bodies[k];
         assert_eq!(b.center.y, y, "box {k} left its plane");
-        assert!(b.v.y == 0.0 && b.w.x == 0.0 && b.w.z == 0.0, "{k}: {} {}", b.v, b.w);
+        assert!(
+            b.v.y == 0.0 && b.w.x == 0.0 && b.w.z == 0.0,
+            "{k}: {} {}",
+            b.v,
+            b.w
+        );
         assert!(b.center.z > 0.0, "box {k} fell through: {}", b.center);
         assert!(b.v.length() < 0.05, "box {k} still moves: {}", b.v);
     }
