@@ -5,7 +5,10 @@
 //!
 //! `cargo run --release --example bvh_costs` (about 20 s). Environment: `URTO_BVH_TRIANGLES`, the
 //! approximate triangle count of each mesh (default 20000); `URTO_BVH_LEAF_SIZE` (default 4);
-//! `URTO_BVH_KINDS`, a comma-separated subset of `sphere,aabb,obb,kdop14,kdop18,kdop26,parry`.
+//! `URTO_BVH_KINDS`, a comma-separated subset of `sphere,aabb,obb,kdop14,kdop18,kdop26,parry`;
+//! `URTO_BVH_MESH`, an OBJ, STL or PLY file of your own to measure instead of the tori (two
+//! copies of it, centred, placed at random against each other): what
+//! `MeshCollider::with_hierarchy`'s choices cost for that mesh.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -41,11 +44,14 @@ fn run_kind<B: Bv>(name: &str, a: &Mesh, b: &Mesh, poses: &[Isometry]) {
         let build = time(|| Bvh::<B>::build(&a.vertices, &a.triangles, &options).unwrap());
         let ta = Bvh::<B>::build(&a.vertices, &a.triangles, &options).unwrap();
         let tb = Bvh::<B>::build(&b.vertices, &b.triangles, &options).unwrap();
+        // The nodes and the leaves' triangle indices.
+        let bytes = std::mem::size_of_val(ta.nodes()) + 4 * a.triangles.len();
         println!(
-            "{name:7} {rule:9?} build {:8.2} ms  nodes {:6} depth {:3}",
+            "{name:7} {rule:9?} build {:8.2} ms  nodes {:6} depth {:3}  memory {:8.1} KiB",
             build.as_secs_f64() * 1e3,
             ta.nodes().len(),
-            ta.depth()
+            ta.depth(),
+            bytes as f64 / 1024.0
         );
         let mut scratch = QueryScratch::new();
         let mut out = Vec::new();
@@ -158,6 +164,20 @@ fn run_parry(a: &Mesh, b: &Mesh, poses: &[Isometry]) {
     );
 }
 
+/// The mesh in `path`, centred on its bounding box (the placements are about the origin).
+fn own_mesh(path: &str) -> Result<Mesh, urto::geometry::mesh_io::MeshLoadError> {
+    let mesh = urto::geometry::mesh_io::load(path)?;
+    let (lo, hi) = mesh.vertices().iter().fold(
+        (glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN)),
+        |(lo, hi), v| (lo.min(*v), hi.max(*v)),
+    );
+    let centre = (lo + hi) * 0.5;
+    Ok(Mesh {
+        vertices: mesh.vertices().iter().map(|v| *v - centre).collect(),
+        triangles: mesh.triangles().to_vec(),
+    })
+}
+
 fn env_or(name: &str, default: usize) -> usize {
     std::env::var(name)
         .ok()
@@ -170,7 +190,16 @@ fn main() {
     let kinds = std::env::var("URTO_BVH_KINDS")
         .unwrap_or_else(|_| "parry,sphere,aabb,obb,kdop14,kdop18,kdop26".into());
     let wanted = |k: &str| kinds.split(',').any(|w| w.trim() == k);
-    let (a, b) = torus_pair(n);
+    let (a, b) = match std::env::var("URTO_BVH_MESH") {
+        Ok(path) => match own_mesh(&path) {
+            Ok(mesh) => (mesh.clone(), mesh),
+            Err(e) => {
+                eprintln!("cannot measure {path}: {e}");
+                std::process::exit(1);
+            }
+        },
+        Err(_) => torus_pair(n),
+    };
     let poses = placements(&a, &b, PLACEMENTS, 2024);
     println!(
         "A: {} triangles, B: {} triangles, {PLACEMENTS} placements; times per placement",
