@@ -28,10 +28,12 @@ pub struct ContactData {
     pub manifold: ContactManifold,
     /// The largest normal impulse (N·s) the rigid-body solver applied at one point in one
     /// substep of the step: 0 for a contact that only touched (a graze, or continuous
-    /// collision's impacts), and always 0 on the lecture's pipeline (`SoftStepPlugin` disabled).
+    /// collision's impacts). On the lecture's pipeline (`SoftStepPlugin` disabled), its
+    /// response's total normal impulse in the substep.
     pub normal_impulse: f32,
     /// The speed (m/s) at which the bodies met along the normal (≥ 0), from the rigid-body
-    /// solver or a continuous-collision impact; 0 on the lecture's pipeline.
+    /// solver or a continuous-collision impact; on the lecture's pipeline, the approach speed
+    /// before its response.
     pub impact_speed: f32,
 }
 

@@ -110,12 +110,13 @@ pub struct ContactPair {
     /// speculative margin apart, with negative depths).
     pub manifold: ContactManifold,
     /// The largest normal impulse the rigid-body solver applied to this contact in one substep
-    /// of the step (N·s); 0 until it has solved, and without it.
+    /// of the step (N·s), or the lecture's response's in its substep; 0 until it has solved.
     pub normal_impulse: f32,
     /// The speed (m/s) at which the two bodies met along the normal: the fastest approach of
     /// the points the rigid-body solver pushed this step, taken when each first pushed (a
     /// speculative point's speed carried on to the surface). What a game scales a hit sound or
-    /// damage by; about 0 for a resting contact, 0 until it has solved, and without it.
+    /// damage by; about 0 for a resting contact, 0 until it has solved. The lecture's response
+    /// gives the approach speed before it solved.
     pub impact_speed: f32,
 }
 

@@ -87,7 +87,7 @@ type MovableFilter = (Without<Static>, Without<Quarantined>);
 
 #[allow(clippy::too_many_arguments)]
 fn resolve_contacts(
-    contacts: Res<Contacts>,
+    mut contacts: ResMut<Contacts>,
     mut bodies: Query<Movable, MovableFilter>,
     restitution: Query<&Restitution>,
     friction: Query<&Friction>,
@@ -169,6 +169,7 @@ fn resolve_contacts(
         &mut b.displacement,
     );
     b.remember_impulses();
+    b.report_impulses(&mut contacts.pairs);
     for i in 1..b.entities.len() {
         if b.inverse_mass[i] > 0.0
             && let Ok((mut p, mut v, _, asleep, mut state)) = bodies.get_mut(b.entities[i])
@@ -202,6 +203,18 @@ impl ResponseBuffers {
     }
 
     /// Keeps this substep's impulses for the next one; contacts that ended are forgotten.
+    /// Each contact's normal impulse and approach speed along its normal before the solve,
+    /// for the collision messages' contact data (what the rigid-body solver reports too).
+    fn report_impulses(&self, pairs: &mut [ContactPair]) {
+        for c in &self.constraints {
+            if let Some(pair) = pairs.get_mut(c.tag as usize) {
+                let (va, vb) = (self.velocities_before[c.a], self.velocities_before[c.b]);
+                pair.normal_impulse = c.impulse();
+                pair.impact_speed = (va - vb).dot(c.normal).max(0.0);
+            }
+        }
+    }
+
     fn remember_impulses(&mut self) {
         self.warm.clear();
         for c in &self.constraints {
