@@ -90,16 +90,31 @@ pub(crate) fn spread_points(
 }
 
 /// The point maximising `key` among those `in_front`, unless a point outside the front has a
-/// key more than 1 / [`FRONT_PREFERENCE`] times larger: then that one.
+/// key more than 1 / [`FRONT_PREFERENCE`] times larger: then that one. One pass, each key
+/// computed once (two `argmax` passes cost a twentieth of a box pyramid's step, callgrind);
+/// ties go to the lower index in both maxima, as `argmax`'s.
 fn pick(
     points: &[ContactPoint],
     in_front: impl Fn(&ContactPoint) -> bool,
     key: impl Fn(&ContactPoint) -> f32,
 ) -> Option<usize> {
-    let any = argmax(points, &key)?;
-    let front = argmax(points, |p| if in_front(p) { key(p) } else { f32::NAN });
+    let mut any: Option<(usize, f32)> = None;
+    let mut front: Option<(usize, f32)> = None;
+    for (i, p) in points.iter().enumerate() {
+        let k = key(p);
+        if k.is_nan() {
+            continue;
+        }
+        if any.is_none_or(|(_, b)| k > b) {
+            any = Some((i, k));
+        }
+        if in_front(p) && front.is_none_or(|(_, b)| k > b) {
+            front = Some((i, k));
+        }
+    }
+    let (any, largest) = any?;
     match front {
-        Some(f) if key(&points[f]) >= FRONT_PREFERENCE * key(&points[any]) => Some(f),
+        Some((f, k)) if k >= FRONT_PREFERENCE * largest => Some(f),
         _ => Some(any),
     }
 }
