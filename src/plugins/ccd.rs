@@ -6,7 +6,9 @@
 //! size in one substep. For each, the motion the integrator just produced (its centre of mass,
 //! start → end) is swept against the static scenery its swept volume meets ([`crate::ccd`]:
 //! exact time of impact of a sphere about the centre of mass holding the body, against spheres,
-//! boxes, planes and meshes). The centre of mass, not the origin, because that is what
+//! boxes, planes and meshes; for a body of one convex collider, refined from there to the
+//! collider's own first contact by conservative advancement, [`toi_shape_from`], so a long thin
+//! body is not stopped where its bounding sphere met the wall). The centre of mass, not the origin, because that is what
 //! [`Velocity`] moves and what the solver turns the body about: sweeping the origin of a
 //! spinning body whose centre is off it (a cone, a compound) and reflecting the velocity there
 //! moved its centre of mass up to 1.17 × its speed bound in a step (the fuzz scenes). At the first
@@ -21,10 +23,13 @@
 //! at the start of its motion is the contact solver's business, not an impact.
 
 use crate::bvh::QueryScratch;
-use crate::ccd::{InitialOverlap, SphereSweep, Toi, toi_sphere_shape};
+use crate::ccd::{
+    InitialOverlap, ShapeOnSweep, SphereSweep, Toi, toi_shape_from, toi_sphere_shape,
+};
 use crate::components::*;
 use crate::dynamics::response::reflect;
 use crate::geometry::ContactManifold;
+use crate::geometry::contacts::ContactScratch;
 use crate::plugins::broad_phase::BroadPhaseIndex;
 use crate::plugins::integration::IntegrateBodies;
 use crate::plugins::joints::JointedPairs;
@@ -37,7 +42,7 @@ use crate::settings::{ContactSettings, PhysicsTimestep};
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
-use glam::Vec3;
+use glam::{Quat, Vec3};
 use std::time::Instant;
 
 /// Sweeps fast bodies against static scenery each substep.
@@ -113,6 +118,8 @@ struct SweepStart {
     from: Vec3,
     radius: f32,
     local_center: Vec3,
+    /// The body's orientation at the substep's start.
+    rotation: Quat,
 }
 
 #[derive(Resource, Default)]
@@ -121,6 +128,7 @@ struct CcdScratch {
     candidates: Vec<Entity>,
     stack: Vec<Entity>,
     query: QueryScratch,
+    contacts: ContactScratch,
 }
 
 type Mover<'a> = (
@@ -184,6 +192,7 @@ fn record_sweep_starts(
                 from: p.0 + offset,
                 radius,
                 local_center,
+                rotation: Rotation::of(r),
             });
         }
     }
@@ -238,6 +247,7 @@ fn sweep_fast_bodies(
             from,
             radius,
             local_center,
+            rotation,
         } = s.starts[i];
         let Ok((mut p, r, mut v, e_body)) = bodies.get_mut(body) else {
             continue;
@@ -246,7 +256,19 @@ fn sweep_fast_bodies(
         let offset = Rotation::of(r) * local_center;
         let to = p.0 + offset;
         let e_body = e_body.map_or(contact_settings.default_restitution, |r| r.0);
-        let layers = layers_of(obstacles.get(body).ok().and_then(|o| o.5));
+        let own = obstacles.get(body).ok();
+        let layers = layers_of(own.and_then(|o| o.5));
+        // A single convex collider is refined from its sphere's impact to its own (a compound's
+        // sphere also holds its parts, which are not refined).
+        let mut refined = own
+            .filter(|o| o.3.is_none())
+            .and_then(|o| o.0)
+            .filter(|c| ShapeOnSweep::worth_refining(&c.shape))
+            .map(|c| ShapeOnSweep {
+                shape: &c.shape,
+                rotations: [rotation, Rotation::of(r)],
+                local_center,
+            });
         if !(to - from).is_finite() {
             // The integrator overflowed: leave the body where it is, for the refit to quarantine.
             continue;
@@ -262,9 +284,13 @@ fn sweep_fast_bodies(
                 break;
             };
             let sweep = sweep.with_initial_overlap(InitialOverlap::ApproachingOnly);
-            let Some((hit, root, leaf, e_obstacle)) =
-                first_impact(&sweep, (body, layers, jointed), &obstacles, &mut index, s)
-            else {
+            let Some((hit, root, leaf, e_obstacle)) = first_impact(
+                &sweep,
+                (body, layers, jointed, refined.as_ref()),
+                &obstacles,
+                &mut index,
+                s,
+            ) else {
                 at += motion;
                 motion = Vec3::ZERO;
                 break;
@@ -279,6 +305,10 @@ fn sweep_fast_bodies(
                 e
             };
             at = sweep.position_at(hit.t);
+            if let Some(shape) = refined.as_mut() {
+                // The next sweep turns on from where this one met the obstacle.
+                shape.rotations[0] = shape.rotation_at(hit.t);
+            }
             impacted = true;
             velocity = reflect(velocity, hit.normal, e);
             remaining *= 1.0 - hit.t;
@@ -313,10 +343,17 @@ const TOUCHING_TOLERANCE: f32 = 1e-4;
 
 /// The earliest impact of `sweep` (`body`, with `layers`) with the static scenery its swept
 /// volume meets, its layers interact with and no joint keeps it from colliding with: the hit,
-/// the obstacle's root, the collider hit, and that collider's restitution.
+/// the obstacle's root, the collider hit, and that collider's restitution. With `shape`, each
+/// sphere impact is refined to the shape's own ([`toi_shape_from`]), and one the shape misses
+/// is none.
 fn first_impact(
     sweep: &SphereSweep,
-    (body, layers, jointed): (Entity, CollisionLayers, Option<&JointedPairs>),
+    (body, layers, jointed, shape): (
+        Entity,
+        CollisionLayers,
+        Option<&JointedPairs>,
+        Option<&ShapeOnSweep>,
+    ),
     obstacles: &Query<Obstacle, Without<Quarantined>>,
     index: &mut BroadPhaseIndex,
     s: &mut CcdScratch,
@@ -346,9 +383,16 @@ fn first_impact(
             if sensor || !layers.interacts_with(&layers_of(node_layers)) {
                 continue;
             }
-            let Some(hit) = toi_sphere_shape(sweep, &c.shape, &global.0, &mut s.query) else {
+            let Some(mut hit) = toi_sphere_shape(sweep, &c.shape, &global.0, &mut s.query) else {
                 continue;
             };
+            if let Some(shape) = shape {
+                let obstacle = (&c.shape, &global.0);
+                match toi_shape_from(sweep, shape, hit.t, obstacle, &mut s.contacts) {
+                    Some(own) => hit = own,
+                    None => continue,
+                }
+            }
             // A contact already there at t = 0 counts when the motion goes into it by more than
             // rounding: left to the solver, which sees only the end of the substep, a body
             // touching a thin wall would pass it. Motion along the surface is no impact.

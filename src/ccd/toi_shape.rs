@@ -1,0 +1,320 @@
+//! The time of impact of a body's own convex shape, refined from its bounding sphere's.
+//!
+//! The sweep moves a sphere holding the body, whose time of impact is never later than the
+//! body's own but can be much earlier: a 2 m capsule flying broadside has a bounding sphere
+//! ten times its thickness, and stopped (and bounced) a metre short of the wall. From the
+//! sphere's time on, conservative advancement (Mirtich 1996, see [`super::advancement`]) on the
+//! true gap between the shape and the obstacle finds the shape's first contact. The body's
+//! centre moves by `d` over the sweep while it turns by the angle `θ` at a steady rate about
+//! it (the orientation slerped from start to end), so no point of it moves faster than
+//! `|d| + θ r` per unit of `t`, `r` the sphere's radius about the centre: the gap `g` at `t`
+//! cannot close before `t + g / (|d| + θ r)`.
+//!
+//! The gap comes from the speculative contact ([`speculative_contact_with_scratch`]): exact
+//! for GJK shapes (cylinders, cones, ellipsoids, hulls) and grown spheres and capsules, and on
+//! the early side for a box near its edges and corners, by up to 0.73 of the margin asked for.
+//! So the margin follows the gap: twice the last gap measured (at least twice the sweep's
+//! tolerance), which keeps that error a fraction of the gap left; a probe that finds nothing
+//! within its margin proves the gap larger, so the sweep advances by the margin and doubles it;
+//! and a touch is believed only from a probe of at most four tolerances' margin (a wider one
+//! that reads touching is repeated at a quarter of its margin).
+//! Every answer is early or exact, never late: the property that keeps a body from tunnelling.
+
+use super::{SphereSweep, Toi};
+use crate::geometry::contacts::{ContactScratch, speculative_contact_with_scratch};
+use crate::geometry::{ContactManifold, Isometry, Shape};
+use glam::{Quat, Vec3};
+
+/// Probes [`toi_shape_from`] allows before it settles for its last safe time.
+pub const MAX_SHAPE_ADVANCEMENT_ITERATIONS: u32 = 32;
+
+/// A body's shape riding on a [`SphereSweep`] that moves its centre (the point `local_center`
+/// of the shape's frame), turning from `rotations[0]` to `rotations[1]` over the sweep.
+#[derive(Clone, Copy, Debug)]
+pub struct ShapeOnSweep<'a> {
+    /// The body's collider.
+    pub shape: &'a Shape,
+    /// Its orientation at the sweep's start and end.
+    pub rotations: [Quat; 2],
+    /// The swept centre in the shape's frame (the centre of mass).
+    pub local_center: Vec3,
+}
+
+impl ShapeOnSweep<'_> {
+    /// Whether refining pays: not for a sphere (the sweep is exact for it), nor for shapes
+    /// without a finite convex gap (half-spaces, meshes).
+    pub fn worth_refining(shape: &Shape) -> bool {
+        !matches!(
+            shape,
+            Shape::Sphere(_) | Shape::HalfSpace(_) | Shape::TriMesh(_)
+        )
+    }
+
+    /// The orientation at `t` (a steady turn from start to end).
+    pub fn rotation_at(&self, t: f32) -> Quat {
+        self.rotations[0].slerp(self.rotations[1], t).normalize()
+    }
+
+    fn pose_at(&self, sweep: &SphereSweep, t: f32) -> Isometry {
+        let rotation = self.rotation_at(t);
+        Isometry::new(
+            sweep.position_at(t) - rotation * self.local_center,
+            rotation,
+        )
+    }
+
+    /// How fast any point of the body can move, per unit of the sweep's `t`.
+    fn speed_bound(&self, sweep: &SphereSweep) -> f32 {
+        let [a, b] = self.rotations;
+        let turn = a.angle_between(b);
+        sweep.displacement().length() + turn * sweep.radius()
+    }
+}
+
+/// The first time in `from..=1` at which `body` riding on `sweep` comes within the sweep's
+/// tolerance of `obstacle` at `obstacle_pose`, with the normal from the obstacle to the body and
+/// the deepest point; `None` if it does not. `from` is the bounding sphere's time of impact
+/// (the body cannot touch before it).
+pub fn toi_shape_from(
+    sweep: &SphereSweep,
+    body: &ShapeOnSweep<'_>,
+    from: f32,
+    (obstacle, obstacle_pose): (&Shape, &Isometry),
+    scratch: &mut ContactScratch,
+) -> Option<Toi> {
+    let speed = body.speed_bound(sweep);
+    let tolerance = sweep.tolerance();
+    let mut t = from.clamp(0.0, 1.0);
+    let mut margin = (speed * (1.0 - t)).max(2.0 * tolerance);
+    let mut last: Option<(f32, ContactManifold)> = None;
+    for _ in 0..MAX_SHAPE_ADVANCEMENT_ITERATIONS {
+        let pose = body.pose_at(sweep, t);
+        let probe = speculative_contact_with_scratch(
+            body.shape,
+            &pose,
+            obstacle,
+            obstacle_pose,
+            margin,
+            scratch,
+        );
+        let advance = match probe {
+            Some(m) => {
+                let gap = -deepest(&m).map_or(f32::NEG_INFINITY, |(_, d)| d);
+                if gap <= tolerance {
+                    if margin <= 4.0 * tolerance {
+                        return toi(t, &m);
+                    }
+                    // A box's corner grown by a wide margin reads closer than it is: look
+                    // again with a narrower one before calling it a contact.
+                    margin = (0.25 * margin).max(2.0 * tolerance);
+                    continue;
+                }
+                last = Some((t, m));
+                margin = (2.0 * gap).max(2.0 * tolerance);
+                gap
+            }
+            None => {
+                // Farther than the margin: safe to move by it.
+                let advance = margin;
+                margin = (2.0 * margin).min(speed.max(2.0 * tolerance));
+                advance
+            }
+        };
+        // No motion (or a NaN speed) cannot close a gap; nor can the sweep go past its end.
+        if speed.is_nan() || speed <= 0.0 || t >= 1.0 {
+            return None;
+        }
+        let next = (t + advance / speed).min(1.0);
+        if next == t {
+            break;
+        }
+        t = next;
+    }
+    // Out of probes (a grazing approach): stop at the last time known safe, if anything was
+    // close enough to give a normal there.
+    last.and_then(|(_, m)| toi(t, &m))
+}
+
+/// The deepest point of `m` and its depth (negative: still apart).
+fn deepest(m: &ContactManifold) -> Option<(Vec3, f32)> {
+    m.points()
+        .iter()
+        .map(|p| (p.point, p.depth))
+        .reduce(|a, b| if b.1 > a.1 { b } else { a })
+}
+
+fn toi(t: f32, m: &ContactManifold) -> Option<Toi> {
+    let (point, _) = deepest(m)?;
+    Some(Toi {
+        t,
+        normal: -m.normal,
+        point,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bvh::QueryScratch;
+    use crate::ccd::toi_sphere_shape;
+
+    /// A capsule of half-length 1 and radius 0.1 lying along y, its centre swept along +x from
+    /// `x0` by `dx`, against a 0.1 m thick wall whose face is at x = 9.95.
+    fn broadside(x0: f32, dx: f32) -> (Option<Toi>, Option<Toi>) {
+        let capsule = Shape::capsule(1.0, 0.1);
+        let wall = Shape::cuboid(Vec3::new(0.05, 5.0, 5.0));
+        let wall_pose = Isometry::new(Vec3::new(10.0, 0.0, 0.0), Quat::IDENTITY);
+        let sweep = SphereSweep::new(
+            Vec3::new(x0, 0.0, 0.0),
+            capsule.bounding_radius(),
+            Vec3::new(dx, 0.0, 0.0),
+        )
+        .unwrap();
+        let sphere = toi_sphere_shape(&sweep, &wall, &wall_pose, &mut QueryScratch::new());
+        let body = ShapeOnSweep {
+            shape: &capsule,
+            rotations: [Quat::from_rotation_x(std::f32::consts::FRAC_PI_2); 2],
+            local_center: Vec3::ZERO,
+        };
+        let refined = sphere.and_then(|s| {
+            toi_shape_from(
+                &sweep,
+                &body,
+                s.t,
+                (&wall, &wall_pose),
+                &mut ContactScratch::new(),
+            )
+        });
+        (sphere, refined)
+    }
+
+    #[test]
+    fn a_capsule_flying_broadside_stops_at_the_wall_within_the_tolerance_not_its_sphere_s_metre_short()
+     {
+        let (sphere, refined) = broadside(7.0, 4.0);
+        let (sphere, refined) = (sphere.unwrap(), refined.unwrap());
+        // The sphere (radius 1.1) meets the face at x = 8.85; the capsule (thickness 0.1) at
+        // 9.85.
+        assert!((7.0 + 4.0 * sphere.t - 8.85).abs() < 1e-3, "{sphere:?}");
+        let x = 7.0 + 4.0 * refined.t;
+        assert!(x <= 9.85 + 1e-4 && x > 9.85 - 2e-3, "stopped at {x}");
+        assert!((refined.normal - Vec3::new(-1.0, 0.0, 0.0)).length() < 1e-4);
+        assert!((refined.point.x - 9.95).abs() < 0.06, "{refined:?}");
+    }
+
+    #[test]
+    fn a_capsule_whose_sphere_clips_a_wall_edge_but_whose_body_passes_has_no_impact() {
+        // The wall ends at y = 5; the capsule lying along x (its sphere 1.1 wide) flies along
+        // +z past the wall's end, 0.5 m beyond it: its sphere crosses the wall's corner region,
+        // its body (0.1 thick across y) does not.
+        let capsule = Shape::capsule(1.0, 0.1);
+        let wall = Shape::cuboid(Vec3::new(5.0, 5.0, 0.05));
+        let wall_pose = Isometry::default();
+        let start = Vec3::new(0.0, 5.5, -3.0);
+        let sweep = SphereSweep::new(start, 1.1, Vec3::new(0.0, 0.0, 6.0)).unwrap();
+        let sphere = toi_sphere_shape(&sweep, &wall, &wall_pose, &mut QueryScratch::new());
+        assert!(sphere.is_some(), "the sphere does clip the edge");
+        let body = ShapeOnSweep {
+            shape: &capsule,
+            rotations: [Quat::from_rotation_y(std::f32::consts::FRAC_PI_2); 2],
+            local_center: Vec3::ZERO,
+        };
+        let refined = toi_shape_from(
+            &sweep,
+            &body,
+            sphere.unwrap().t,
+            (&wall, &wall_pose),
+            &mut ContactScratch::new(),
+        );
+        assert!(refined.is_none(), "{refined:?}");
+    }
+
+    /// A small seeded generator (a linear congruential one; the test needs spread, not quality).
+    struct Lcg(u64);
+
+    impl Lcg {
+        fn unit(&mut self) -> f32 {
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (self.0 >> 40) as f32 / (1u64 << 24) as f32
+        }
+
+        fn range(&mut self, lo: f32, hi: f32) -> f32 {
+            lo + (hi - lo) * self.unit()
+        }
+
+        fn rotation(&mut self) -> Quat {
+            let axis = Vec3::new(self.range(-1.0, 1.0), self.range(-1.0, 1.0), 0.5).normalize();
+            Quat::from_axis_angle(axis, self.range(0.0, std::f32::consts::TAU))
+        }
+    }
+
+    #[test]
+    fn every_shape_stops_within_1e_4_of_the_sweep_before_its_true_contact_never_1e_5_after() {
+        // Against the answer of bisection on the static contact test (measured: boxes early by
+        // up to 3.4e-5 of the sweep, the others 1.1e-5; late by under 1e-6, bisection's
+        // resolution).
+        let mut rng = Lcg(7);
+        let shapes = [
+            Shape::cuboid(Vec3::new(0.6, 0.2, 0.3)),
+            Shape::capsule(0.8, 0.15),
+            Shape::cylinder(0.5, 0.2),
+            Shape::cone(0.4, 0.3),
+            Shape::ellipsoid(Vec3::new(0.7, 0.3, 0.2)),
+        ];
+        let wall = Shape::cuboid(Vec3::new(0.05, 3.0, 3.0));
+        let wall_pose = Isometry::default();
+        let mut scratch = ContactScratch::new();
+        let mut hits = 0;
+        for k in 0..200 {
+            let shape = &shapes[k % shapes.len()];
+            // Turning by up to a radian over the sweep, about an off-origin centre.
+            let rotations = [rng.rotation(), rng.rotation()];
+            let rotations = [rotations[0], rotations[0].slerp(rotations[1], 0.15)];
+            let local_center = Vec3::new(0.1, -0.05, 0.2);
+            let start = Vec3::new(-3.0, rng.range(-2.0, 2.0), rng.range(-2.0, 2.0));
+            let d = Vec3::new(6.0, rng.range(-1.0, 1.0), rng.range(-1.0, 1.0));
+            let radius = shape.bounding_radius() + local_center.length();
+            let sweep = SphereSweep::new(start, radius, d).unwrap();
+            let body = ShapeOnSweep {
+                shape,
+                rotations,
+                local_center,
+            };
+            let touches = |t: f32| {
+                let pose = body.pose_at(&sweep, t);
+                crate::geometry::contacts::contact(shape, &pose, &wall, &wall_pose).is_some()
+            };
+            // The first of 400 samples that touches (steps of 1.5 cm, thinner than wall and
+            // body together), then bisection down to it.
+            let first = (0..=400).map(|i| i as f32 / 400.0).find(|&t| touches(t));
+            let truth = first.map(|hit| {
+                let (mut lo, mut hi) = ((hit - 1.0 / 400.0).max(0.0), hit);
+                for _ in 0..30 {
+                    let mid = 0.5 * (lo + hi);
+                    if touches(mid) { hi = mid } else { lo = mid }
+                }
+                hi
+            });
+            let Some(sphere) =
+                toi_sphere_shape(&sweep, &wall, &wall_pose, &mut QueryScratch::new())
+            else {
+                assert!(truth.is_none());
+                continue;
+            };
+            let got = toi_shape_from(&sweep, &body, sphere.t, (&wall, &wall_pose), &mut scratch);
+            match (got, truth) {
+                (Some(got), Some(truth)) => {
+                    hits += 1;
+                    assert!(got.t <= truth + 1e-5, "{k}: late {} > {truth}", got.t);
+                    assert!(got.t >= truth - 1e-4, "{k}: early {} < {truth}", got.t);
+                }
+                (None, Some(truth)) => panic!("{k}: missed the contact at {truth}"),
+                _ => {}
+            }
+        }
+        assert!(hits > 100, "{hits}");
+    }
+}
