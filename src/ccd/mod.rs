@@ -2,11 +2,12 @@
 //! straight displacement during one step, so that a fast body stops at a thin wall instead of
 //! tunnelling through it (the slides' "oggetti veloci o sottili", cured here without substeps).
 //!
-//! urto's bodies do not rotate, so a body's motion during a step is a translation `d`
-//! (velocity × dt). The moving body is a sphere (a body of another shape sweeps its bounding
-//! sphere, which is conservative); the obstacle is static (two moving spheres use their relative
-//! motion). Every query answers: the first fraction `t ∈ [0, 1]` of `d` at which the sphere
-//! touches the obstacle, or `None`.
+//! A body's centre moves along a straight displacement `d` (velocity × dt) during a step. The
+//! moving body is a sphere about that centre (a body of another shape sweeps its bounding
+//! sphere, which is conservative whatever it turns); the obstacle is static (two moving spheres
+//! use their relative motion). Every query answers: the first fraction `t ∈ [0, 1]` of `d` at
+//! which the sphere touches the obstacle, or `None`. [`toi_shape_from`] then brings a convex
+//! body on from its sphere's impact to its own, turning as it goes (conservative advancement).
 //!
 //! # How each TOI is found
 //!
@@ -95,7 +96,9 @@ pub use sweep_cull::SweepCull;
 pub use swept_aabb::swept_aabb;
 pub(crate) use swept_point::segment_in_box;
 pub use toi::{MeshToi, Toi, toi_sphere_shape};
-pub use toi_shape::{MAX_SHAPE_ADVANCEMENT_ITERATIONS, ShapeOnSweep, toi_shape_from};
+pub use toi_shape::{
+    MAX_REFINED_TURN, MAX_SHAPE_ADVANCEMENT_ITERATIONS, ShapeOnSweep, toi_shape_from,
+};
 pub use toi_sphere_capsule::toi_sphere_capsule;
 pub use toi_sphere_convex::toi_sphere_convex;
 pub use toi_sphere_cuboid::toi_sphere_cuboid;

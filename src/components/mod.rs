@@ -280,7 +280,10 @@ pub struct StepStartPose(pub Isometry);
 /// swept against static scenery and it stops at the first impact, then spends the rest of the
 /// step from there. Costs one sweep per step; bodies without it pay nothing.
 ///
-/// The sweep uses the body's bounding sphere (exact for balls, conservative for other shapes).
+/// The sweep uses the body's bounding sphere (exact for balls), and a body of one convex
+/// collider is then brought on to where its own shape meets the obstacle
+/// ([`toi_shape_from`](crate::ccd::toi_shape_from)); compounds and meshes stop where their
+/// sphere does (early, never tunnelling).
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Ccd;
 

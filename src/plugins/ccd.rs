@@ -24,7 +24,8 @@
 
 use crate::bvh::QueryScratch;
 use crate::ccd::{
-    InitialOverlap, ShapeOnSweep, SphereSweep, Toi, toi_shape_from, toi_sphere_shape,
+    InitialOverlap, MAX_REFINED_TURN, ShapeOnSweep, SphereSweep, Toi, toi_shape_from,
+    toi_sphere_shape,
 };
 use crate::components::*;
 use crate::dynamics::response::reflect;
@@ -120,6 +121,8 @@ struct SweepStart {
     local_center: Vec3,
     /// The body's orientation at the substep's start.
     rotation: Quat,
+    /// How far it may turn in the substep (rad, at its angular velocity then).
+    turn: f32,
 }
 
 #[derive(Resource, Default)]
@@ -133,7 +136,12 @@ struct CcdScratch {
 
 type Mover<'a> = (
     Entity,
-    (&'a Position, Option<&'a Rotation>, Option<&'a Inertia>),
+    (
+        &'a Position,
+        Option<&'a Rotation>,
+        Option<&'a Inertia>,
+        Option<&'a AngularVelocity>,
+    ),
     &'a Velocity,
     &'a BoundingVolume,
     Option<&'a Collider>,
@@ -175,7 +183,7 @@ fn record_sweep_starts(
 ) {
     scratch.starts.clear();
     let dt = timestep.substep_dt();
-    for (body, (p, r, inertia), v, bv, collider, compound, marked) in &bodies {
+    for (body, (p, r, inertia, w), v, bv, collider, compound, marked) in &bodies {
         let Some(radius) = sweep_radius(p.0, bv, collider, compound) else {
             continue;
         };
@@ -193,6 +201,7 @@ fn record_sweep_starts(
                 radius,
                 local_center,
                 rotation: Rotation::of(r),
+                turn: w.map_or(0.0, |w| w.0.length() * dt),
             });
         }
     }
@@ -213,6 +222,7 @@ type Swept<'a> = (
     Option<&'a Rotation>,
     &'a mut Velocity,
     Option<&'a Restitution>,
+    Option<&'a LockedAxes>,
 );
 
 /// Sweeps each recorded body from its start to where the integrator put it.
@@ -248,8 +258,9 @@ fn sweep_fast_bodies(
             radius,
             local_center,
             rotation,
+            turn,
         } = s.starts[i];
-        let Ok((mut p, r, mut v, e_body)) = bodies.get_mut(body) else {
+        let Ok((mut p, r, mut v, e_body, locked)) = bodies.get_mut(body) else {
             continue;
         };
         // Where the integrator put the centre of mass, the body turned as it ends the substep.
@@ -259,9 +270,10 @@ fn sweep_fast_bodies(
         let own = obstacles.get(body).ok();
         let layers = layers_of(own.and_then(|o| o.5));
         // A single convex collider is refined from its sphere's impact to its own (a compound's
-        // sphere also holds its parts, which are not refined).
+        // sphere also holds its parts, which are not refined; nor is a body spinning so fast
+        // that the slerp between its two orientations may not be the way it turned).
         let mut refined = own
-            .filter(|o| o.3.is_none())
+            .filter(|o| o.3.is_none() && turn <= MAX_REFINED_TURN)
             .and_then(|o| o.0)
             .filter(|c| ShapeOnSweep::worth_refining(&c.shape))
             .map(|c| ShapeOnSweep {
@@ -273,6 +285,7 @@ fn sweep_fast_bodies(
             // The integrator overflowed: leave the body where it is, for the refit to quarantine.
             continue;
         }
+        let free = locked.map_or(Vec3::ONE, |l| l.free_translation_axes());
         let (mut at, mut velocity, mut motion) = (from, v.0, to - from);
         let mut impacted = false;
         // The share of the step still to move: each impact uses up its sweep's `t` of what was
@@ -310,7 +323,8 @@ fn sweep_fast_bodies(
                 shape.rotations[0] = shape.rotation_at(hit.t);
             }
             impacted = true;
-            velocity = reflect(velocity, hit.normal, e);
+            // A bounce off a tilted surface must not push a body along a locked axis.
+            velocity = reflect(velocity, hit.normal, e) * free;
             remaining *= 1.0 - hit.t;
             motion = velocity * dt * remaining;
             impacts.contacts.push(ContactPair {
@@ -387,8 +401,13 @@ fn first_impact(
                 continue;
             };
             if let Some(shape) = shape {
+                // The shape's impact is never earlier than its sphere's: past the best so far,
+                // it cannot win.
+                if best.as_ref().is_some_and(|(b, ..)| b.t <= hit.t) {
+                    continue;
+                }
                 let obstacle = (&c.shape, &global.0);
-                match toi_shape_from(sweep, shape, hit.t, obstacle, &mut s.contacts) {
+                match toi_shape_from(sweep, shape, hit, obstacle, &mut s.contacts) {
                     Some(own) => hit = own,
                     None => continue,
                 }

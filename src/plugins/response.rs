@@ -202,19 +202,21 @@ impl ResponseBuffers {
         self.inverse_mass.push(0.0);
     }
 
-    /// Keeps this substep's impulses for the next one; contacts that ended are forgotten.
     /// Each contact's normal impulse and approach speed along its normal before the solve,
-    /// for the collision messages' contact data (what the rigid-body solver reports too).
+    /// for the collision messages' contact data (what the rigid-body solver reports too). A
+    /// continuous-collision impact, added before the solve with its speed and already
+    /// separating, keeps the larger.
     fn report_impulses(&self, pairs: &mut [ContactPair]) {
         for c in &self.constraints {
             if let Some(pair) = pairs.get_mut(c.tag as usize) {
                 let (va, vb) = (self.velocities_before[c.a], self.velocities_before[c.b]);
-                pair.normal_impulse = c.impulse();
-                pair.impact_speed = (va - vb).dot(c.normal).max(0.0);
+                pair.normal_impulse = pair.normal_impulse.max(c.impulse());
+                pair.impact_speed = pair.impact_speed.max((va - vb).dot(c.normal));
             }
         }
     }
 
+    /// Keeps this substep's impulses for the next one; contacts that ended are forgotten.
     fn remember_impulses(&mut self) {
         self.warm.clear();
         for c in &self.constraints {

@@ -148,7 +148,7 @@ impl ContactBatch {
         self.friction = each(|c| c.friction);
         debug_assert!(
             lanes.iter().flatten().all(|c| !c.translation_locked),
-            "contacts of a body with a locked translation axis are solved one at a time"
+            "contacts of a body locked along some translation axes are solved one at a time"
         );
         self.inverse_mass = [each(|c| c.inverse_mass[0].x), each(|c| c.inverse_mass[1].x)];
         self.softness = [

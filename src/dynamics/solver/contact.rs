@@ -12,7 +12,9 @@
 //! using `(ω × r)·n = ω·(r × n)`. The effective mass is `1/K` with
 //! `K = J M⁻¹ Jᵀ = 1/m_a + 1/m_b + (r_a × n)·I_a⁻¹(r_a × n) + (r_b × n)·I_b⁻¹(r_b × n)`,
 //! and an impulse `λ` changes the velocities by `M⁻¹ Jᵀ λ`: `v_a −= λn/m_a`,
-//! `ω_a −= I_a⁻¹ (r_a × λn)`, and the opposite for B.
+//! `ω_a −= I_a⁻¹ (r_a × λn)`, and the opposite for B. A body with locked translation axes has
+//! the diagonal `W = diag(1/m per axis)` (0 along a locked one) in place of `1/m`:
+//! `K = n·W_a n + n·W_b n + …` and `v_a −= W_a λn`.
 //!
 //! # Separation during substeps
 //! Contacts are found once per step. Within it each body has moved by `dp` and turned by `dq`
@@ -124,9 +126,9 @@ pub struct ContactConstraint {
     /// `1/m` of A and B per world axis (0 along a locked one), copied so the passes touch
     /// only the velocities.
     pub inverse_mass: [Vec3; 2],
-    /// Whether a body has a locked translation axis: its `1/m` differs between axes, which
-    /// the batches' one-number-per-body lanes cannot carry (such contacts are solved one at a
-    /// time, so a scene without locks pays nothing for them).
+    /// Whether a body is locked along some translation axes, not all: its `1/m` differs
+    /// between axes, which the batches' one-number-per-body lanes cannot carry (such contacts
+    /// are solved one at a time, so a scene without locks pays nothing for them).
     pub translation_locked: bool,
     /// Whether A and B may be moved (kinematic and static bodies keep their velocities).
     pub dynamic: [bool; 2],

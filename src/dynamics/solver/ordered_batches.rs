@@ -14,7 +14,7 @@
 //!
 //! Static and kinematic bodies are read only, so any number of contacts of a batch may touch
 //! the same floor. Contacts with rolling resistance (whose rows the batches do not carry) and
-//! those of a body with a locked translation axis (whose per-axis `1/m` the lanes do not carry)
+//! those of a body locked along some translation axes (whose per-axis `1/m` the lanes do not carry)
 //! are solved one at a time after the batches.
 
 use super::contact::ContactConstraint;
@@ -49,8 +49,7 @@ impl OrderedBatches {
             let moved = [(c.a, c.dynamic[0]), (c.b, c.dynamic[1])].map(|(slot, dynamic)| {
                 (dynamic && (slot as usize) < bodies).then_some(slot as usize)
             });
-            let one_number_masses = !c.translation_locked;
-            if c.rolling.arm != 0.0 || !one_number_masses || moved.iter().all(Option::is_none) {
+            if c.rolling.arm != 0.0 || c.translation_locked || moved.iter().all(Option::is_none) {
                 self.one_by_one.push(i as u32);
                 continue;
             }
