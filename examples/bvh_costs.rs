@@ -167,15 +167,11 @@ fn run_parry(a: &Mesh, b: &Mesh, poses: &[Isometry]) {
 /// The mesh in `path`, centred on its bounding box (the placements are about the origin).
 fn own_mesh(path: &str) -> Result<Mesh, urto::geometry::mesh_io::MeshLoadError> {
     let mesh = urto::geometry::mesh_io::load(path)?;
-    let (lo, hi) = mesh.vertices().iter().fold(
-        (glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN)),
-        |(lo, hi), v| (lo.min(*v), hi.max(*v)),
-    );
-    let centre = (lo + hi) * 0.5;
-    Ok(Mesh {
-        vertices: mesh.vertices().iter().map(|v| *v - centre).collect(),
+    let own = Mesh {
+        vertices: mesh.vertices().to_vec(),
         triangles: mesh.triangles().to_vec(),
-    })
+    };
+    Ok(own.centred())
 }
 
 fn env_or(name: &str, default: usize) -> usize {

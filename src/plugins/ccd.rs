@@ -285,7 +285,7 @@ fn sweep_fast_bodies(
             // The integrator overflowed: leave the body where it is, for the refit to quarantine.
             continue;
         }
-        let free = locked.map_or(Vec3::ONE, |l| l.free_translation_axes());
+        let free = locked.copied().unwrap_or_default().free_translation_axes();
         let (mut at, mut velocity, mut motion) = (from, v.0, to - from);
         let mut impacted = false;
         // The share of the step still to move: each impact uses up its sweep's `t` of what was

@@ -359,6 +359,8 @@ fn body_input(
     let (_, p, r, v, w, mass, inertia, locked, angular_drag, drag, ..) = m;
     let inverse_mass = mass.inverse();
     let dynamic = inverse_mass > 0.0;
+    // Without the component nothing is locked (`LockedAxes::default()`).
+    let locks = locked.copied().unwrap_or_default();
     BodyInput {
         center: p.0 + r.0 * inertia.local_center_of_mass,
         orientation: r.0,
@@ -375,8 +377,8 @@ fn body_input(
         torque: Vec3::ZERO,
         linear_damping: drag.map_or(0.0, |d| d.0 * inverse_mass),
         angular_damping: angular_drag.map_or(0.0, |d| d.0),
-        free_axes: locked.map_or(Vec3::ONE, |l| l.free_rotation_axes()),
-        free_translation: locked.map_or(Vec3::ONE, |l| l.free_translation_axes()),
+        free_axes: locks.free_rotation_axes(),
+        free_translation: locks.free_translation_axes(),
         gyroscopic,
     }
 }
