@@ -1,20 +1,42 @@
 //! Same scene, same result: bit-identical state after many steps, run after run and thread
 //! after thread (the physics schedules run single-threaded, and no result depends on a hash
-//! order).
+//! order), and whichever moving-body broad phase is plugged in (the pairs reach the solver in
+//! key order, not in the broad phase's own order).
 
 mod common;
 
+use bevy_app::{App, PluginGroup};
 use bevy_ecs::prelude::*;
 use common::rng::Rng;
 use glam::Vec3;
 use std::hash::{DefaultHasher, Hash, Hasher};
+use urto::broad_phase::{RegionSweep, SortAndSweep};
 use urto::geometry::TriMesh;
+use urto::plugins::{BroadPhaseFactory, BroadPhasePlugin};
 use urto::prelude::*;
 
 /// Spheres, boxes, a compound body, a mesh, springs, drag, a fast bullet (CCD) and a wall,
 /// stepped 300 times; the hash of every body's position and velocity bits.
 fn run_scene() -> u64 {
-    let mut app = common::app_with(1.0 / 60.0, 2);
+    run_scene_in(common::app_with(1.0 / 60.0, 2))
+}
+
+/// The scene of [`run_scene`] with another moving-body broad phase.
+fn run_scene_with(moving: BroadPhaseFactory) -> u64 {
+    let mut app = App::new();
+    let timestep = PhysicsTimestep::new(1.0 / 60.0, 2).expect("valid test timestep");
+    app.add_plugins(
+        UrtoPlugins::with_timestep(timestep)
+            .build()
+            .set(BroadPhasePlugin {
+                moving,
+                ..Default::default()
+            }),
+    );
+    run_scene_in(app)
+}
+
+fn run_scene_in(mut app: App) -> u64 {
     app.insert_resource(Gravity::EARTH_Z_UP);
     let world = app.world_mut();
     world.spawn((Collider::half_space(Vec3::Z), Static));
@@ -115,5 +137,20 @@ fn the_same_scene_gives_bit_identical_state_in_every_run_and_thread() {
     assert!(
         threads.iter().all(|h| *h == first),
         "runs on concurrent threads"
+    );
+}
+
+#[test]
+fn the_segmented_and_the_from_scratch_broad_phases_give_the_default_state_bit_for_bit() {
+    let default = run_scene();
+    assert_eq!(
+        run_scene_with(|| Box::new(RegionSweep::new())),
+        default,
+        "regions"
+    );
+    assert_eq!(
+        run_scene_with(|| Box::new(SortAndSweep::new())),
+        default,
+        "sort and sweep"
     );
 }

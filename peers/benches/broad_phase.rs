@@ -1,5 +1,6 @@
-//! Broad-phase peer benchmark (issue 12): urto's incremental sweep and prune, and its adaptive
-//! variant (which falls back to sorting from scratch while insertion sort loses), against
+//! Broad-phase peer benchmark (issue 12): urto's incremental sweep and prune, its adaptive
+//! variant (which falls back to sorting from scratch while insertion sort loses) and its
+//! segmented one (`RegionSweep`: a sweep per cell of a self-tuned grid), against
 //! parry3d's `Bvh` (the tree rapier3d's broad phase is built on) on the same scenes, in one
 //! process.
 //!
@@ -27,7 +28,7 @@ use rapier3d::parry::bounding_volume::Aabb as ParryAabb;
 use rapier3d::parry::partitioning::{Bvh, BvhBuildStrategy, BvhWorkspace};
 use std::time::{Duration, Instant};
 use urto::bounding::Aabb;
-use urto::broad_phase::{AdaptiveSweep, BodyKind, BroadPhase, IncrementalSap};
+use urto::broad_phase::{AdaptiveSweep, BodyKind, BroadPhase, IncrementalSap, RegionSweep};
 
 const WARM_UP: usize = 5;
 const STEPS: usize = 30;
@@ -257,33 +258,38 @@ fn ratio(urto: Duration, peer: Duration) -> String {
     }
 }
 
-/// Steps the three broad phases on `scene`, interleaved, and prints its table row.
+/// Steps the four broad phases on `scene`, interleaved, and prints its table row.
 fn run(mut scene: Scene) {
     let mut sap: IncrementalSap = urto_filled(&scene);
     let mut adaptive: AdaptiveSweep = urto_filled(&scene);
+    let mut regions: RegionSweep = urto_filled(&scene);
     let mut parry = ParryBroadPhase::new(&scene);
-    let mut times = [Vec::new(), Vec::new(), Vec::new()];
-    let (mut sap_pairs, mut adaptive_pairs) = (0, 0);
+    let mut times = [Vec::new(), Vec::new(), Vec::new(), Vec::new()];
+    let mut pairs = [0; 3];
     for step in 0..WARM_UP + STEPS {
         scene.advance();
         let start = Instant::now();
-        sap_pairs = urto_step(&mut sap, &scene);
+        pairs[0] = urto_step(&mut sap, &scene);
         let t0 = start.elapsed();
         let start = Instant::now();
-        adaptive_pairs = urto_step(&mut adaptive, &scene);
+        pairs[1] = urto_step(&mut adaptive, &scene);
         let t1 = start.elapsed();
         let start = Instant::now();
-        parry.step(&scene);
+        pairs[2] = urto_step(&mut regions, &scene);
         let t2 = start.elapsed();
+        let start = Instant::now();
+        parry.step(&scene);
+        let t3 = start.elapsed();
         if step >= WARM_UP {
-            for (list, t) in times.iter_mut().zip([t0, t1, t2]) {
+            for (list, t) in times.iter_mut().zip([t0, t1, t2, t3]) {
                 list.push(t);
             }
         }
     }
-    let [s, a, p] = times.map(median);
+    let [s, a, r, p] = times.map(median);
+    let [sap_pairs, adaptive_pairs, region_pairs] = pairs;
     println!(
-        "| {} | {:.3} ms | {:.3} ms ({}) | {:.3} ms | SAP {}, adaptive {} | {sap_pairs} / {adaptive_pairs} / {} |",
+        "| {} | {:.3} ms | {:.3} ms ({}) | {:.3} ms ({:.2} m cells, {:.0} per region) | {:.3} ms | SAP {}, adaptive {}, regions {} | {sap_pairs} / {adaptive_pairs} / {region_pairs} / {} |",
         scene.name,
         ms(s),
         ms(a),
@@ -292,9 +298,13 @@ fn run(mut scene: Scene) {
         } else {
             "incremental"
         },
+        ms(r),
+        regions.cell_size().unwrap_or(0.0),
+        regions.members_per_region(),
         ms(p),
         ratio(s, p),
         ratio(a, p),
+        ratio(r, p),
         parry.pairs.len()
     );
 }
@@ -302,9 +312,9 @@ fn run(mut scene: Scene) {
 fn main() {
     let quick = std::env::var("PEERS_BROAD_PHASE_QUICK").is_ok();
     println!(
-        "| scene | urto SAP | urto adaptive (mode at the end) | parry3d Bvh | urto vs parry | pairs (SAP / adaptive / parry) |"
+        "| scene | urto SAP | urto adaptive (mode at the end) | urto regions (layout at the end) | parry3d Bvh | urto vs parry | pairs (SAP / adaptive / regions / parry) |"
     );
-    println!("| --- | ---: | ---: | ---: | --- | ---: |");
+    println!("| --- | ---: | ---: | ---: | ---: | --- | ---: |");
     run(Scene::cloud(1_000, 1.0, 1));
     run(Scene::cloud(10_000, 1.0, 2));
     if !quick {

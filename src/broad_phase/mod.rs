@@ -8,8 +8,10 @@
 //! under frame-to-frame coherence, tell which pairs overlap at a cost proportional to how much
 //! the scene *changed*, not to its size. [`IncrementalSap`] is that algorithm (with Bullet's
 //! refinements, Coumans' `btAxisSweep3`); [`SortAndSweep`] re-sorts from scratch every step and
-//! [`BruteForce`] tests all pairs; all three implement [`BroadPhase`] so tests and benches can
-//! compare them on the same call sequence.
+//! [`BruteForce`] tests all pairs; [`AdaptiveSweep`] is the SAP that falls back to sorting from
+//! scratch while insertion sort loses, and [`RegionSweep`] the segmented SAP (a sweep per cell
+//! of a self-tuned grid, for large scenes where the whole-scene lists get dense). All implement
+//! [`BroadPhase`] so tests and benches can compare them on the same call sequence.
 //!
 //! # The contract
 //! - Bodies are named by caller-chosen [`ProxyId`]s (`0..=MAX_PROXY_ID`). Memory grows with the
@@ -32,11 +34,14 @@ mod brute_force;
 mod endpoints;
 pub mod grid;
 mod id_marks;
+mod large_bodies;
 mod pair_diff;
 mod pair_hash;
 mod pair_set;
 mod pair_tracking;
 mod positions;
+mod region;
+mod regions;
 mod sap;
 mod sort_sweep;
 
@@ -44,6 +49,7 @@ pub use adaptive::AdaptiveSweep;
 pub use brute_force::BruteForce;
 pub use grid::{GridError, GridQueryStats, StaticGrid, StaticGridConfig};
 pub use pair_tracking::{AxisBits, AxisTests, PairTracking};
+pub use regions::RegionSweep;
 pub use sap::IncrementalSap;
 pub use sort_sweep::SortAndSweep;
 

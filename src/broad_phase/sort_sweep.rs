@@ -53,7 +53,7 @@ impl SortAndSweep {
 }
 
 /// The axis along which the box centres have the largest variance.
-fn sweep_axis(aabbs: &[Aabb]) -> usize {
+pub(super) fn sweep_axis(aabbs: &[Aabb]) -> usize {
     let (mut sum, mut sum_sq) = ([0.0f64; 3], [0.0f64; 3]);
     for aabb in aabbs {
         let c = aabb.center();

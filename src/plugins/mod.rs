@@ -36,7 +36,7 @@ mod step_app;
 pub mod transform_sync;
 pub mod validation;
 
-pub use broad_phase::{BroadPhaseIndex, BroadPhasePairs, BroadPhasePlugin};
+pub use broad_phase::{BroadPhaseFactory, BroadPhaseIndex, BroadPhasePairs, BroadPhasePlugin};
 pub use ccd::{CcdImpacts, CcdPlugin, CcdSettings};
 pub use core::{PhysicsCorePlugin, StepError, step};
 pub use forces::{ForcesPlugin, GatheredForces};

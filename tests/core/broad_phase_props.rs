@@ -11,7 +11,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use urto::bounding::Aabb;
 use urto::broad_phase::{
     AdaptiveSweep, AxisBits, AxisTests, BodyKind, BroadPhase, BroadPhaseError, BruteForce,
-    IncrementalSap, MAX_PROXY_ID, Pair, ProxyId, SortAndSweep,
+    IncrementalSap, MAX_PROXY_ID, Pair, ProxyId, RegionSweep, SortAndSweep,
 };
 
 // ---------------------------------------------------------------- the subjects
@@ -26,6 +26,8 @@ struct Subjects {
     bits: [IncrementalSap<AxisBits>; 2],
     /// The SAP that falls back to sorting from scratch.
     adaptive: AdaptiveSweep,
+    /// Segmented sweep and prune.
+    regions: RegionSweep,
 }
 
 impl Subjects {
@@ -43,6 +45,7 @@ impl Subjects {
                 IncrementalSap::new().with_full_sort_fraction(0.0),
             ],
             adaptive: AdaptiveSweep::new(),
+            regions: RegionSweep::new(),
         }
     }
 
@@ -58,6 +61,7 @@ impl Subjects {
             ("sap-bits", b0),
             ("sap-bits-full-sort", b1),
             ("adaptive", &mut self.adaptive),
+            ("regions", &mut self.regions),
         ]
     }
 
@@ -312,17 +316,17 @@ proptest! {
 // ---------------------------------------------------------------- larger scenes
 
 /// A small deterministic generator (xorshift64*), so the scene test needs no extra crate.
-struct Rng(u64);
+pub(super) struct Rng(pub u64);
 
 impl Rng {
-    fn next_f32(&mut self) -> f32 {
+    pub fn next_f32(&mut self) -> f32 {
         self.0 ^= self.0 >> 12;
         self.0 ^= self.0 << 25;
         self.0 ^= self.0 >> 27;
         (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 40) as f32 / (1u64 << 24) as f32
     }
 
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
+    pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
         lo + (hi - lo) * self.next_f32()
     }
 }
@@ -529,13 +533,13 @@ unsafe impl std::alloc::GlobalAlloc for CountingAllocator {
 #[global_allocator]
 static ALLOCATOR: CountingAllocator = CountingAllocator;
 
-fn allocations() -> u64 {
+pub(super) fn allocations() -> u64 {
     ALLOCATIONS.with(|n| n.get())
 }
 
 /// 2,000 unit boxes on a 1.5 m lattice, each swinging on its own phase by up to 0.8 m, so
 /// every step starts and ends overlaps; the motion repeats every `PERIOD` steps.
-fn swinging_box(i: u32, step: u32) -> Aabb {
+pub(super) fn swinging_box(i: u32, step: u32) -> Aabb {
     const PERIOD: f32 = 60.0;
     let cell = Vec3::new((i % 20) as f32, ((i / 20) % 10) as f32, (i / 200) as f32) * 1.5;
     let phase = std::f32::consts::TAU * (step as f32 / PERIOD) + i as f32;

@@ -25,6 +25,7 @@ mod grid_props;
 mod mass_properties;
 mod mesh_contacts;
 mod mesh_io;
+mod region_sweep;
 mod tri_tri_properties;
 mod tri_tri_vs_parry;
 mod trimesh_brute_force;

@@ -1,0 +1,132 @@
+//! The bodies of [`super::RegionSweep`] too large for its cells (a ground slab, a level's
+//! outer wall): kept out of the regions, so that one box does not join thousands of them, and
+//! tested against the other bodies directly. They own every pair that involves one of them.
+//!
+//! Such bodies are few and rarely move. When none of them changed, a commit re-tests only the
+//! bodies that changed against them; when one changed, every pair of a large body is found
+//! again from scratch (`O(large × bodies)`).
+
+use super::{BodyKind, Pair, ProxyId};
+use crate::bounding::Aabb;
+use std::mem::size_of;
+
+/// What the large bodies need to know of every body.
+pub(super) trait LargeView {
+    /// The box, kind and whether the body is large, for a present id; `None` otherwise.
+    fn body(&self, id: ProxyId) -> Option<(Aabb, BodyKind, bool)>;
+    /// One past the largest id that was ever used.
+    fn id_bound(&self) -> ProxyId;
+    /// Whether the id changed in this commit.
+    fn changed(&self, id: ProxyId) -> bool;
+}
+
+/// The large bodies and the pairs they own.
+#[derive(Debug, Default)]
+pub(super) struct LargeBodies {
+    /// The large bodies as of the last commit, by id.
+    ids: Vec<ProxyId>,
+    /// Their pairs, sorted.
+    owned: Vec<Pair>,
+    /// This commit's pairs (scratch).
+    found: Vec<Pair>,
+}
+
+impl LargeBodies {
+    /// Whether any pair or body is held (else a commit without a large change skips them).
+    pub fn is_idle(&self) -> bool {
+        self.ids.is_empty() && self.owned.is_empty()
+    }
+
+    /// Hands every owned pair to `removed` and forgets everything (the regions are laid out
+    /// again).
+    pub fn clear(&mut self, removed: &mut Vec<Pair>) {
+        removed.append(&mut self.owned);
+        self.ids.clear();
+    }
+
+    /// Finds this commit's pairs of the large bodies and appends the difference with the last
+    /// ones; `full` when a large body changed (or a body became or stopped being large).
+    /// Returns the box tests made.
+    pub fn refresh(
+        &mut self,
+        view: &impl LargeView,
+        changed: &[ProxyId],
+        full: bool,
+        (added, removed): (&mut Vec<Pair>, &mut Vec<Pair>),
+    ) -> u64 {
+        let tests = if full {
+            self.find_all(view)
+        } else {
+            self.find_changed(view, changed)
+        };
+        self.found.sort_unstable();
+        super::pair_diff::diff_sorted(&self.owned, &self.found, added, removed);
+        std::mem::swap(&mut self.owned, &mut self.found);
+        tests
+    }
+
+    /// Every pair of a large body, from scratch.
+    fn find_all(&mut self, view: &impl LargeView) -> u64 {
+        self.ids.clear();
+        self.ids.extend(
+            (0..view.id_bound()).filter(|&id| view.body(id).is_some_and(|(_, _, large)| large)),
+        );
+        self.found.clear();
+        let mut tests = 0;
+        for &l in &self.ids {
+            let Some((big, big_kind, _)) = view.body(l) else {
+                continue;
+            };
+            for other in 0..view.id_bound() {
+                let Some((aabb, kind, large)) = view.body(other) else {
+                    continue;
+                };
+                // A pair of two large bodies is found once, from its smaller id.
+                if other == l || (large && other < l) {
+                    continue;
+                }
+                tests += 1;
+                if !both_static(big_kind, kind) && big.intersects(&aabb) {
+                    self.found.push(Pair::ordered(l, other));
+                }
+            }
+        }
+        tests
+    }
+
+    /// The last pairs of unchanged bodies, and the changed bodies against the large ones.
+    fn find_changed(&mut self, view: &impl LargeView, changed: &[ProxyId]) -> u64 {
+        self.found.clear();
+        self.found.extend(
+            self.owned
+                .iter()
+                .filter(|p| !view.changed(p.a) && !view.changed(p.b)),
+        );
+        let mut tests = 0;
+        for &id in changed {
+            let Some((aabb, kind, false)) = view.body(id) else {
+                continue;
+            };
+            for &l in &self.ids {
+                let Some((big, big_kind, _)) = view.body(l) else {
+                    continue;
+                };
+                tests += 1;
+                if !both_static(big_kind, kind) && big.intersects(&aabb) {
+                    self.found.push(Pair::ordered(l, id));
+                }
+            }
+        }
+        tests
+    }
+
+    /// Heap bytes held.
+    pub fn memory_bytes(&self) -> usize {
+        self.ids.capacity() * size_of::<ProxyId>()
+            + (self.owned.capacity() + self.found.capacity()) * size_of::<Pair>()
+    }
+}
+
+fn both_static(a: BodyKind, b: BodyKind) -> bool {
+    a == BodyKind::Static && b == BodyKind::Static
+}

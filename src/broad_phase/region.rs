@@ -1,0 +1,433 @@
+//! One region of [`super::RegionSweep`]: the bodies whose boxes touch one cell of a uniform
+//! grid, kept sorted along the sweep axis from step to step, and the pairs this region owns.
+//!
+//! The sort is incremental (insertion sort from last step's order: under coherence a body
+//! passes few others, and a region holds tens of bodies, not the whole scene), with a budget:
+//! past `REGION_SWAP_BUDGET · n` swaps the region finishes with a sort from scratch, the rule
+//! of [`super::AdaptiveSweep`] brought down to one region. The sweep is Ericson's forward
+//! sweep (*Real-Time Collision Detection*, §7.5.2) over struct-of-arrays scratch.
+//!
+//! **Who reports a pair.** A box belongs to every cell it touches, so two boxes may share
+//! several regions. Each pair is reported by exactly one: the region whose cell holds the
+//! *min corner of the two boxes' intersection* (Terdiman's and PhysX's multi-box pruning rule).
+//! That corner lies inside both boxes, so its cell is in both boxes' cell ranges; the cell
+//! function is monotone, so that cell is the larger of the two boxes' min cells on each axis,
+//! and the test needs no shared state between regions.
+
+use super::{Pair, ProxyId};
+use crate::bounding::Aabb;
+
+/// Insertion sort gives up and sorts from scratch past this many swaps per member.
+const REGION_SWAP_BUDGET: u64 = 8;
+
+/// The integer cell of a coordinate (monotone in `v`; saturates at the `i32` range).
+///
+/// `f32::floor` is a libm call on the baseline x86-64 target (no SSE4.1 `roundss`), a tenth of
+/// a step in a profile; truncation and a correction give the same cell.
+#[inline]
+pub(super) fn cell_of(v: f32, inverse_size: f32) -> i32 {
+    let x = v * inverse_size;
+    let truncated = x as i32;
+    if (truncated as f32) > x {
+        truncated.saturating_sub(1)
+    } else {
+        truncated
+    }
+}
+
+/// The cells a box touches, inclusive on both ends, per world axis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct CellRange {
+    pub lo: [i32; 3],
+    pub hi: [i32; 3],
+}
+
+impl CellRange {
+    /// The cells `aabb` touches for cells of side `1 / inverse_size`.
+    pub fn of(aabb: &Aabb, inverse_size: f32) -> Self {
+        let cell = |v| cell_of(v, inverse_size);
+        Self {
+            lo: [cell(aabb.min.x), cell(aabb.min.y), cell(aabb.min.z)],
+            hi: [cell(aabb.max.x), cell(aabb.max.y), cell(aabb.max.z)],
+        }
+    }
+
+    /// How many cells the range covers (saturating: a huge box counts as huge, not as 0).
+    pub fn count(&self) -> u64 {
+        (0..3).fold(1u64, |n, axis| {
+            let span = (i64::from(self.hi[axis]) - i64::from(self.lo[axis]) + 1) as u64;
+            n.saturating_mul(span)
+        })
+    }
+
+    /// Whether the range holds the cell.
+    #[inline]
+    pub fn contains(&self, cell: [i32; 3]) -> bool {
+        (0..3).all(|axis| self.lo[axis] <= cell[axis] && cell[axis] <= self.hi[axis])
+    }
+
+    /// Every cell of the range (callers bound the count first).
+    pub fn cells(self) -> impl Iterator<Item = [i32; 3]> {
+        let [x0, y0, z0] = self.lo;
+        let [x1, y1, z1] = self.hi;
+        (x0..=x1).flat_map(move |x| (y0..=y1).flat_map(move |y| (z0..=z1).map(move |z| [x, y, z])))
+    }
+}
+
+/// The bodies of one cell and the pairs it reported at the last commit.
+#[derive(Debug, Default)]
+pub(super) struct Region {
+    /// The cell.
+    pub cell: [i32; 3],
+    /// The members' sweep entries, sorted along the sweep axis as of the last sweep. An
+    /// unchanged body's entry is kept as it is: only changed bodies are read again.
+    pub entries: Vec<Entry>,
+    /// Bodies that changed this commit and touched this cell before or after (arrivals,
+    /// departures and movers), in any order, perhaps repeated.
+    pub changed: Vec<ProxyId>,
+    /// The pairs this region owns, sorted.
+    pub owned: Vec<Pair>,
+    /// Queued for this commit's sweep.
+    pub dirty: bool,
+}
+
+/// What a region needs to know of a body during its sweep.
+pub(super) trait BodyView {
+    /// The body's sweep entry (axes in `axes` order), if it belongs to `cell` now.
+    fn entry(&self, id: ProxyId, cell: [i32; 3], axes: [usize; 3]) -> Option<Entry>;
+    /// One past the largest id.
+    fn id_bound(&self) -> usize;
+}
+
+/// `Entry::owner`'s bit for a static body.
+const STATIC: u32 = 1;
+/// `Entry::owner`'s bit for a body that changed this commit (ids use bits 1 to 30).
+const FRESH: u32 = 1 << 31;
+
+/// One member as the sweep reads it: 40 bytes, so a region's entries stay in a few cache
+/// lines and insertion sort moves them whole.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Entry {
+    /// Min on the sweep axis (the sort key).
+    pub lo: f32,
+    /// Max on the sweep axis.
+    pub hi: f32,
+    /// `[min_u, max_u, min_v, max_v]` on the other two axes.
+    pub cross: [f32; 4],
+    /// `id << 1 | STATIC`, plus `FRESH` while the body changed this commit.
+    pub owner: u32,
+    /// The cell of the box's min corner, sweep axis first.
+    pub low_cell: [i32; 3],
+}
+
+impl Entry {
+    /// The (fresh) entry of a box for the axis order `[axis, u, v]`.
+    #[inline]
+    pub fn new(
+        aabb: &Aabb,
+        id: ProxyId,
+        is_static: bool,
+        range: &CellRange,
+        axes: [usize; 3],
+    ) -> Self {
+        let [axis, u, v] = axes;
+        // Arrays, not `Vec3` indexing (a three-way branch per read).
+        let (min, max) = (aabb.min.to_array(), aabb.max.to_array());
+        Self {
+            lo: min[axis],
+            hi: max[axis],
+            cross: [min[u], max[u], min[v], max[v]],
+            owner: id << 1 | u32::from(is_static) | FRESH,
+            low_cell: [range.lo[axis], range.lo[u], range.lo[v]],
+        }
+    }
+
+    #[inline]
+    fn id(&self) -> ProxyId {
+        (self.owner & !FRESH) >> 1
+    }
+
+    #[inline]
+    fn is_fresh(&self) -> bool {
+        self.owner & FRESH != 0
+    }
+}
+
+/// Reusable buffers of the sweeps.
+#[derive(Debug, Default)]
+pub(super) struct SweepScratch {
+    /// Which of a region's changed ids were found among its entries (few changed).
+    matched: Vec<bool>,
+    /// Per id, the number of the last region sweep that met it (many changed).
+    met: Vec<u32>,
+    /// This region sweep's number.
+    sweep_number: u32,
+    /// The region's new owned pairs.
+    pub found: Vec<Pair>,
+}
+
+impl SweepScratch {
+    /// A number no id has met yet, with `met` covering ids below `id_bound`.
+    fn next_sweep_number(&mut self, id_bound: usize) -> u32 {
+        if self.met.len() < id_bound {
+            self.met.resize(id_bound, 0);
+        }
+        self.sweep_number = self.sweep_number.wrapping_add(1);
+        if self.sweep_number == 0 {
+            // Wrapped: forget every old number rather than mistake one for this sweep's.
+            self.met.fill(0);
+            self.sweep_number = 1;
+        }
+        self.sweep_number
+    }
+
+    /// Heap bytes held.
+    pub fn memory_bytes(&self) -> usize {
+        self.matched.capacity()
+            + self.met.capacity() * std::mem::size_of::<u32>()
+            + self.found.capacity() * std::mem::size_of::<Pair>()
+    }
+}
+
+/// Counters of one region's sweep.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct SweepCounts {
+    pub swaps: u64,
+    pub tests: u64,
+}
+
+/// The sweep's axis order and cell size.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct SweepFrame {
+    /// Sweep axis, then the two others.
+    pub axes: [usize; 3],
+    pub inverse_size: f32,
+}
+
+impl Region {
+    /// Brings the entries up to date with the changed bodies, re-sorts them and finds the pairs
+    /// this region owns, left in `scratch.found`, sorted. Returns the change in the number of
+    /// members and the work done.
+    ///
+    /// When few members changed, only they are swept (against their neighbours in sweep
+    /// order), and the last pairs between unchanged members are kept: a region with one mover
+    /// among thirty costs one body's sweep, not thirty.
+    pub fn sweep(
+        &mut self,
+        bodies: &impl BodyView,
+        frame: SweepFrame,
+        scratch: &mut SweepScratch,
+    ) -> (isize, SweepCounts) {
+        let before = self.entries.len() as isize;
+        let few = self.changed.len() * 4 < self.entries.len();
+        if few {
+            self.changed.sort_unstable();
+            self.changed.dedup();
+            self.refresh_few(bodies, frame.axes, &mut scratch.matched);
+        } else {
+            self.refresh_all(bodies, frame.axes, scratch);
+        }
+        let swaps = sort_entries(&mut self.entries);
+        let [axis, u, v] = frame.axes;
+        let cell = [self.cell[axis], self.cell[u], self.cell[v]];
+        let tests = if few {
+            sweep_changed(self, cell, &mut scratch.found)
+        } else {
+            sweep_owned(&self.entries, cell, &mut scratch.found)
+        };
+        scratch.found.sort_unstable();
+        self.changed.clear();
+        (
+            self.entries.len() as isize - before,
+            SweepCounts { swaps, tests },
+        )
+    }
+
+    /// Many changed: re-reads every member (dropping those that left) and appends the
+    /// arrivals, telling them apart by the sweep number each id last met, without sorting the
+    /// changed ids.
+    fn refresh_all(
+        &mut self,
+        bodies: &impl BodyView,
+        axes: [usize; 3],
+        scratch: &mut SweepScratch,
+    ) {
+        let number = scratch.next_sweep_number(bodies.id_bound());
+        let (cell, met) = (self.cell, &mut scratch.met);
+        self.entries.retain_mut(|e| {
+            let id = e.id();
+            met[id as usize] = number;
+            bodies
+                .entry(id, cell, axes)
+                .map(|fresh| *e = fresh)
+                .is_some()
+        });
+        for &id in &self.changed {
+            if std::mem::replace(&mut met[id as usize], number) != number {
+                self.entries.extend(bodies.entry(id, cell, axes));
+            }
+        }
+    }
+
+    /// Few changed (sorted, without repeats): re-reads them (dropping those that left),
+    /// appends the arrivals, and clears the fresh mark of the others.
+    fn refresh_few(&mut self, bodies: &impl BodyView, axes: [usize; 3], matched: &mut Vec<bool>) {
+        let (cell, changed) = (self.cell, &self.changed);
+        matched.clear();
+        matched.resize(changed.len(), false);
+        self.entries
+            .retain_mut(|e| match changed.binary_search(&e.id()) {
+                Ok(at) => {
+                    matched[at] = true;
+                    bodies
+                        .entry(e.id(), cell, axes)
+                        .map(|fresh| *e = fresh)
+                        .is_some()
+                }
+                Err(_) => {
+                    e.owner &= !FRESH;
+                    true
+                }
+            });
+        for (&id, _) in changed.iter().zip(matched.iter()).filter(|(_, m)| !**m) {
+            self.entries.extend(bodies.entry(id, cell, axes));
+        }
+    }
+}
+
+/// Insertion sort by `lo` with a swap budget, then a sort from scratch if it ran out; returns
+/// the swaps made.
+fn sort_entries(entries: &mut [Entry]) -> u64 {
+    let budget = REGION_SWAP_BUDGET * entries.len() as u64;
+    let mut swaps = 0u64;
+    for i in 1..entries.len() {
+        let mut j = i;
+        while j > 0 && entries[j].lo < entries[j - 1].lo {
+            entries.swap(j, j - 1);
+            j -= 1;
+        }
+        swaps += (i - j) as u64;
+        if swaps > budget {
+            entries.sort_unstable_by(|a, b| a.lo.total_cmp(&b.lo).then(a.owner.cmp(&b.owner)));
+            break;
+        }
+    }
+    swaps
+}
+
+/// The pair of two entries overlapping on the cross axes, if this region owns it (see the
+/// module doc) and not both are static; the sweep has checked the sweep axis.
+///
+/// The intersection's min corner is the larger of the two mins on each axis, and the cell
+/// function is monotone, so its cell is the larger of the two boxes' min cells: integer
+/// compares on cells found once per body, no float work per pair.
+#[inline]
+fn owned_pair(a: &Entry, b: &Entry, cell: [i32; 3]) -> Option<Pair> {
+    let (c, d) = (a.cross, b.cross);
+    // `&`, not `&&`: four compares without branches beat unpredictable early exits.
+    let overlap = (c[0] <= d[1]) & (d[0] <= c[1]) & (c[2] <= d[3]) & (d[2] <= c[3]);
+    if !overlap || a.owner & b.owner & STATIC != 0 {
+        return None;
+    }
+    let (ca, cb) = (a.low_cell, b.low_cell);
+    let owned = (ca[0].max(cb[0]) == cell[0])
+        & (ca[1].max(cb[1]) == cell[1])
+        & (ca[2].max(cb[2]) == cell[2]);
+    owned.then(|| Pair::ordered(a.id(), b.id()))
+}
+
+/// The forward sweep over all members; `cell` is the region's cell in sweep-axis order.
+/// Returns the cross-axis tests made.
+fn sweep_owned(entries: &[Entry], cell: [i32; 3], found: &mut Vec<Pair>) -> u64 {
+    found.clear();
+    let mut tests = 0;
+    for (i, a) in entries.iter().enumerate() {
+        let rest = &entries[i + 1..];
+        let reached = rest.iter().position(|b| b.lo > a.hi).unwrap_or(rest.len());
+        for b in &rest[..reached] {
+            if let Some(pair) = owned_pair(a, b, cell) {
+                found.push(pair);
+            }
+        }
+        tests += reached as u64;
+    }
+    tests
+}
+
+/// The last pairs of unchanged members, and each changed member swept against its neighbours:
+/// forward over the members starting before it ends, backward over those that may still
+/// reach it (no further back than the longest member), skipping changed ones backward (their
+/// own forward sweep finds the pair).
+fn sweep_changed(region: &Region, cell: [i32; 3], found: &mut Vec<Pair>) -> u64 {
+    let (entries, changed) = (&region.entries, &region.changed);
+    let unchanged = |id: &ProxyId| changed.binary_search(id).is_err();
+    found.clear();
+    found.extend(
+        region
+            .owned
+            .iter()
+            .filter(|p| unchanged(&p.a) && unchanged(&p.b)),
+    );
+    let longest = entries.iter().fold(0.0f32, |m, e| m.max(e.hi - e.lo));
+    let mut tests = 0;
+    for (i, a) in entries.iter().enumerate().filter(|(_, e)| e.is_fresh()) {
+        for b in entries[i + 1..].iter().take_while(|b| b.lo <= a.hi) {
+            tests += 1;
+            found.extend(owned_pair(a, b, cell));
+        }
+        let reach = a.lo - longest;
+        for b in entries[..i].iter().rev().take_while(|b| b.lo >= reach) {
+            if !b.is_fresh() && b.hi >= a.lo {
+                tests += 1;
+                found.extend(owned_pair(a, b, cell));
+            }
+        }
+    }
+    tests
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_range_holds_the_cells_of_its_corners_and_counts_them() {
+        let aabb = Aabb {
+            min: glam::Vec3::new(-0.5, 0.0, 3.9),
+            max: glam::Vec3::new(1.5, 0.9, 4.1),
+        };
+        let range = CellRange::of(&aabb, 1.0);
+        assert_eq!(range.lo, [-1, 0, 3]);
+        assert_eq!(range.hi, [1, 0, 4]);
+        assert_eq!(range.count(), 6);
+        assert_eq!(range.cells().count(), 6);
+        assert!(range.cells().all(|c| range.contains(c)));
+        let huge = Aabb {
+            min: glam::Vec3::splat(-f32::MAX),
+            max: glam::Vec3::splat(f32::MAX),
+        };
+        assert!(CellRange::of(&huge, 1.0).count() > 1 << 40);
+    }
+
+    #[test]
+    fn sort_entries_counts_swaps_and_falls_back_when_over_budget() {
+        let entry = |lo: f32, owner: u32| Entry {
+            lo,
+            hi: lo,
+            cross: [0.0; 4],
+            owner: owner << 1,
+            low_cell: [0; 3],
+        };
+        let mut nearly: Vec<Entry> = [0.0, 2.0, 1.0, 3.0]
+            .iter()
+            .zip(0..)
+            .map(|(&lo, i)| entry(lo, i))
+            .collect();
+        assert_eq!(sort_entries(&mut nearly), 1);
+        assert!(nearly.windows(2).all(|w| w[0].lo <= w[1].lo));
+        let mut reversed: Vec<Entry> = (0..100).map(|i| entry(-(i as f32), i)).collect();
+        let swaps = sort_entries(&mut reversed);
+        assert!(swaps <= REGION_SWAP_BUDGET * 100 + 100, "{swaps}");
+        assert!(reversed.windows(2).all(|w| w[0].lo <= w[1].lo));
+    }
+}
