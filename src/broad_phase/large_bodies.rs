@@ -37,6 +37,11 @@ impl LargeBodies {
         self.ids.is_empty() && self.owned.is_empty()
     }
 
+    /// The large bodies as of the last full refresh.
+    pub fn count(&self) -> usize {
+        self.ids.len()
+    }
+
     /// Hands every owned pair to `removed` and forgets everything (the regions are laid out
     /// again).
     pub fn clear(&mut self, removed: &mut Vec<Pair>) {

@@ -18,7 +18,8 @@
 //! - **Adaptive layout, no user tuning.** The cell side starts at four times the median box's
 //!   largest extent, the sweep axis is the one where the centres spread most; after a layout,
 //!   the measured members per region tune the side (doubled below
-//!   [`RegionSweep::SPARSE_REGION`], halved above [`RegionSweep::DENSE_REGION`]), and every
+//!   [`RegionSweep::SPARSE_REGION`] or while more than `16 + n / 128` bodies are large,
+//!   halved above [`RegionSweep::DENSE_REGION`]), and every
 //!   [`RegionSweep::CHECK_PERIOD`] commits the occupancy is checked again.
 //! - **Net changes.** Each region diffs its new pairs against its last ones; removals are
 //!   applied before additions, so a pair whose owning cell changed cancels out in the pair
@@ -184,6 +185,11 @@ impl RegionSweep {
         self.memberships as f64 / self.region_count().max(1) as f64
     }
 
+    /// Bodies kept out of the regions for their size (as of the last time one changed).
+    pub fn large_bodies(&self) -> usize {
+        self.large.count()
+    }
+
     /// Times the regions were laid out (the first layout and each re-tuning).
     pub fn layouts(&self) -> u64 {
         self.layouts
@@ -305,7 +311,9 @@ impl RegionSweep {
         let size = 1.0 / layout.frame.inverse_size;
         // Once tuned, only a clear drift (a factor two past the band) starts tuning again.
         let slack = if self.tunings_left > 0 { 1.0 } else { 2.0 };
-        let next = if mean < Self::SPARSE_REGION / slack && regions > 1 {
+        // Too many bodies over `LARGE_CELLS` cells would make the large-body tests quadratic.
+        let too_many_large = self.large.count() > 16 + self.len / 128;
+        let next = if too_many_large || (mean < Self::SPARSE_REGION / slack && regions > 1) {
             Some(size * 2.0)
         } else if mean > Self::DENSE_REGION * slack && size / 2.0 >= layout.floor {
             Some(size / 2.0)

@@ -326,3 +326,50 @@ fn region_sweep_makes_0_allocations_per_step_once_its_buffers_have_grown() {
     );
     assert_eq!(made, 0, "{made} allocations in 120 steady steps");
 }
+
+/// 3,000 small boxes packed in a 16 m cube (seven a region at four median sizes a cell: not
+/// sparse) and 40 boxes twenty times their size, each over 200 of those cells: past `16 + n /
+/// 128` large bodies the cells grow (here to twice their side, where the big ones span at most
+/// 64), and the pairs stay exact.
+#[test]
+fn forty_big_boxes_among_small_ones_grow_the_cells_until_few_are_large_and_stay_exact() {
+    let mut rng = Rng(0xb16_5a11);
+    let bodies: Vec<(ProxyId, Aabb, BodyKind)> = (0..3040)
+        .map(|i| {
+            let c = Vec3::new(
+                rng.range(0.0, 16.0),
+                rng.range(0.0, 16.0),
+                rng.range(0.0, 16.0),
+            );
+            let half = if i < 3000 { 0.25 } else { rng.range(5.0, 6.0) };
+            (
+                i,
+                Aabb::from_center_half_extents(c, Vec3::splat(half)),
+                BodyKind::Dynamic,
+            )
+        })
+        .collect();
+    let (mut subject, mut reference) = (RegionSweep::new(), SortAndSweep::new());
+    for bp in both(&mut subject, &mut reference) {
+        bp.insert_bulk(&bodies).unwrap();
+    }
+    commit_and_compare(&mut subject, &mut reference, 0);
+    let first = subject.cell_size().unwrap();
+    for step in 1..=12usize {
+        for i in (0..3040u32).step_by(3) {
+            let b = reference.aabb(i).unwrap();
+            let d = Vec3::splat(0.1 * (step % 3) as f32 - 0.1);
+            for bp in both(&mut subject, &mut reference) {
+                bp.update(i, Aabb::new(b.min + d, b.max + d)).unwrap();
+            }
+        }
+        commit_and_compare(&mut subject, &mut reference, step);
+    }
+    let last = subject.cell_size().unwrap();
+    assert!(last >= 2.0 * first, "cells {first} -> {last}");
+    assert!(
+        subject.large_bodies() <= 16 + 4000 / 128,
+        "{}",
+        subject.large_bodies()
+    );
+}
