@@ -14,6 +14,7 @@
 //! function is monotone, so that cell is the larger of the two boxes' min cells on each axis,
 //! and the test needs no shared state between regions.
 
+use super::pair_diff::diff_sorted;
 use super::{Pair, ProxyId};
 use crate::bounding::Aabb;
 
@@ -162,8 +163,12 @@ pub(super) struct SweepScratch {
     met: Vec<u32>,
     /// This region sweep's number.
     sweep_number: u32,
-    /// The region's new owned pairs.
-    pub found: Vec<Pair>,
+    /// The pairs a sweep found.
+    found: Vec<Pair>,
+    /// Owned pairs of changed members (few changed).
+    dropped: Vec<Pair>,
+    /// The kept and the found pairs merged (few changed).
+    merged: Vec<Pair>,
 }
 
 impl SweepScratch {
@@ -185,7 +190,8 @@ impl SweepScratch {
     pub fn memory_bytes(&self) -> usize {
         self.matched.capacity()
             + self.met.capacity() * std::mem::size_of::<u32>()
-            + self.found.capacity() * std::mem::size_of::<Pair>()
+            + (self.found.capacity() + self.dropped.capacity() + self.merged.capacity())
+                * std::mem::size_of::<Pair>()
     }
 }
 
@@ -206,8 +212,8 @@ pub(super) struct SweepFrame {
 
 impl Region {
     /// Brings the entries up to date with the changed bodies, re-sorts them and finds the pairs
-    /// this region owns, left in `scratch.found`, sorted. Returns the change in the number of
-    /// members and the work done.
+    /// this region owns now, appending the difference with the last ones to `added` and
+    /// `removed`. Returns the change in the number of members and the work done.
     ///
     /// When few members changed, only they are swept (against their neighbours in sweep
     /// order), and the last pairs between unchanged members are kept: a region with one mover
@@ -217,6 +223,7 @@ impl Region {
         bodies: &impl BodyView,
         frame: SweepFrame,
         scratch: &mut SweepScratch,
+        changes: (&mut Vec<Pair>, &mut Vec<Pair>),
     ) -> (isize, SweepCounts) {
         let before = self.entries.len() as isize;
         let few = self.changed.len() * 4 < self.entries.len();
@@ -231,16 +238,60 @@ impl Region {
         let [axis, u, v] = frame.axes;
         let cell = [self.cell[axis], self.cell[u], self.cell[v]];
         let tests = if few {
-            sweep_changed(self, cell, &mut scratch.found)
+            self.sweep_few(cell, scratch, changes)
         } else {
-            sweep_owned(&self.entries, cell, &mut scratch.found)
+            self.sweep_all(cell, scratch, changes)
         };
-        scratch.found.sort_unstable();
         self.changed.clear();
         (
             self.entries.len() as isize - before,
             SweepCounts { swaps, tests },
         )
+    }
+
+    /// Every pair found again and diffed against the last ones.
+    fn sweep_all(
+        &mut self,
+        cell: [i32; 3],
+        scratch: &mut SweepScratch,
+        (added, removed): (&mut Vec<Pair>, &mut Vec<Pair>),
+    ) -> u64 {
+        let tests = sweep_owned(&self.entries, cell, &mut scratch.found);
+        scratch.found.sort_unstable();
+        diff_sorted(&self.owned, &scratch.found, added, removed);
+        // Copied, not swapped: a swap would pass buffers from region to region, and each would
+        // keep meeting new highs (allocations in a steady state).
+        self.owned.clear();
+        self.owned.extend_from_slice(&scratch.found);
+        tests
+    }
+
+    /// The changed members' pairs found again; the others kept. Only the changed members'
+    /// pairs are sorted and diffed (the kept ones stay sorted), then merged back.
+    fn sweep_few(
+        &mut self,
+        cell: [i32; 3],
+        scratch: &mut SweepScratch,
+        (added, removed): (&mut Vec<Pair>, &mut Vec<Pair>),
+    ) -> u64 {
+        let changed = &self.changed;
+        let unchanged = |id: &ProxyId| changed.binary_search(id).is_err();
+        let dropped = &mut scratch.dropped;
+        dropped.clear();
+        self.owned.retain(|p| {
+            let keep = unchanged(&p.a) && unchanged(&p.b);
+            if !keep {
+                dropped.push(*p);
+            }
+            keep
+        });
+        let tests = sweep_changed(&self.entries, cell, &mut scratch.found);
+        scratch.found.sort_unstable();
+        diff_sorted(&scratch.dropped, &scratch.found, added, removed);
+        merge_sorted(&self.owned, &scratch.found, &mut scratch.merged);
+        self.owned.clear();
+        self.owned.extend_from_slice(&scratch.merged);
+        tests
     }
 
     /// Many changed: re-reads every member (dropping those that left) and appends the
@@ -354,20 +405,11 @@ fn sweep_owned(entries: &[Entry], cell: [i32; 3], found: &mut Vec<Pair>) -> u64 
     tests
 }
 
-/// The last pairs of unchanged members, and each changed member swept against its neighbours:
-/// forward over the members starting before it ends, backward over those that may still
-/// reach it (no further back than the longest member), skipping changed ones backward (their
-/// own forward sweep finds the pair).
-fn sweep_changed(region: &Region, cell: [i32; 3], found: &mut Vec<Pair>) -> u64 {
-    let (entries, changed) = (&region.entries, &region.changed);
-    let unchanged = |id: &ProxyId| changed.binary_search(id).is_err();
+/// Each changed member swept against its neighbours: forward over the members starting
+/// before it ends, backward over those that may still reach it (no further back than the
+/// longest member), skipping changed ones backward (their own forward sweep finds the pair).
+fn sweep_changed(entries: &[Entry], cell: [i32; 3], found: &mut Vec<Pair>) -> u64 {
     found.clear();
-    found.extend(
-        region
-            .owned
-            .iter()
-            .filter(|p| unchanged(&p.a) && unchanged(&p.b)),
-    );
     let longest = entries.iter().fold(0.0f32, |m, e| m.max(e.hi - e.lo));
     let mut tests = 0;
     for (i, a) in entries.iter().enumerate().filter(|(_, e)| e.is_fresh()) {
@@ -384,6 +426,23 @@ fn sweep_changed(region: &Region, cell: [i32; 3], found: &mut Vec<Pair>) -> u64 
         }
     }
     tests
+}
+
+/// Two sorted lists without common items merged into `out`.
+fn merge_sorted(a: &[Pair], b: &[Pair], out: &mut Vec<Pair>) {
+    out.clear();
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() && j < b.len() {
+        if a[i] < b[j] {
+            out.push(a[i]);
+            i += 1;
+        } else {
+            out.push(b[j]);
+            j += 1;
+        }
+    }
+    out.extend_from_slice(&a[i..]);
+    out.extend_from_slice(&b[j..]);
 }
 
 #[cfg(test)]

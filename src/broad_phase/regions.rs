@@ -419,24 +419,14 @@ impl RegionSweep {
     fn sweep_region(&mut self, at: u32, frame: SweepFrame) {
         let region = &mut self.regions[at as usize];
         region.dirty = false;
-        let (delta, counts) = region.sweep(&Slots(&self.slots), frame, &mut self.scratch);
+        let changes = (&mut self.added, &mut self.removed);
+        let (delta, counts) = region.sweep(&Slots(&self.slots), frame, &mut self.scratch, changes);
         self.memberships = self.memberships.saturating_add_signed(delta);
         if region.entries.is_empty() {
-            self.removed.append(&mut region.owned);
+            // Its pairs were all reported removed by the sweep.
             self.cells.remove(&region.cell);
             self.free_regions.push(at);
-            return;
         }
-        super::pair_diff::diff_sorted(
-            &region.owned,
-            &self.scratch.found,
-            &mut self.added,
-            &mut self.removed,
-        );
-        // Copied, not swapped: a swap would pass buffers from region to region, and each would
-        // keep meeting new highs (allocations in a steady state).
-        region.owned.clear();
-        region.owned.extend_from_slice(&self.scratch.found);
         self.stats.endpoint_swaps += counts.swaps;
         self.stats.pair_tests += counts.tests;
     }
