@@ -295,6 +295,8 @@ fn run(mut scene: Scene) {
         ms(a),
         if adaptive.is_sorting_from_scratch() {
             "sorting from scratch"
+        } else if adaptive.is_in_regions() {
+            "regions"
         } else {
             "incremental"
         },

@@ -2,9 +2,11 @@
 //! outer wall): kept out of the regions, so that one box does not join thousands of them, and
 //! tested against the other bodies directly. They own every pair that involves one of them.
 //!
-//! Such bodies are few and rarely move. When none of them changed, a commit re-tests only the
-//! bodies that changed against them; when one changed, every pair of a large body is found
-//! again from scratch (`O(large × bodies)`).
+//! Such bodies are expected to be few and to move rarely (nothing enforces it; the cells grow
+//! when there are many). When none of them changed, a commit re-tests only the bodies that
+//! changed against them; when one changed, every pair of a large body is found again from
+//! scratch, a scan over every id up to the largest (`O((large + 1) × largest id)`: about
+//! 0.2 ms a step per 100k ids for a ground slab that moves every step).
 
 use super::{BodyKind, Pair, ProxyId};
 use crate::bounding::Aabb;

@@ -410,7 +410,11 @@ fn sweep_owned(entries: &[Entry], cell: [i32; 3], found: &mut Vec<Pair>) -> u64 
 /// longest member), skipping changed ones backward (their own forward sweep finds the pair).
 fn sweep_changed(entries: &[Entry], cell: [i32; 3], found: &mut Vec<Pair>) -> u64 {
     found.clear();
-    let longest = entries.iter().fold(0.0f32, |m, e| m.max(e.hi - e.lo));
+    // Rounded up: `hi - lo` rounded to nearest can fall short of the true length, and then
+    // `a.lo - longest` would stop the backward walk one member early (a touching pair lost).
+    let longest = entries
+        .iter()
+        .fold(0.0f32, |m, e| m.max((e.hi - e.lo).next_up()));
     let mut tests = 0;
     for (i, a) in entries.iter().enumerate().filter(|(_, e)| e.is_fresh()) {
         for b in entries[i + 1..].iter().take_while(|b| b.lo <= a.hi) {

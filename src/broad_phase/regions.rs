@@ -17,10 +17,15 @@
 //!   ([`large_bodies`]).
 //! - **Adaptive layout, no user tuning.** The cell side starts at four times the median box's
 //!   largest extent, the sweep axis is the one where the centres spread most; after a layout,
-//!   the measured members per region tune the side (doubled below
-//!   [`RegionSweep::SPARSE_REGION`] or while more than `16 + n / 128` bodies are large,
-//!   halved above [`RegionSweep::DENSE_REGION`]), and every
-//!   [`RegionSweep::CHECK_PERIOD`] commits the occupancy is checked again.
+//!   the measured members per region tune the side: doubled below
+//!   [`RegionSweep::SPARSE_REGION`] members or while more than `16 + n / 128` bodies are large
+//!   (and then never halved below that side again, so the two rules cannot flip it back and
+//!   forth), halved above [`RegionSweep::DENSE_REGION`] but not below the median extent. A round
+//!   of up to six tunings follows a layout; then every [`RegionSweep::CHECK_PERIOD`] commits
+//!   the occupancy is checked again with a band twice as wide. Boxes of median extent 1e-6 or
+//!   less (points) start from the bounds' size over `∛n` instead.
+//! - **Memory** grows with the largest id, as the contract says: about 90 bytes an id (the box,
+//!   the placement and up to eight remembered regions), plus 40 bytes per region membership.
 //! - **Net changes.** Each region diffs its new pairs against its last ones; removals are
 //!   applied before additions, so a pair whose owning cell changed cancels out in the pair
 //!   set's log, and [`BroadPhase::added`] / [`BroadPhase::removed`] are the net changes.
@@ -134,6 +139,8 @@ pub struct RegionSweep {
     layout: Option<Layout>,
     /// A new cell side to lay the regions out with at the next commit.
     relayout_to: Option<f32>,
+    /// The smallest side tuning may halve to, raised when too many large bodies grew it.
+    min_side: f32,
     cells: HashMap<[i32; 3], u32, PairHashBuilder>,
     regions: Vec<Region>,
     free_regions: Vec<u32>,
@@ -313,9 +320,13 @@ impl RegionSweep {
         let slack = if self.tunings_left > 0 { 1.0 } else { 2.0 };
         // Too many bodies over `LARGE_CELLS` cells would make the large-body tests quadratic.
         let too_many_large = self.large.count() > 16 + self.len / 128;
+        if too_many_large {
+            self.min_side = self.min_side.max(size * 2.0);
+        }
+        let smallest = layout.floor.max(self.min_side);
         let next = if too_many_large || (mean < Self::SPARSE_REGION / slack && regions > 1) {
             Some(size * 2.0)
-        } else if mean > Self::DENSE_REGION * slack && size / 2.0 >= layout.floor {
+        } else if mean > Self::DENSE_REGION * slack && size / 2.0 >= smallest {
             Some(size / 2.0)
         } else {
             None

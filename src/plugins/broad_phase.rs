@@ -45,7 +45,8 @@ pub type BroadPhaseFactory = fn() -> Box<dyn BroadPhase + Send + Sync>;
 #[derive(Debug, Clone)]
 pub struct BroadPhasePlugin {
     /// The moving-body algorithm (default: incremental sweep and prune that falls back to
-    /// sorting from scratch while insertion sort loses, [`AdaptiveSweep`]).
+    /// sorting from scratch while insertion sort loses, and moves into the segmented sweep and
+    /// prune from 20,000 bodies, [`AdaptiveSweep`]).
     pub moving: BroadPhaseFactory,
     /// The static grid's settings (default: cell size chosen from the statics' sizes).
     pub grid: StaticGridConfig,

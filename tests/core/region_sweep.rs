@@ -373,3 +373,36 @@ fn forty_big_boxes_among_small_ones_grow_the_cells_until_few_are_large_and_stay_
         subject.large_bodies()
     );
 }
+
+/// The review's case: a member spanning x from 0.1 to 1.0, whose length `1.0 - 0.1` rounds
+/// below the true one, touched at x = 1.0 by the one member that moved. The backward walk of
+/// the partial sweep must still reach it.
+#[test]
+fn a_pair_touching_at_a_rounded_length_is_found_by_the_partial_sweep() {
+    let span = |x0: f32, x1: f32| Aabb::new(Vec3::new(x0, 0.0, 0.0), Vec3::new(x1, 0.5, 0.5));
+    let (mut subject, mut reference) = (RegionSweep::new(), BruteForce::new());
+    let start = [
+        (0.1, 1.0),
+        (1.05, 1.45),
+        (1.5, 1.9),
+        (1.6, 1.9),
+        (1.7, 1.95),
+    ];
+    for (id, (x0, x1)) in start.into_iter().enumerate() {
+        for bp in [&mut subject as &mut dyn BroadPhase, &mut reference] {
+            bp.insert(id as ProxyId, span(x0, x1), BodyKind::Dynamic)
+                .unwrap();
+        }
+    }
+    for bp in [&mut subject as &mut dyn BroadPhase, &mut reference] {
+        bp.commit();
+        bp.update(1, span(1.0, 1.4)).unwrap();
+        bp.commit();
+    }
+    let (mut expected, mut got) = (Vec::new(), Vec::new());
+    reference.sorted_pairs_into(&mut expected);
+    subject.sorted_pairs_into(&mut got);
+    assert!(expected.contains(&Pair { a: 0, b: 1 }));
+    assert_eq!(got, expected);
+    assert_eq!(subject.added(), reference.added());
+}
