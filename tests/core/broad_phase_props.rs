@@ -547,32 +547,41 @@ pub(super) fn swinging_box(i: u32, step: u32) -> Aabb {
     Aabb::from_center_half_extents(cell + swing, Vec3::splat(0.5))
 }
 
-#[test]
-fn the_incremental_sap_makes_0_allocations_per_step_once_its_buffers_have_grown() {
-    let mut sap = IncrementalSap::<AxisTests>::new();
+/// Steps 2,000 swinging boxes in `bp` (`at(i, step)`) for 600 steps, then counts the
+/// allocations of 120 more; returns them and the pair changes of those 120 steps.
+pub(super) fn steady_state_allocations(
+    bp: &mut impl BroadPhase,
+    at: impl Fn(u32, u32) -> Aabb,
+) -> (u64, usize) {
     let bodies: Vec<(ProxyId, Aabb, BodyKind)> = (0..2000)
-        .map(|i| (i, swinging_box(i, 0), BodyKind::Dynamic))
+        .map(|i| (i, at(i, 0), BodyKind::Dynamic))
         .collect();
-    sap.insert_bulk(&bodies).expect("valid boxes");
-    sap.commit();
-    let step = |n: u32, sap: &mut IncrementalSap<AxisTests>| {
+    bp.insert_bulk(&bodies).expect("valid boxes");
+    bp.commit();
+    let step = |n: u32, bp: &mut dyn BroadPhase| {
         for i in 0..2000 {
-            sap.update(i, swinging_box(i, n)).expect("a known body");
+            bp.update(i, at(i, n)).expect("a known body");
         }
-        sap.commit();
+        bp.commit();
     };
     // Ten periods grow every buffer to what the motion needs (the motion repeats only up to
     // rounding, so a buffer may still reach a new high in the first periods).
     for n in 1..=600 {
-        step(n, &mut sap);
+        step(n, bp);
     }
     let before = allocations();
     let mut churn = 0;
     for n in 601..=720 {
-        step(n, &mut sap);
-        churn += sap.added().len() + sap.removed().len();
+        step(n, bp);
+        churn += bp.added().len() + bp.removed().len();
     }
-    let made = allocations() - before;
+    (allocations() - before, churn)
+}
+
+#[test]
+fn the_incremental_sap_makes_0_allocations_per_step_once_its_buffers_have_grown() {
+    let mut sap = IncrementalSap::<AxisTests>::new();
+    let (made, churn) = steady_state_allocations(&mut sap, swinging_box);
     assert!(
         churn > 1000,
         "the scene must start and end overlaps: {churn}"

@@ -4,7 +4,7 @@
 //! far-away boxes; pairs, additions and removals must equal an independent broad phase's after
 //! every commit. And no allocation per step once its buffers have grown.
 
-use super::broad_phase_props::{Rng, allocations, swinging_box};
+use super::broad_phase_props::{Rng, steady_state_allocations, swinging_box};
 use glam::Vec3;
 use urto::bounding::Aabb;
 use urto::broad_phase::{
@@ -27,6 +27,53 @@ fn commit_and_compare(subject: &mut RegionSweep, reference: &mut dyn BroadPhase,
     );
 }
 
+/// Static for one id in `n`, dynamic otherwise.
+fn static_one_in(i: u32, n: u32) -> BodyKind {
+    if i.is_multiple_of(n) {
+        BodyKind::Static
+    } else {
+        BodyKind::Dynamic
+    }
+}
+
+/// Both broad phases holding `bodies`, committed once and compared.
+fn started(bodies: &[(ProxyId, Aabb, BodyKind)]) -> (RegionSweep, SortAndSweep) {
+    let (mut subject, mut reference) = (RegionSweep::new(), SortAndSweep::new());
+    for bp in both(&mut subject, &mut reference) {
+        bp.insert_bulk(bodies).unwrap();
+    }
+    commit_and_compare(&mut subject, &mut reference, 0);
+    (subject, reference)
+}
+
+/// Moves body `i` in both by a random step of up to `speed` along each axis.
+fn shake(
+    i: ProxyId,
+    speed: f32,
+    rng: &mut Rng,
+    subject: &mut RegionSweep,
+    reference: &mut SortAndSweep,
+) {
+    let b = reference.aabb(i).unwrap();
+    let d = Vec3::new(
+        rng.range(-speed, speed),
+        rng.range(-speed, speed),
+        rng.range(-speed, speed),
+    );
+    for bp in both(subject, reference) {
+        bp.update(i, Aabb::new(b.min + d, b.max + d)).unwrap();
+    }
+}
+
+/// A point uniformly in the cube `[0, side]³`.
+fn in_cube(rng: &mut Rng, side: f32) -> Vec3 {
+    Vec3::new(
+        rng.range(0.0, side),
+        rng.range(0.0, side),
+        rng.range(0.0, side),
+    )
+}
+
 fn both<'a>(
     subject: &'a mut RegionSweep,
     reference: &'a mut SortAndSweep,
@@ -42,21 +89,13 @@ fn mixed_sizes_with_large_bodies_match_sort_and_sweep_exactly_for_120_steps() {
     let mut rng = Rng(0x5eed_0f7e_5700);
     let mut bodies: Vec<(ProxyId, Aabb, BodyKind)> = (0..3000)
         .map(|i| {
-            let c = Vec3::new(
-                rng.range(0.0, 30.0),
-                rng.range(0.0, 30.0),
-                rng.range(0.0, 30.0),
-            );
+            let c = in_cube(&mut rng, 30.0);
             let half = Vec3::new(
                 rng.range(0.1, 1.0),
                 rng.range(0.1, 1.0),
                 rng.range(0.1, 1.0),
             );
-            let kind = if i % 20 == 0 {
-                BodyKind::Static
-            } else {
-                BodyKind::Dynamic
-            };
+            let kind = static_one_in(i, 20);
             (i, Aabb::from_center_half_extents(c, half), kind)
         })
         .collect();
@@ -66,23 +105,11 @@ fn mixed_sizes_with_large_bodies_match_sort_and_sweep_exactly_for_120_steps() {
     bodies.push((3001, wall, BodyKind::Static));
     let slab = |t: f32| Aabb::new(Vec3::new(-5.0, t, -5.0), Vec3::new(35.0, t + 0.5, 35.0));
     bodies.push((3002, slab(0.0), BodyKind::Dynamic));
-    let (mut subject, mut reference) = (RegionSweep::new(), SortAndSweep::new());
-    for bp in both(&mut subject, &mut reference) {
-        bp.insert_bulk(&bodies).unwrap();
-    }
-    commit_and_compare(&mut subject, &mut reference, 0);
+    let (mut subject, mut reference) = started(&bodies);
     for step in 1..=120usize {
         let speed = if step % 20 == 0 { 3.0 } else { 0.1 };
         for i in (0..3000u32).filter(|i| (*i as usize + step).is_multiple_of(3)) {
-            let b = reference.aabb(i).unwrap();
-            let d = Vec3::new(
-                rng.range(-speed, speed),
-                rng.range(-speed, speed),
-                rng.range(-speed, speed),
-            );
-            for bp in both(&mut subject, &mut reference) {
-                bp.update(i, Aabb::new(b.min + d, b.max + d)).unwrap();
-            }
+            shake(i, speed, &mut rng, &mut subject, &mut reference);
         }
         for bp in both(&mut subject, &mut reference) {
             bp.update(3002, slab(step as f32 * 0.25)).unwrap();
@@ -114,41 +141,21 @@ fn few_movers_among_many_match_sort_and_sweep_exactly_for_100_steps() {
     let mut rng = Rng(0xfe00_5eed);
     let bodies: Vec<(ProxyId, Aabb, BodyKind)> = (0..4000)
         .map(|i| {
-            let c = Vec3::new(
-                rng.range(0.0, 25.0),
-                rng.range(0.0, 25.0),
-                rng.range(0.0, 25.0),
-            );
+            let c = in_cube(&mut rng, 25.0);
             let mut half = Vec3::splat(rng.range(0.2, 0.6));
             if i % 50 == 0 {
                 half[(i / 50 % 3) as usize] = 2.5;
             }
-            let kind = if i % 7 == 0 {
-                BodyKind::Static
-            } else {
-                BodyKind::Dynamic
-            };
+            let kind = static_one_in(i, 7);
             (i, Aabb::from_center_half_extents(c, half), kind)
         })
         .collect();
-    let (mut subject, mut reference) = (RegionSweep::new(), SortAndSweep::new());
-    for bp in both(&mut subject, &mut reference) {
-        bp.insert_bulk(&bodies).unwrap();
-    }
-    commit_and_compare(&mut subject, &mut reference, 0);
+    let (mut subject, mut reference) = started(&bodies);
     for step in 1..=100usize {
         for k in 0..40u32 {
             let i = (k * 97 + step as u32 * 13) % 4000;
             let speed = if k % 10 == 0 { 4.0 } else { 0.15 };
-            let b = reference.aabb(i).unwrap();
-            let d = Vec3::new(
-                rng.range(-speed, speed),
-                rng.range(-speed, speed),
-                rng.range(-speed, speed),
-            );
-            for bp in both(&mut subject, &mut reference) {
-                bp.update(i, Aabb::new(b.min + d, b.max + d)).unwrap();
-            }
+            shake(i, speed, &mut rng, &mut subject, &mut reference);
         }
         commit_and_compare(&mut subject, &mut reference, step);
     }
@@ -164,11 +171,7 @@ fn a_sparse_cloud_grows_its_cells_at_least_4_fold_and_stays_exact() {
     let (mut subject, mut reference) = (RegionSweep::new(), SortAndSweep::new());
     let boxes: Vec<Aabb> = (0..1000)
         .map(|_| {
-            let c = Vec3::new(
-                rng.range(0.0, 200.0),
-                rng.range(0.0, 200.0),
-                rng.range(0.0, 200.0),
-            );
+            let c = in_cube(&mut rng, 200.0);
             Aabb::from_center_half_extents(c, Vec3::splat(0.5))
         })
         .collect();
@@ -291,35 +294,12 @@ fn coincident_points_far_boxes_and_an_all_space_box_match_brute_force() {
 
 #[test]
 fn region_sweep_makes_0_allocations_per_step_once_its_buffers_have_grown() {
-    let mut regions = RegionSweep::new();
-    let bodies: Vec<(ProxyId, Aabb, BodyKind)> = (0..2000)
-        .map(|i| (i, swinging_box(i, 0), BodyKind::Dynamic))
-        .collect();
-    regions.insert_bulk(&bodies).expect("valid boxes");
-    regions.commit();
-    let step = |n: u32, regions: &mut RegionSweep| {
-        for i in 0..2000 {
-            // The phase taken modulo the period, so the motion repeats bit for bit: without it,
-            // rounding lets a box near a cell's edge enter a new cell late. Freed regions are
-            // reused in a different order from one period to the next, so their buffers take a
-            // few periods to all reach what any cell needs.
-            let phase = n % 60;
-            regions
-                .update(i, swinging_box(i, phase))
-                .expect("a known body");
-        }
-        regions.commit();
-    };
-    for n in 1..=600 {
-        step(n, &mut regions);
-    }
-    let before = allocations();
-    let mut churn = 0;
-    for n in 601..=720 {
-        step(n, &mut regions);
-        churn += regions.added().len() + regions.removed().len();
-    }
-    let made = allocations() - before;
+    // The phase taken modulo the period, so the motion repeats bit for bit: without it,
+    // rounding lets a box near a cell's edge enter a new cell late. Freed regions are reused in
+    // a different order from one period to the next, so their buffers take a few periods to
+    // all reach what any cell needs.
+    let (made, churn) =
+        steady_state_allocations(&mut RegionSweep::new(), |i, n| swinging_box(i, n % 60));
     assert!(
         churn > 1000,
         "the scene must start and end overlaps: {churn}"
@@ -336,11 +316,7 @@ fn forty_big_boxes_among_small_ones_grow_the_cells_until_few_are_large_and_stay_
     let mut rng = Rng(0xb16_5a11);
     let bodies: Vec<(ProxyId, Aabb, BodyKind)> = (0..3040)
         .map(|i| {
-            let c = Vec3::new(
-                rng.range(0.0, 16.0),
-                rng.range(0.0, 16.0),
-                rng.range(0.0, 16.0),
-            );
+            let c = in_cube(&mut rng, 16.0);
             let half = if i < 3000 { 0.25 } else { rng.range(5.0, 6.0) };
             (
                 i,
@@ -349,11 +325,7 @@ fn forty_big_boxes_among_small_ones_grow_the_cells_until_few_are_large_and_stay_
             )
         })
         .collect();
-    let (mut subject, mut reference) = (RegionSweep::new(), SortAndSweep::new());
-    for bp in both(&mut subject, &mut reference) {
-        bp.insert_bulk(&bodies).unwrap();
-    }
-    commit_and_compare(&mut subject, &mut reference, 0);
+    let (mut subject, mut reference) = started(&bodies);
     let first = subject.cell_size().unwrap();
     for step in 1..=12usize {
         for i in (0..3040u32).step_by(3) {
