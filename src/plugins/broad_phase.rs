@@ -2,8 +2,9 @@
 //! bounding volumes): keeps the broad-phase structures in step with the world and lists the
 //! candidate pairs of root bodies.
 //!
-//! - Moving bodies are in an incremental sweep and prune (the slides' §8), fed only the bodies
-//!   whose volume changed, so bodies at rest cost nothing.
+//! - Moving bodies are in an incremental sweep and prune (the slides' §8; from 20,000 bodies
+//!   its segmented form, a sweep per cell of a grid), fed only the bodies whose volume
+//!   changed, so bodies at rest cost nothing.
 //! - Bounded static scenery is in a hashed uniform grid (the slides' "object vs static scene"):
 //!   indexed once, queried with each moving body's volume; statics never enter the sort.
 //! - Unbounded scenery (grounds, walls) is paired with every moving body.
