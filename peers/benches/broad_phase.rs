@@ -21,7 +21,8 @@
 //! median step. Single thread.
 //!
 //! Run (from `peers/`): `cargo bench --bench broad_phase`; `PEERS_BROAD_PHASE_QUICK=1` drops the
-//! 100k scenes.
+//! 100k scenes, `PEERS_BROAD_PHASE_1M=1` adds a cloud of 1M all moving (a few minutes: the
+//! whole-scene SAP takes seconds a step there).
 
 use glam::Vec3;
 use rapier3d::parry::bounding_volume::Aabb as ParryAabb;
@@ -325,4 +326,7 @@ fn main() {
     }
     run(Scene::row(10_000, 5));
     run(Scene::mixed(10_000, 6));
+    if std::env::var("PEERS_BROAD_PHASE_1M").is_ok() {
+        run(Scene::cloud(1_000_000, 1.0, 7));
+    }
 }
