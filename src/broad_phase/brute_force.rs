@@ -43,8 +43,7 @@ impl BroadPhase for BruteForce {
         let out = self.history.begin();
         for i in 0..ids.len() {
             for j in i + 1..ids.len() {
-                let both_static = kinds[i] == BodyKind::Static && kinds[j] == BodyKind::Static;
-                if !both_static && aabbs[i].intersects(&aabbs[j]) {
+                if !BodyKind::both_static(kinds[i], kinds[j]) && aabbs[i].intersects(&aabbs[j]) {
                     out.push(Pair::ordered(ids[i], ids[j]));
                 }
             }

@@ -8,16 +8,15 @@
 //! scratch, a scan over every id up to the largest (`O((large + 1) × largest id)`: about
 //! 0.2 ms a step per 100k ids for a ground slab that moves every step).
 
+use super::region::BodyView;
 use super::{BodyKind, Pair, ProxyId};
 use crate::bounding::Aabb;
 use std::mem::size_of;
 
-/// What the large bodies need to know of every body.
-pub(super) trait LargeView {
+/// What the large bodies need to know of every body (ids below [`BodyView::id_bound`]).
+pub(super) trait LargeView: BodyView {
     /// The box, kind and whether the body is large, for a present id; `None` otherwise.
     fn body(&self, id: ProxyId) -> Option<(Aabb, BodyKind, bool)>;
-    /// One past the largest id that was ever used.
-    fn id_bound(&self) -> ProxyId;
     /// Whether the id changed in this commit.
     fn changed(&self, id: ProxyId) -> bool;
 }
@@ -76,7 +75,8 @@ impl LargeBodies {
     fn find_all(&mut self, view: &impl LargeView) -> u64 {
         self.ids.clear();
         self.ids.extend(
-            (0..view.id_bound()).filter(|&id| view.body(id).is_some_and(|(_, _, large)| large)),
+            (0..view.id_bound() as ProxyId)
+                .filter(|&id| view.body(id).is_some_and(|(_, _, large)| large)),
         );
         self.found.clear();
         let mut tests = 0;
@@ -84,7 +84,7 @@ impl LargeBodies {
             let Some((big, big_kind, _)) = view.body(l) else {
                 continue;
             };
-            for other in 0..view.id_bound() {
+            for other in 0..view.id_bound() as ProxyId {
                 let Some((aabb, kind, large)) = view.body(other) else {
                     continue;
                 };
@@ -93,7 +93,7 @@ impl LargeBodies {
                     continue;
                 }
                 tests += 1;
-                if !both_static(big_kind, kind) && big.intersects(&aabb) {
+                if !BodyKind::both_static(big_kind, kind) && big.intersects(&aabb) {
                     self.found.push(Pair::ordered(l, other));
                 }
             }
@@ -119,7 +119,7 @@ impl LargeBodies {
                     continue;
                 };
                 tests += 1;
-                if !both_static(big_kind, kind) && big.intersects(&aabb) {
+                if !BodyKind::both_static(big_kind, kind) && big.intersects(&aabb) {
                     self.found.push(Pair::ordered(l, id));
                 }
             }
@@ -132,8 +132,4 @@ impl LargeBodies {
         self.ids.capacity() * size_of::<ProxyId>()
             + (self.owned.capacity() + self.found.capacity()) * size_of::<Pair>()
     }
-}
-
-fn both_static(a: BodyKind, b: BodyKind) -> bool {
-    a == BodyKind::Static && b == BodyKind::Static
 }

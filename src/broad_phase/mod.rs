@@ -115,6 +115,14 @@ pub enum BodyKind {
     Static,
 }
 
+impl BodyKind {
+    /// Whether a pair of these kinds is never reported (two parts of the scenery).
+    #[inline]
+    pub(crate) fn both_static(a: Self, b: Self) -> bool {
+        a == Self::Static && b == Self::Static
+    }
+}
+
 /// Why a broad-phase call was refused (the structure is left as it was).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BroadPhaseError {

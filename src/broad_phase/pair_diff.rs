@@ -1,5 +1,6 @@
-//! Pair changes for the broad phases that recompute all pairs each commit: keep the previous
-//! sorted list and diff it against the new one in one merge pass.
+//! Sorted pair lists: the changes between two (for the broad phases that recompute pairs each
+//! commit, or a region of [`super::RegionSweep`]: keep the previous sorted list and diff it
+//! against the new one in one merge pass), and the merge of two.
 
 use super::Pair;
 use std::cmp::Ordering;
@@ -81,6 +82,23 @@ pub fn diff_sorted(old: &[Pair], new: &[Pair], added: &mut Vec<Pair>, removed: &
     }
     removed.extend_from_slice(&old[i..]);
     added.extend_from_slice(&new[j..]);
+}
+
+/// Two sorted lists without common items merged into `out`.
+pub fn merge_sorted(a: &[Pair], b: &[Pair], out: &mut Vec<Pair>) {
+    out.clear();
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() && j < b.len() {
+        if a[i] < b[j] {
+            out.push(a[i]);
+            i += 1;
+        } else {
+            out.push(b[j]);
+            j += 1;
+        }
+    }
+    out.extend_from_slice(&a[i..]);
+    out.extend_from_slice(&b[j..]);
 }
 
 #[cfg(test)]

@@ -14,7 +14,7 @@
 //! function is monotone, so that cell is the larger of the two boxes' min cells on each axis,
 //! and the test needs no shared state between regions.
 
-use super::pair_diff::diff_sorted;
+use super::pair_diff::{diff_sorted, merge_sorted};
 use super::{Pair, ProxyId};
 use crate::bounding::Aabb;
 
@@ -259,10 +259,7 @@ impl Region {
         let tests = sweep_owned(&self.entries, cell, &mut scratch.found);
         scratch.found.sort_unstable();
         diff_sorted(&self.owned, &scratch.found, added, removed);
-        // Copied, not swapped: a swap would pass buffers from region to region, and each would
-        // keep meeting new highs (allocations in a steady state).
-        self.owned.clear();
-        self.owned.extend_from_slice(&scratch.found);
+        self.set_owned(&scratch.found);
         tests
     }
 
@@ -289,9 +286,16 @@ impl Region {
         scratch.found.sort_unstable();
         diff_sorted(&scratch.dropped, &scratch.found, added, removed);
         merge_sorted(&self.owned, &scratch.found, &mut scratch.merged);
-        self.owned.clear();
-        self.owned.extend_from_slice(&scratch.merged);
+        self.set_owned(&scratch.merged);
         tests
+    }
+
+    /// Copies the new owned pairs in. Copied, not swapped with the scratch buffer: a swap
+    /// would pass buffers from region to region, and each would keep meeting new highs
+    /// (allocations in a steady state).
+    fn set_owned(&mut self, pairs: &[Pair]) {
+        self.owned.clear();
+        self.owned.extend_from_slice(pairs);
     }
 
     /// Many changed: re-reads every member (dropping those that left) and appends the
@@ -430,23 +434,6 @@ fn sweep_changed(entries: &[Entry], cell: [i32; 3], found: &mut Vec<Pair>) -> u6
         }
     }
     tests
-}
-
-/// Two sorted lists without common items merged into `out`.
-fn merge_sorted(a: &[Pair], b: &[Pair], out: &mut Vec<Pair>) {
-    out.clear();
-    let (mut i, mut j) = (0, 0);
-    while i < a.len() && j < b.len() {
-        if a[i] < b[j] {
-            out.push(a[i]);
-            i += 1;
-        } else {
-            out.push(b[j]);
-            j += 1;
-        }
-    }
-    out.extend_from_slice(&a[i..]);
-    out.extend_from_slice(&b[j..]);
 }
 
 #[cfg(test)]

@@ -113,10 +113,6 @@ impl LargeView for Slots<'_> {
         Some((slot.aabb, slot.kind, slot.placed == Placement::Large))
     }
 
-    fn id_bound(&self) -> ProxyId {
-        self.0.len() as ProxyId
-    }
-
     fn changed(&self, id: ProxyId) -> bool {
         self.0[id as usize].queued
     }
@@ -376,15 +372,13 @@ impl RegionSweep {
     fn place(&mut self, id: ProxyId, inverse_size: f32) {
         let slot = &self.slots[id as usize];
         let range = CellRange::of(&slot.aabb, inverse_size);
+        let slot = *slot;
         if slot.present && slot.home_count > 0 && slot.placed == Placement::Cells(range) {
-            // Moved within its cells: the common case under coherence, without hashing.
-            let (homes, count) = (slot.homes, usize::from(slot.home_count));
-            for &at in &homes[..count] {
-                self.touch(at, id);
-            }
+            // Moved within its cells, the common case under coherence: its remembered regions
+            // re-read it, and nothing is hashed.
+            self.leave(&slot, id);
             return;
         }
-        let slot = *slot;
         let new = if !slot.present {
             Placement::Absent
         } else if range.count() > Self::LARGE_CELLS {

@@ -58,17 +58,20 @@ impl ShapeOnSweep<'_> {
     }
 
     fn pose_at(&self, sweep: &SphereSweep, t: f32) -> Isometry {
-        let rotation = self.rotation_at(t);
+        self.pose_with(sweep, t, self.rotation_at(t))
+    }
+
+    /// The pose at `t` with the body turned to `rotation` (its centre of mass on the sweep).
+    fn pose_with(&self, sweep: &SphereSweep, t: f32, rotation: Quat) -> Isometry {
         Isometry::new(
             sweep.position_at(t) - rotation * self.local_center,
             rotation,
         )
     }
 
-    /// How fast any point of the body can move, per unit of the sweep's `t`.
-    fn speed_bound(&self, sweep: &SphereSweep) -> f32 {
-        let [a, b] = self.rotations;
-        let turn = a.angle_between(b);
+    /// How fast any point of the body can move, per unit of the sweep's `t`, for a body
+    /// turning by `turn` radians over the sweep.
+    fn speed_bound(&self, sweep: &SphereSweep, turn: f32) -> f32 {
         sweep.displacement().length() + turn * sweep.radius()
     }
 }
@@ -93,10 +96,11 @@ pub fn toi_shape_from(
     scratch: &mut ContactScratch,
 ) -> Option<Toi> {
     let [start, end] = body.rotations;
-    if start.angle_between(end) > MAX_REFINED_TURN {
+    let turn = start.angle_between(end);
+    if turn > MAX_REFINED_TURN {
         return Some(sphere);
     }
-    let speed = body.speed_bound(sweep);
+    let speed = body.speed_bound(sweep, turn);
     let tolerance = sweep.tolerance();
     let mut t = sphere.t.clamp(0.0, 1.0);
     // At the sphere's impact the body, inside the sphere, is at most its diameter away.
@@ -158,7 +162,7 @@ pub fn toi_shape_from(
         .and_then(|m| toi(t, &m))
         .unwrap_or(Toi { t, ..sphere });
     // Where the body stops it keeps its end orientation: that must not be inside the obstacle.
-    let kept = Isometry::new(sweep.position_at(hit.t) - end * body.local_center, end);
+    let kept = body.pose_with(sweep, hit.t, end);
     let inside = contact_with_scratch(body.shape, &kept, obstacle, obstacle_pose, scratch)
         .is_some_and(|m| m.max_depth() > tolerance);
     Some(if inside { sphere } else { hit })
@@ -342,8 +346,7 @@ mod tests {
                     assert!(got.t <= truth + 1e-5, "{k}: late {} > {truth}", got.t);
                     // A turning body is kept at its end orientation, which must not be inside
                     // the wall: where it would be, the answer is the sphere's, earlier.
-                    let end = rotations[1];
-                    let kept = Isometry::new(sweep.position_at(got.t) - end * local_center, end);
+                    let kept = body.pose_with(&sweep, got.t, rotations[1]);
                     let depth = crate::geometry::contacts::contact(shape, &kept, &wall, &wall_pose)
                         .map_or(0.0, |m| m.max_depth());
                     assert!(depth <= sweep.tolerance(), "{k}: kept {depth} deep");

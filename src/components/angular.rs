@@ -84,6 +84,11 @@ pub struct AngularDrag(pub f32);
 pub struct LockedAxes(u8);
 
 impl LockedAxes {
+    /// The locks of a body that may have no `LockedAxes` (nothing locked then).
+    pub fn of(locked: Option<&LockedAxes>) -> LockedAxes {
+        locked.copied().unwrap_or_default()
+    }
+
     /// Nothing locked.
     pub const NONE: Self = Self(0);
     /// Rotation locked about every axis: the body only translates.

@@ -188,7 +188,8 @@ fn record_sweep_starts(
             continue;
         };
         let local_center = inertia.map_or(Vec3::ZERO, |i| i.local_center_of_mass);
-        let offset = Rotation::of(r) * local_center;
+        let rotation = Rotation::of(r);
+        let offset = rotation * local_center;
         // The sphere about the origin holding the body, grown to be about the centre of mass.
         let radius = radius + offset.length();
         let fast = settings
@@ -200,7 +201,7 @@ fn record_sweep_starts(
                 from: p.0 + offset,
                 radius,
                 local_center,
-                rotation: Rotation::of(r),
+                rotation,
                 turn: w.map_or(0.0, |w| w.0.length() * dt),
             });
         }
@@ -264,11 +265,16 @@ fn sweep_fast_bodies(
             continue;
         };
         // Where the integrator put the centre of mass, the body turned as it ends the substep.
-        let offset = Rotation::of(r) * local_center;
+        let now = Rotation::of(r);
+        let offset = now * local_center;
         let to = p.0 + offset;
         let e_body = e_body.map_or(contact_settings.default_restitution, |r| r.0);
         let own = obstacles.get(body).ok();
         let layers = layers_of(own.and_then(|o| o.5));
+        if !(to - from).is_finite() {
+            // The integrator overflowed: leave the body where it is, for the refit to quarantine.
+            continue;
+        }
         // A single convex collider is refined from its sphere's impact to its own (a compound's
         // sphere also holds its parts, which are not refined; nor is a body spinning so fast
         // that the slerp between its two orientations may not be the way it turned).
@@ -278,14 +284,10 @@ fn sweep_fast_bodies(
             .filter(|c| ShapeOnSweep::worth_refining(&c.shape))
             .map(|c| ShapeOnSweep {
                 shape: &c.shape,
-                rotations: [rotation, Rotation::of(r)],
+                rotations: [rotation, now],
                 local_center,
             });
-        if !(to - from).is_finite() {
-            // The integrator overflowed: leave the body where it is, for the refit to quarantine.
-            continue;
-        }
-        let free = locked.copied().unwrap_or_default().free_translation_axes();
+        let free = LockedAxes::of(locked).free_translation_axes();
         let (mut at, mut velocity, mut motion) = (from, v.0, to - from);
         let mut impacted = false;
         // The share of the step still to move: each impact uses up its sweep's `t` of what was

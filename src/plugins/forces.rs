@@ -215,13 +215,14 @@ fn apply_impulses(
             }
             let inverse_mass = mass.inverse();
             if inverse_mass > 0.0 {
-                let free = locked.copied().unwrap_or_default().free_translation_axes();
+                let locks = LockedAxes::of(locked);
+                let free = locks.free_translation_axes();
                 v.0 += impulse.linear() * inverse_mass * free;
                 if let (Some(mut w), Some(inertia)) = (w, inertia) {
                     let center = center_of_mass(p, r, Some(inertia));
                     let moment = impulse.angular_about(center);
                     let spin = inertia.inverse_world_times(Rotation::of(r), moment);
-                    let spin = spin * locked.copied().unwrap_or_default().free_rotation_axes();
+                    let spin = spin * locks.free_rotation_axes();
                     if spin != Vec3::ZERO {
                         w.0 += spin;
                     }

@@ -125,7 +125,7 @@ fn gather_turning(bodies: &Query<Turning, TurningFilter>, b: &mut RotationBuffer
             inertia_frame: inertia.frame,
             torque,
             drag: drag.map_or(0.0, |d| d.0),
-            free_axes: locked.copied().unwrap_or_default().free_rotation_axes(),
+            free_axes: LockedAxes::of(locked).free_rotation_axes(),
         };
         if !body.is_still() {
             b.slots.push(slot as u32);

@@ -360,7 +360,7 @@ fn body_input(
     let inverse_mass = mass.inverse();
     let dynamic = inverse_mass > 0.0;
     // Without the component nothing is locked (`LockedAxes::default()`).
-    let locks = locked.copied().unwrap_or_default();
+    let locks = LockedAxes::of(locked);
     BodyInput {
         center: p.0 + r.0 * inertia.local_center_of_mass,
         orientation: r.0,
