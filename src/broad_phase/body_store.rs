@@ -17,6 +17,8 @@ pub struct BodyStore {
     aabbs: Vec<Aabb>,
     kinds: Vec<BodyKind>,
     seen: Vec<ProxyId>,
+    /// Whether a body came, went or moved since [`Self::take_changed`].
+    changed: bool,
 }
 
 impl BodyStore {
@@ -95,6 +97,7 @@ impl BodyStore {
             self.position_of.resize(slot + 1, ABSENT);
         }
         self.position_of[slot] = self.ids.len() as u32;
+        self.changed = true;
         self.ids.push(id);
         self.aabbs.push(aabb);
         self.kinds.push(kind);
@@ -104,6 +107,7 @@ impl BodyStore {
     pub fn update(&mut self, id: ProxyId, aabb: Aabb) -> Result<(), BroadPhaseError> {
         let at = self.position(id).ok_or(BroadPhaseError::UnknownId(id))?;
         check_aabb(id, &aabb)?;
+        self.changed |= self.aabbs[at] != aabb;
         self.aabbs[at] = aabb;
         Ok(())
     }
@@ -112,6 +116,7 @@ impl BodyStore {
     pub fn remove(&mut self, id: ProxyId) -> Result<(), BroadPhaseError> {
         let at = self.position(id).ok_or(BroadPhaseError::UnknownId(id))?;
         self.position_of[id as usize] = ABSENT;
+        self.changed = true;
         self.ids.swap_remove(at);
         self.aabbs.swap_remove(at);
         self.kinds.swap_remove(at);
@@ -119,6 +124,12 @@ impl BodyStore {
             self.position_of[moved as usize] = at as u32;
         }
         Ok(())
+    }
+
+    /// Whether a body came, went or moved since the last call (a rebuilder's commit with
+    /// nothing changed keeps its pairs).
+    pub fn take_changed(&mut self) -> bool {
+        std::mem::take(&mut self.changed)
     }
 
     /// Heap bytes held.

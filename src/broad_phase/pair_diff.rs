@@ -36,6 +36,12 @@ impl PairHistory {
         std::mem::swap(&mut self.current, &mut self.next);
     }
 
+    /// A commit that found the same pairs as the one before (nothing moved): no changes.
+    pub fn keep(&mut self) {
+        self.added.clear();
+        self.removed.clear();
+    }
+
     /// The pairs of the last commit, sorted.
     pub fn current(&self) -> &[Pair] {
         &self.current

@@ -150,6 +150,13 @@ impl BroadPhase for SortAndSweep {
     }
 
     fn commit(&mut self) {
+        if !self.bodies.take_changed() {
+            // The same boxes find the same pairs: a game re-sending unchanged boxes (the ECS
+            // commits twice a step) pays nothing.
+            self.history.keep();
+            self.stats = StepStats::default();
+            return;
+        }
         let axis = sweep_axis(self.bodies.aabbs());
         fill_arrays(&mut self.arrays, &self.bodies, axis);
         let tests = sweep(&self.arrays, self.history.begin());
@@ -209,5 +216,28 @@ mod tests {
             })
             .collect();
         assert_eq!(sweep_axis(&boxes), 2);
+    }
+
+    /// A commit with the same boxes keeps the pairs, reports no change and rebuilds nothing;
+    /// one moved box brings the rebuild back.
+    #[test]
+    fn a_commit_with_the_same_boxes_rebuilds_nothing_and_reports_no_change() {
+        let at = |x: f32| Aabb::from_center_half_extents(glam::Vec3::X * x, glam::Vec3::ONE);
+        let mut sweep = SortAndSweep::new();
+        for (id, x) in [(0, 0.0), (1, 1.5), (2, 5.0)] {
+            sweep.insert(id, at(x), BodyKind::Dynamic).unwrap();
+        }
+        sweep.commit();
+        assert_eq!(sweep.added(), &[Pair::ordered(0, 1)]);
+        sweep.update(2, at(5.0)).unwrap();
+        sweep.commit();
+        assert!(sweep.added().is_empty() && sweep.removed().is_empty());
+        assert_eq!(sweep.pairs(), &[Pair::ordered(0, 1)]);
+        assert!(!sweep.stats().rebuilt);
+        sweep.update(2, at(3.0)).unwrap();
+        sweep.commit();
+        assert!(sweep.stats().rebuilt);
+        assert_eq!(sweep.added(), &[Pair::ordered(1, 2)]);
+        assert!(sweep.removed().is_empty());
     }
 }

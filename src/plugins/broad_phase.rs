@@ -233,8 +233,10 @@ fn sync_broad_phase(
     index.moving.commit();
     index.proxies.end_step();
     let steps = index.moving.stats();
-    stats.set_counter("broad_phase/sap_swaps", steps.endpoint_swaps as f64);
-    stats.set_counter(
+    // Summed: the index is committed at the step's start and again in its substeps, and a
+    // commit with nothing moved would otherwise hide the one that did the work.
+    stats.add_counter("broad_phase/sap_swaps", steps.endpoint_swaps as f64);
+    stats.add_counter(
         "broad_phase/rebuilt_from_scratch",
         f64::from(u8::from(steps.rebuilt)),
     );
