@@ -51,6 +51,7 @@ impl PairMasses {
     /// Applies the impulse `λ` of a row, linear part `l λ`, angular parts `u_a λ`, `u_b λ`:
     /// `v_a −= W_a l λ` (`W` the per-axis `1/m`), `ω_a −= I_a⁻¹ u_a λ`, and the opposite
     /// signs for B.
+    #[inline]
     pub fn apply(
         &self,
         states: &mut [BodyState],
@@ -248,16 +249,32 @@ pub fn skew(v: Vec3) -> Mat3 {
 }
 
 /// The point rows' `K` for anchors `r_a`, `r_b` (see the module doc).
+#[inline]
 pub fn point_mass(m: &PairMasses, r_a: Vec3, r_b: Vec3) -> Mat3 {
-    let (sa, sb) = (skew(r_a), skew(r_b));
     let [ia, ib] = m.inverse_inertia;
-    Mat3::from_diagonal(m.inverse_mass[0] + m.inverse_mass[1]) - sa * ia * sa - sb * ib * sb
+    Mat3::from_diagonal(m.inverse_mass[0] + m.inverse_mass[1])
+        - skew_sandwich(r_a, ia)
+        - skew_sandwich(r_b, ib)
+}
+
+/// `[r]× I [r]×` in 36 multiplications instead of two matrix products' 54 (it is taken for
+/// every joint in every substep): the columns of `[r]× I` are `r` crossed with `I`'s columns,
+/// and multiplying by `[r]×` combines them with `[r]×`'s entries, a third of which are zero.
+#[inline]
+fn skew_sandwich(r: Vec3, i: Mat3) -> Mat3 {
+    let c = [r.cross(i.x_axis), r.cross(i.y_axis), r.cross(i.z_axis)];
+    Mat3::from_cols(
+        c[1] * r.z - c[2] * r.y,
+        c[2] * r.x - c[0] * r.z,
+        c[0] * r.y - c[1] * r.x,
+    )
 }
 
 /// Solves the point rows: anchors `r_a`, `r_b` (world, now), position error `c` (`None` in a
 /// relax pass), `k_inverse` the rows' effective mass ([`point_mass`] inverted by
 /// [`inverse_mass`]); `accumulated` is the world impulse on B. Returns the impulse applied.
 #[allow(clippy::too_many_arguments)]
+#[inline]
 pub fn solve_point(
     m: &PairMasses,
     states: &mut [BodyState],
@@ -498,6 +515,31 @@ mod tests {
             (acc.abs() - (1.0 / 12.0 + 0.25) * 2.0).abs() < 1e-4,
             "{acc}"
         );
+    }
+
+    #[test]
+    fn the_skew_sandwich_equals_the_two_matrix_products_within_1e_5() {
+        let mut seed = 7u32;
+        let mut next = || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (seed >> 8) as f32 / (1u32 << 24) as f32 * 4.0 - 2.0
+        };
+        for _ in 0..1000 {
+            let r = Vec3::new(next(), next(), next());
+            let i = Mat3::from_cols_array(&std::array::from_fn(|_| next()));
+            let expected = skew(r) * i * skew(r);
+            let got = skew_sandwich(r, i);
+            let scale = 1.0
+                + expected
+                    .abs()
+                    .to_cols_array()
+                    .iter()
+                    .fold(0.0f32, |a, &b| a.max(b));
+            assert!(
+                got.abs_diff_eq(expected, 1e-5 * scale),
+                "{got} vs {expected}"
+            );
+        }
     }
 
     #[test]

@@ -9,7 +9,7 @@
 //!    last step's impulses ([`WarmStartCache`]), then packed up to four at a time into
 //!    [`ContactBatch`]es of contacts that share no moving body ([`ordered_batches`]); joints
 //!    seeded with theirs, held to what the speed and spin bounds allow
-//!    ([`JointConstraint::bound_impulses`]);
+//!    (`joint_list.rs`, `JointList::bound_impulses`);
 //! 2. `substeps` times:
 //!    1. **integrate velocities** — springs, then gravity, forces, torques and damping, all
 //!       evaluated at the substep's starting state (so a stiff spring is as stable as the
@@ -51,7 +51,9 @@ pub mod body;
 pub mod contact;
 mod integrate;
 pub mod joint;
+mod joint_extra;
 pub mod joint_input;
+mod joint_list;
 pub mod joint_rows;
 pub mod lanes;
 pub mod ordered_batches;
@@ -77,6 +79,7 @@ use crate::dynamics::forces::{ForceModel, Spring, SpringEnd};
 use crate::settings::{MAX_SUBSTEPS, SettingsError};
 use glam::Vec3;
 use integrate::{capped, integrate_positions, integrate_velocities};
+use joint_list::JointList;
 use ordered_batches::OrderedBatches;
 
 /// How many times the speed and spin bounds a joint's carried impulses may change a body's
@@ -210,10 +213,8 @@ pub struct Solver {
     clamped_springs: usize,
     /// How many joints of the last step carried impulses past the warm-start bound.
     bounded_joints: usize,
-    /// The step's joints, with their impulses.
-    joints: Vec<JointConstraint>,
-    /// Last step's joint impulses by key, for the warm start.
-    joint_cache: Vec<(u64, JointImpulses)>,
+    /// The step's joints, with their impulses (and last step's, for the warm start).
+    joints: JointList,
     /// The last step's substep (s).
     substep: f32,
 }
@@ -236,7 +237,7 @@ impl Solver {
     /// The joints of the last step, with their impulses (in the order given; see
     /// [`JointConstraint::load`] for the force each applied).
     pub fn joints(&self) -> &[JointConstraint] {
-        &self.joints
+        self.joints.joints()
     }
 
     /// The last step's substep (s).
@@ -270,7 +271,7 @@ impl Solver {
         let inv_h = 1.0 / h;
         self.substep = h;
         self.prepare(bodies, contacts, h);
-        self.prepare_joints(bodies, joints);
+        self.joints.prepare(bodies, joints);
         self.bound_joint_impulses(inv_h);
         let joint_soft = Softness::new(s.joint_hertz, s.joint_damping_ratio, h);
         self.stabilise_springs(bodies, springs, h);
@@ -286,22 +287,18 @@ impl Solver {
             integrate_velocities(bodies, h);
             flip = !flip;
             // Joints before contacts, as Box2D: the contacts, solved last, win a conflict.
-            for j in &self.joints {
-                j.warm_start(&mut bodies.states);
-            }
+            self.joints.warm_start(&mut bodies.states);
             self.warm_start(bodies, flip);
             self.solve_joints(bodies, joint_soft, h, true);
             self.solve_contacts(bodies, inv_h, true, flip);
             integrate_positions(bodies, h, s.max_rotation_per_substep, s.max_linear_speed);
-            for j in &mut self.joints {
-                j.refresh(&bodies.states);
-            }
+            self.joints.refresh(&bodies.states);
             for _ in 0..s.relax_iterations {
                 self.solve_joints(bodies, joint_soft, h, false);
                 self.solve_contacts(bodies, inv_h, false, flip);
             }
         }
-        self.store_joint_impulses();
+        self.joints.store();
         for batch in &self.batches {
             batch.unpack(&mut self.constraints);
         }
@@ -315,38 +312,14 @@ impl Solver {
         self.stable_springs = springs;
     }
 
-    /// Prepares the step's joints, each seeded with its impulses of the last step.
-    fn prepare_joints(&mut self, bodies: &SolverBodies, joints: &[JointInput]) {
-        let n = bodies.len() as u32;
-        self.joints.clear();
-        for joint in joints {
-            let usable = joint.frame_a.is_usable()
-                && joint.frame_b.is_usable()
-                && joint.kind.problem().is_none();
-            if joint.a >= n || joint.b >= n || joint.a == joint.b || !usable {
-                continue;
-            }
-            let mut c = JointConstraint::prepare(joint, bodies);
-            if let Ok(i) = self.joint_cache.binary_search_by_key(&joint.key, |e| e.0) {
-                c.impulses = self.joint_cache[i].1;
-            }
-            self.joints.push(c);
-        }
-    }
-
     /// Holds the impulses each joint carries into the step to what could change a body's
     /// velocity by [`WARM_START_BOUND`] times the speed and spin bounds (see
-    /// [`JointConstraint::bound_impulses`]).
+    /// `JointList::bound_impulses`).
     fn bound_joint_impulses(&mut self, inv_h: f32) {
         let s = &self.settings;
         let max_speed = WARM_START_BOUND * s.max_linear_speed;
         let max_spin = WARM_START_BOUND * s.max_rotation_per_substep * inv_h;
-        self.bounded_joints = 0;
-        for j in &mut self.joints {
-            if j.bound_impulses(max_speed, max_spin) {
-                self.bounded_joints += 1;
-            }
-        }
+        self.bounded_joints = self.joints.bound_impulses(max_speed, max_spin);
     }
 
     /// The relax passes and the bounces after the last move can still speed a dynamic body
@@ -365,17 +338,7 @@ impl Solver {
 
     /// One pass over the joints, biased or relaxing.
     fn solve_joints(&mut self, bodies: &mut SolverBodies, soft: Softness, h: f32, bias: bool) {
-        for j in &mut self.joints {
-            j.solve(&mut bodies.states, soft, h, bias);
-        }
-    }
-
-    /// Keeps the joints' impulses for the next step's warm start, by key.
-    fn store_joint_impulses(&mut self) {
-        self.joint_cache.clear();
-        self.joint_cache
-            .extend(self.joints.iter().map(|j| (j.input.key, j.impulses)));
-        self.joint_cache.sort_unstable_by_key(|e| e.0);
+        self.joints.solve(&mut bodies.states, soft, h, bias);
     }
 
     /// How many springs of the last step were too stiff or too damped for the substep and were
@@ -386,7 +349,7 @@ impl Solver {
 
     /// How many joints carried impulses into the last step that were not finite or could have
     /// changed a body's velocity by more than twice the speed or spin bound,
-    /// and were dropped or scaled down ([`JointConstraint::bound_impulses`]). Joints that keep
+    /// and were dropped or scaled down (`joint_list.rs`, `JointList::bound_impulses`). Joints that keep
     /// tripping it fight each other or carry far more than their bodies can take.
     pub fn bounded_joints(&self) -> usize {
         self.bounded_joints

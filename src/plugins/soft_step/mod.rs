@@ -120,7 +120,7 @@ impl SoftStepSolver {
         self.solver
             .joints()
             .iter()
-            .map(move |j| (Entity::from_bits(j.input.key), j.load(h)))
+            .map(move |j| (Entity::from_bits(j.key), j.load(h)))
     }
 
     /// A solver with these settings (unusable ones step with the defaults; see

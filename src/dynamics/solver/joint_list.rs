@@ -1,0 +1,167 @@
+//! The step's joints as the solver keeps them: every joint's [`JointConstraint`] in one dense
+//! array that every pass streams, the extra rows of the kinds that have them in another
+//! ([`JointExtra`]), and last step's impulses by key for the warm start (Box2D v3's joint
+//! arrays and its `b2WarmStartJoint` / `b2SolveJoint` passes).
+
+use super::body::{BodyState, SolverBodies};
+use super::joint::{JointConstraint, JointImpulses, JointInput};
+use super::joint_extra::{JointExtra, Pass};
+use super::softness::Softness;
+
+/// The step's joints (see the module doc).
+#[derive(Clone, Debug, Default)]
+pub(super) struct JointList {
+    joints: Vec<JointConstraint>,
+    extras: Vec<JointExtra>,
+    /// Last step's impulses by key, sorted.
+    cache: Vec<(u64, JointImpulses)>,
+}
+
+impl JointList {
+    /// The step's joints, with their impulses.
+    pub(super) fn joints(&self) -> &[JointConstraint] {
+        &self.joints
+    }
+
+    /// Prepares the step's joints over `bodies`, each seeded with its impulses of the last
+    /// step. A joint naming a slot past the bodies or one body twice, or with unusable frames,
+    /// limit or motor, is skipped (see [`JointKind::problem`](super::JointKind::problem)).
+    pub(super) fn prepare(&mut self, bodies: &SolverBodies, inputs: &[JointInput]) {
+        let n = bodies.len() as u32;
+        self.joints.clear();
+        self.extras.clear();
+        for joint in inputs {
+            let usable = joint.frame_a.is_usable()
+                && joint.frame_b.is_usable()
+                && joint.kind.problem().is_none();
+            if joint.a >= n || joint.b >= n || joint.a == joint.b || !usable {
+                continue;
+            }
+            let mut c = JointConstraint::prepare(joint, bodies);
+            if let Ok(i) = self.cache.binary_search_by_key(&joint.key, |e| e.0) {
+                c.impulses = self.cache[i].1;
+            }
+            let turns = (
+                bodies.orientations[joint.a as usize],
+                bodies.orientations[joint.b as usize],
+            );
+            if let Some(mut extra) = JointExtra::prepare(joint, &c.masses, turns) {
+                let start = BodyState::default();
+                extra.refresh(&c.masses, &start, &start, &c.point);
+                c.extra = Some(self.extras.len() as u32);
+                self.extras.push(extra);
+            }
+            self.joints.push(c);
+        }
+    }
+
+    /// Holds the impulses each joint carries into the step to what could change a body's
+    /// velocity by at most `max_speed` and its spin by at most `max_spin`, and drops them if
+    /// they are not finite. A joint fighting another one that holds the same body somewhere
+    /// else (two joints to static bodies at places the body cannot reach at once) otherwise
+    /// grows its rigid passes' impulses step after step until they overflow. The bound is per
+    /// joint: a sound joint can reach it too where a light, thin body carries a heavy one (a
+    /// 0.2 kg rod holding 10 kg 10 cm off its axis), and is then held to it. Returns how many
+    /// joints it changed.
+    pub(super) fn bound_impulses(&mut self, max_speed: f32, max_spin: f32) -> usize {
+        let mut bounded = 0;
+        for i in 0..self.joints.len() {
+            if self.joints[i].impulses == JointImpulses::default() {
+                continue;
+            }
+            let mut effect = [BodyState::default(); 2];
+            self.apply_impulses(i, &mut effect, (0, 1));
+            let joint = &mut self.joints[i];
+            let finite = effect
+                .iter()
+                .all(|s| s.linear_velocity.is_finite() && s.angular_velocity.is_finite());
+            if !finite {
+                joint.impulses = JointImpulses::default();
+                bounded += 1;
+                continue;
+            }
+            let over = effect
+                .iter()
+                .map(|s| {
+                    let speed = s.linear_velocity.length_squared() / (max_speed * max_speed);
+                    let spin = s.angular_velocity.length_squared() / (max_spin * max_spin);
+                    speed.max(spin)
+                })
+                .fold(0.0f32, f32::max);
+            if over > 1.0 {
+                joint.impulses.scale(1.0 / over.sqrt());
+                bounded += 1;
+            }
+        }
+        bounded
+    }
+
+    /// Applies joint `i`'s accumulated impulses to the bodies in `states` at slots `ab`.
+    fn apply_impulses(&self, i: usize, states: &mut [BodyState], ab: (usize, usize)) {
+        let joint = &self.joints[i];
+        joint.apply_point_impulse(states, ab);
+        if let Some(x) = joint.extra {
+            let extra = &self.extras[x as usize];
+            extra.apply_impulses(&joint.masses, states, ab, &joint.impulses);
+        }
+    }
+
+    /// Applies every joint's accumulated impulses.
+    pub(super) fn warm_start(&self, states: &mut [BodyState]) {
+        for i in 0..self.joints.len() {
+            self.apply_impulses(i, states, self.joints[i].slots());
+        }
+    }
+
+    /// One pass over every joint: biased (`soft` closes the position errors) or relaxing
+    /// (rigid, no bias); per joint its motor and limits, then the rows that hold it together,
+    /// the point rows last (Box2D's order: the hard rows last, so they win).
+    pub(super) fn solve(
+        &mut self,
+        states: &mut [BodyState],
+        soft: Softness,
+        h: f32,
+        use_bias: bool,
+    ) {
+        for joint in &mut self.joints {
+            if let Some(x) = joint.extra {
+                let ab = joint.slots();
+                let pass = Pass {
+                    masses: &joint.masses,
+                    ab,
+                    soft,
+                    h,
+                    use_bias,
+                };
+                self.extras[x as usize].solve(&pass, states, &mut joint.impulses);
+            }
+            joint.solve_point(states, soft, use_bias);
+        }
+    }
+
+    /// Takes every joint's rows where the bodies are now (after their positions moved).
+    pub(super) fn refresh(&mut self, states: &[BodyState]) {
+        for joint in &mut self.joints {
+            let (a, b) = joint.slots();
+            let (sa, sb) = (&states[a], &states[b]);
+            joint.refresh(sa, sb);
+            if let Some(x) = joint.extra {
+                self.extras[x as usize].refresh(&joint.masses, sa, sb, &joint.point);
+            }
+        }
+    }
+
+    /// Sets joint `i`'s carried point impulse (a test's stand-in for a bad warm start).
+    #[cfg(test)]
+    pub(super) fn set_impulses(&mut self, i: usize, point: glam::Vec3) {
+        self.joints[i].impulses.point = point;
+    }
+
+    /// Keeps the joints' impulses for the next step's warm start, by key.
+    pub(super) fn store(&mut self) {
+        self.cache.clear();
+        self.cache
+            .extend(self.joints.iter().map(|j| (j.key, j.impulses)));
+        self.cache.sort_unstable_by_key(|e| e.0);
+    }
+}
