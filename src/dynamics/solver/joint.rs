@@ -98,9 +98,9 @@ pub struct JointConstraint {
     /// The bodies' masses.
     pub(super) masses: PairMasses,
     /// Anchors from the centres of mass, world, at the step's start.
-    anchors: [Vec3; 2],
+    pub(super) anchors: [Vec3; 2],
     /// `c_b − c_a` at the step's start.
-    delta_center: Vec3,
+    pub(super) delta_center: Vec3,
     /// The point rows where the bodies are now ([`Self::refresh`]).
     pub(super) point: PointRows,
 }
@@ -145,6 +145,12 @@ impl JointConstraint {
         let start = BodyState::default();
         c.refresh(&start, &start);
         c
+    }
+
+    /// Whether the joint is nothing but its point rows (a ball joint without limits): the
+    /// joints that ride in [`JointBatch`](super::joint_batch::JointBatch)es.
+    pub(super) fn is_free_ball(&self) -> bool {
+        self.holds_point && self.extra.is_none()
     }
 
     /// The bodies' slots.

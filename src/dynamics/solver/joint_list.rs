@@ -1,11 +1,17 @@
 //! The step's joints as the solver keeps them: every joint's [`JointConstraint`] in one dense
-//! array that every pass streams, the extra rows of the kinds that have them in another
-//! ([`JointExtra`]), and last step's impulses by key for the warm start (Box2D v3's joint
-//! arrays and its `b2WarmStartJoint` / `b2SolveJoint` passes).
+//! array, the extra rows of the kinds that have them in another ([`JointExtra`]), and last
+//! step's impulses by key for the warm start (Box2D v3's joint arrays and its
+//! `b2WarmStartJoint` / `b2SolveJoint` passes).
+//!
+//! The free ball joints ride four at a time in [`JointBatch`]es, packed by the contacts'
+//! [`OrderedBatches`] so that the batches in order solve them as the key-order sweep would;
+//! the other joints are solved one at a time after the batches, in key order.
 
 use super::body::{BodyState, SolverBodies};
 use super::joint::{JointConstraint, JointImpulses, JointInput};
+use super::joint_batch::JointBatch;
 use super::joint_extra::{JointExtra, Pass};
+use super::ordered_batches::OrderedBatches;
 use super::softness::Softness;
 
 /// The step's joints (see the module doc).
@@ -15,6 +21,10 @@ pub(super) struct JointList {
     extras: Vec<JointExtra>,
     /// Last step's impulses by key, sorted.
     cache: Vec<(u64, JointImpulses)>,
+    /// Which joints ride in which batch, and which are solved one at a time.
+    batching: OrderedBatches,
+    /// The batches of the step (refilled in place each step).
+    batches: Vec<JointBatch>,
 }
 
 impl JointList {
@@ -24,9 +34,24 @@ impl JointList {
     }
 
     /// Prepares the step's joints over `bodies`, each seeded with its impulses of the last
-    /// step. A joint naming a slot past the bodies or one body twice, or with unusable frames,
-    /// limit or motor, is skipped (see [`JointKind::problem`](super::JointKind::problem)).
-    pub(super) fn prepare(&mut self, bodies: &SolverBodies, inputs: &[JointInput]) {
+    /// step held to `(max_speed, max_spin)` ([`Self::bound_impulses`]), and packs the free
+    /// ball joints into batches; returns how many joints the bound changed. A joint naming a
+    /// slot past the bodies or one body twice, or with unusable frames, limit or motor, is
+    /// skipped (see [`JointKind::problem`](super::JointKind::problem)).
+    pub(super) fn prepare(
+        &mut self,
+        bodies: &SolverBodies,
+        inputs: &[JointInput],
+        (max_speed, max_spin): (f32, f32),
+    ) -> usize {
+        self.gather(bodies, inputs);
+        let bounded = self.bound_impulses(max_speed, max_spin);
+        self.pack(bodies.len());
+        bounded
+    }
+
+    /// The usable joints of `inputs`, seeded with their impulses of the last step.
+    fn gather(&mut self, bodies: &SolverBodies, inputs: &[JointInput]) {
         let n = bodies.len() as u32;
         self.joints.clear();
         self.extras.clear();
@@ -96,6 +121,29 @@ impl JointList {
         bounded
     }
 
+    /// Packs the free ball joints into batches over `bodies` slots (after the carried impulses
+    /// are bounded: the batches take them as they are).
+    fn pack(&mut self, bodies: usize) {
+        let joints = &self.joints;
+        self.batching.pack_by(joints.len(), bodies, |i| {
+            let j = &joints[i];
+            let (a, b) = j.slots();
+            let moved = [(a, j.masses.dynamic[0]), (b, j.masses.dynamic[1])];
+            j.is_free_ball()
+                .then(|| moved.map(|(slot, dynamic)| dynamic.then_some(slot)))
+        });
+        let mut used = 0;
+        for members in self.batching.batches() {
+            if used == self.batches.len() {
+                self.batches.push(JointBatch::default());
+            }
+            if self.batches[used].repack(members, joints) {
+                used += 1;
+            }
+        }
+        self.batches.truncate(used);
+    }
+
     /// Applies joint `i`'s accumulated impulses to the bodies in `states` at slots `ab`.
     fn apply_impulses(&self, i: usize, states: &mut [BodyState], ab: (usize, usize)) {
         let joint = &self.joints[i];
@@ -108,14 +156,18 @@ impl JointList {
 
     /// Applies every joint's accumulated impulses.
     pub(super) fn warm_start(&self, states: &mut [BodyState]) {
-        for i in 0..self.joints.len() {
+        for batch in &self.batches {
+            batch.warm_start(states);
+        }
+        for &i in self.batching.one_by_one() {
+            let i = i as usize;
             self.apply_impulses(i, states, self.joints[i].slots());
         }
     }
 
     /// One pass over every joint: biased (`soft` closes the position errors) or relaxing
-    /// (rigid, no bias); per joint its motor and limits, then the rows that hold it together,
-    /// the point rows last (Box2D's order: the hard rows last, so they win).
+    /// (rigid, no bias); the batches, then per joint its motor and limits and the rows that
+    /// hold it together, the point rows last (Box2D's order: the hard rows last, so they win).
     pub(super) fn solve(
         &mut self,
         states: &mut [BodyState],
@@ -123,7 +175,11 @@ impl JointList {
         h: f32,
         use_bias: bool,
     ) {
-        for joint in &mut self.joints {
+        for batch in &mut self.batches {
+            batch.solve(states, soft, use_bias);
+        }
+        for &i in self.batching.one_by_one() {
+            let joint = &mut self.joints[i as usize];
             if let Some(x) = joint.extra {
                 let ab = joint.slots();
                 let pass = Pass {
@@ -141,7 +197,11 @@ impl JointList {
 
     /// Takes every joint's rows where the bodies are now (after their positions moved).
     pub(super) fn refresh(&mut self, states: &[BodyState]) {
-        for joint in &mut self.joints {
+        for batch in &mut self.batches {
+            batch.refresh(states);
+        }
+        for &i in self.batching.one_by_one() {
+            let joint = &mut self.joints[i as usize];
             let (a, b) = joint.slots();
             let (sa, sb) = (&states[a], &states[b]);
             joint.refresh(sa, sb);
@@ -157,8 +217,31 @@ impl JointList {
         self.joints[i].impulses.point = point;
     }
 
+    /// Sets every joint's point impulse to `point(i)`, in the joints and their batches.
+    #[cfg(test)]
+    pub(super) fn set_impulses_all(&mut self, point: impl Fn(usize) -> glam::Vec3) {
+        for (i, j) in self.joints.iter_mut().enumerate() {
+            j.impulses.point = point(i);
+        }
+        let bodies = self.batching.bodies();
+        self.pack(bodies);
+    }
+
+    /// How many joints ride in lanes next to another.
+    #[cfg(test)]
+    pub(super) fn batch_lanes(&self) -> usize {
+        self.batching
+            .batches()
+            .filter(|b| b.len() > 1)
+            .map(<[u32]>::len)
+            .sum()
+    }
+
     /// Keeps the joints' impulses for the next step's warm start, by key.
     pub(super) fn store(&mut self) {
+        for batch in &self.batches {
+            batch.unpack(&mut self.joints);
+        }
         self.cache.clear();
         self.cache
             .extend(self.joints.iter().map(|j| (j.key, j.impulses)));

@@ -6,7 +6,7 @@
 //! ones, so a lane computes what the scalar solver computes for the same contact (up to the
 //! rounding of glam's quaternion rotation).
 
-use glam::{Quat, Vec3};
+use glam::{Mat3, Quat, Vec3};
 use std::ops::{Add, Mul, Neg, Sub};
 use wide::f32x4;
 
@@ -149,6 +149,110 @@ impl Quatx4 {
     }
 }
 
+/// A 3×3 matrix per lane, by columns.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Mat3x4 {
+    /// The columns.
+    pub cols: [Vec3x4; 3],
+}
+
+impl Mat3x4 {
+    /// Lane `i` holds `m[i]`.
+    pub fn gather(m: [Mat3; LANES]) -> Self {
+        Self {
+            cols: [0, 1, 2].map(|c| Vec3x4::gather(m.map(|m| m.col(c)))),
+        }
+    }
+
+    /// The diagonal matrix of `d` per lane.
+    pub fn diagonal(d: Vec3x4) -> Self {
+        let zero = Lanes::ZERO;
+        let column = |x, y, z| Vec3x4 { x, y, z };
+        Self {
+            cols: [
+                column(d.x, zero, zero),
+                column(zero, d.y, zero),
+                column(zero, zero, d.z),
+            ],
+        }
+    }
+
+    /// Per-lane matrix times vector.
+    pub fn mul_vec(&self, v: Vec3x4) -> Vec3x4 {
+        let [x, y, z] = self.cols;
+        x * v.x + y * v.y + z * v.z
+    }
+
+    /// `[r]× M [r]×` per lane, as [`skew_sandwich`](super::joint_rows) computes it.
+    pub fn skew_sandwich(&self, r: Vec3x4) -> Self {
+        let c = self.cols.map(|col| r.cross(col));
+        Self {
+            cols: [
+                c[1] * r.z - c[2] * r.y,
+                c[2] * r.x - c[0] * r.z,
+                c[0] * r.y - c[1] * r.x,
+            ],
+        }
+    }
+
+    /// Per-lane difference.
+    pub fn sub(&self, o: &Self) -> Self {
+        Self {
+            cols: [0, 1, 2].map(|c| self.cols[c] - o.cols[c]),
+        }
+    }
+
+    /// The inverse of a symmetric positive semi-definite matrix per lane, as
+    /// [`inverse_mass`](super::joint_rows::inverse_mass) takes it: the inverse where it is well
+    /// conditioned, else the inverse of the diagonal (0 for a non-positive entry).
+    pub fn inverse_mass(&self) -> Self {
+        let [x, y, z] = self.cols;
+        // glam's `Mat3::inverse`: the adjugate's rows are the columns' cross products.
+        let (t0, t1, t2) = (y.cross(z), z.cross(x), x.cross(y));
+        let det = z.dot(t2);
+        let scale = x.x * y.y * z.z;
+        let zero = Lanes::ZERO;
+        let sound = det.is_finite() & det.simd_gt(Lanes::splat(1e-6) * scale) & scale.simd_gt(zero);
+        let inv_det = sound.select(Lanes::ONE / det, zero);
+        let row = |t: Vec3x4| t * inv_det;
+        let (r0, r1, r2) = (row(t0), row(t1), row(t2));
+        let general = [
+            Vec3x4 {
+                x: r0.x,
+                y: r1.x,
+                z: r2.x,
+            },
+            Vec3x4 {
+                x: r0.y,
+                y: r1.y,
+                z: r2.y,
+            },
+            Vec3x4 {
+                x: r0.z,
+                y: r1.z,
+                z: r2.z,
+            },
+        ];
+        let inv = |d: Lanes| {
+            let positive = d.simd_gt(zero);
+            positive.select(Lanes::ONE / positive.select(d, Lanes::ONE), zero)
+        };
+        let diagonal = Self::diagonal(Vec3x4 {
+            x: inv(x.x),
+            y: inv(y.y),
+            z: inv(z.z),
+        });
+        let pick = |g: Vec3x4, d: Vec3x4| Vec3x4 {
+            x: sound.select(g.x, d.x),
+            y: sound.select(g.y, d.y),
+            z: sound.select(g.z, d.z),
+        };
+        Self {
+            cols: [0, 1, 2].map(|c| pick(general[c], diagonal.cols[c])),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -173,6 +277,32 @@ mod tests {
             let scale = a[i].length() * b[i].length() + 1.0;
             assert!((dots[i] - a[i].dot(b[i])).abs() <= 1e-6 * scale);
             assert!((cross.lane(i) - a[i].cross(b[i])).length() <= 1e-6 * scale);
+        }
+    }
+
+    /// A well-conditioned lane, a singular one (a body turning about one axis only), a
+    /// zero one (a padding lane) and a badly scaled one, against the scalar rule.
+    #[test]
+    fn lanes_invert_effective_masses_as_the_scalar_rule_within_1e_5_relative() {
+        use crate::dynamics::solver::joint_rows::inverse_mass;
+        let m = [
+            Mat3::from_cols_array(&[2.0, 0.3, -0.1, 0.3, 1.5, 0.2, -0.1, 0.2, 1.0]),
+            Mat3::from_diagonal(Vec3::new(1.0, 0.0, 0.0)),
+            Mat3::ZERO,
+            Mat3::from_diagonal(Vec3::new(1e4, 2e-3, 7.0)),
+        ];
+        let wide = Mat3x4::gather(m).inverse_mass();
+        for (lane, m) in m.iter().enumerate() {
+            let expected = inverse_mass(*m);
+            for c in 0..3 {
+                let got = wide.cols[c].lane(lane);
+                let want = expected.col(c);
+                let error = (got - want).length();
+                assert!(
+                    error <= 1e-5 * (want.length() + 1.0),
+                    "lane {lane}: {got} vs {want}"
+                );
+            }
         }
     }
 

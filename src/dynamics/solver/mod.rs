@@ -51,6 +51,7 @@ pub mod body;
 pub mod contact;
 mod integrate;
 pub mod joint;
+mod joint_batch;
 mod joint_extra;
 pub mod joint_input;
 mod joint_list;
@@ -271,8 +272,7 @@ impl Solver {
         let inv_h = 1.0 / h;
         self.substep = h;
         self.prepare(bodies, contacts, h);
-        self.joints.prepare(bodies, joints);
-        self.bound_joint_impulses(inv_h);
+        self.prepare_joints(bodies, joints, inv_h);
         let joint_soft = Softness::new(s.joint_hertz, s.joint_damping_ratio, h);
         self.stabilise_springs(bodies, springs, h);
         let springs = std::mem::take(&mut self.stable_springs);
@@ -312,14 +312,14 @@ impl Solver {
         self.stable_springs = springs;
     }
 
-    /// Holds the impulses each joint carries into the step to what could change a body's
-    /// velocity by [`WARM_START_BOUND`] times the speed and spin bounds (see
-    /// `JointList::bound_impulses`).
-    fn bound_joint_impulses(&mut self, inv_h: f32) {
+    /// Prepares the step's joints, holding the impulses each carries into the step to what
+    /// could change a body's velocity by [`WARM_START_BOUND`] times the speed and spin bounds
+    /// (see `JointList::bound_impulses`).
+    fn prepare_joints(&mut self, bodies: &SolverBodies, joints: &[JointInput], inv_h: f32) {
         let s = &self.settings;
         let max_speed = WARM_START_BOUND * s.max_linear_speed;
         let max_spin = WARM_START_BOUND * s.max_rotation_per_substep * inv_h;
-        self.bounded_joints = self.joints.bound_impulses(max_speed, max_spin);
+        self.bounded_joints = self.joints.prepare(bodies, joints, (max_speed, max_spin));
     }
 
     /// The relax passes and the bounces after the last move can still speed a dynamic body

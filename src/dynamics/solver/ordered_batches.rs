@@ -39,20 +39,35 @@ impl OrderedBatches {
     /// Packs `constraints` over `bodies` slots (from scratch each step: a few array lookups per
     /// contact).
     pub fn pack(&mut self, constraints: &[ContactConstraint], bodies: usize) {
+        self.pack_by(constraints.len(), bodies, |i| {
+            let c = &constraints[i];
+            let moved = [(c.a, c.dynamic[0]), (c.b, c.dynamic[1])]
+                .map(|(slot, dynamic)| dynamic.then_some(slot as usize));
+            (c.rolling.arm == 0.0 && !c.translation_locked).then_some(moved)
+        });
+    }
+
+    /// Packs `count` constraints over `bodies` slots: `moved(i)` gives the slots constraint
+    /// `i` moves (a static or kinematic side as `None`), or `None` for a constraint the
+    /// batches do not carry; it and those that move no body are solved one at a time.
+    pub fn pack_by(
+        &mut self,
+        count: usize,
+        bodies: usize,
+        moved: impl Fn(usize) -> Option<[Option<usize>; 2]>,
+    ) {
         self.members.clear();
         self.used.clear();
         self.room.clear();
         self.one_by_one.clear();
         self.after.clear();
         self.after.resize(bodies, 0);
-        for (i, c) in constraints.iter().enumerate() {
-            let moved = [(c.a, c.dynamic[0]), (c.b, c.dynamic[1])].map(|(slot, dynamic)| {
-                (dynamic && (slot as usize) < bodies).then_some(slot as usize)
-            });
-            if c.rolling.arm != 0.0 || c.translation_locked || moved.iter().all(Option::is_none) {
+        for i in 0..count {
+            let slots = moved(i).map(|m| m.map(|s| s.filter(|&s| s < bodies)));
+            let Some(moved) = slots.filter(|m| m.iter().any(Option::is_some)) else {
                 self.one_by_one.push(i as u32);
                 continue;
-            }
+            };
             let earliest = moved
                 .iter()
                 .flatten()
@@ -102,6 +117,11 @@ impl OrderedBatches {
             .iter()
             .enumerate()
             .map(|(k, &n)| &self.members[k * LANES..k * LANES + n as usize])
+    }
+
+    /// The body slots of the last packing.
+    pub fn bodies(&self) -> usize {
+        self.after.len()
     }
 
     /// The contacts solved one at a time, after the batches.

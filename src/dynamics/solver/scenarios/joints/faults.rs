@@ -151,7 +151,8 @@ fn a_nan_carried_impulse_is_dropped_and_a_huge_one_scaled_until_the_spin_is_at_i
     let bob = bob_below_pivot(&mut scene, Vec3::Z, BALL);
     scene.step();
     let mut list = JointList::default();
-    list.prepare(&scene.arrays, &scene.joints);
+    let unbounded = (f32::INFINITY, f32::INFINITY);
+    assert_eq!(list.prepare(&scene.arrays, &scene.joints, unbounded), 0);
     list.set_impulses(0, Vec3::new(f32::NAN, 0.0, 0.0));
     assert_eq!(list.bound_impulses(800.0, 100.0), 1);
     assert_eq!(list.joints()[0].impulses, JointImpulses::default());

@@ -1,0 +1,340 @@
+//! Four ball joints solved at once: the point rows of [`JointConstraint`] laid out one joint
+//! per SIMD lane, as [`ContactBatch`](super::ContactBatch) lays out contacts (rapier's
+//! `JointConstraint<SimdReal, 4>`, Box2D v3's wide solver).
+//!
+//! Only joints that are nothing but their point rows ride in lanes: free ball joints, the
+//! joints of Box2D's `joint_grid`, of nets and of chains. The joints of a batch move no
+//! common body ([`OrderedBatches`](super::ordered_batches::OrderedBatches), so the batches in
+//! order give the key-order sweep of the scalar path), so no two lanes write the same
+//! velocities: a batch gathers its bodies' velocities, runs the scalar arithmetic of
+//! [`joint_rows`](super::joint_rows) (`point_mass`, `inverse_mass`, `solve_point`) in every
+//! lane, and scatters them back. Padding lanes hold zero masses and impulses: their `K⁻¹` is
+//! zero and their impulses stay zero.
+
+use super::body::BodyState;
+use super::joint::JointConstraint;
+use super::lanes::{LANES, Lanes, Mat3x4, Quatx4, Vec3x4};
+use super::softness::Softness;
+use glam::{Mat3, Vec3};
+
+/// Up to four free ball joints that move no common body.
+#[derive(Clone, Debug, Default)]
+pub(super) struct JointBatch {
+    /// Which joint each lane holds (`None`: padding).
+    joints: [Option<u32>; LANES],
+    /// Body slots of A and B per lane (padding lanes repeat lane 0's).
+    bodies: [[usize; LANES]; 2],
+    /// Whether the lane writes A's and B's velocities back (dynamic bodies of real lanes).
+    writes: [[bool; LANES]; 2],
+    /// `1/m` per world axis of A and B.
+    inverse_mass: [Vec3x4; 2],
+    /// World `I⁻¹` of A and B at the step's start.
+    inverse_inertia: [Mat3x4; 2],
+    /// The anchors from the centres of mass at the step's start (world).
+    anchors: [Vec3x4; 2],
+    /// `c_b − c_a` at the step's start.
+    delta_center: Vec3x4,
+    /// The anchors where the bodies are now.
+    arms: [Vec3x4; 2],
+    /// Anchor to anchor where the bodies are now.
+    separation: Vec3x4,
+    /// The point rows' `K⁻¹` where the bodies are now.
+    k_inverse: Mat3x4,
+    /// The accumulated impulse on B.
+    impulse: Vec3x4,
+}
+
+impl JointBatch {
+    /// Packs joints `indices` (1 to [`LANES`] free ball joints moving no common body) of
+    /// `joints` into this batch, with their rows where the bodies are now; false (the batch
+    /// left as it was) for no index, too many or one out of range.
+    pub(super) fn repack(&mut self, indices: &[u32], joints: &[JointConstraint]) -> bool {
+        if indices.is_empty() || indices.len() > LANES {
+            return false;
+        }
+        let mut lanes: [Option<&JointConstraint>; LANES] = [None; LANES];
+        for (lane, &i) in lanes.iter_mut().zip(indices) {
+            match joints.get(i as usize) {
+                Some(j) => *lane = Some(j),
+                None => return false,
+            }
+        }
+        let Some(first) = lanes[0] else {
+            return false;
+        };
+        let real = |l: usize| lanes[l].unwrap_or(first).slots();
+        let vectors = |f: &dyn Fn(&JointConstraint) -> Vec3| {
+            Vec3x4::gather(std::array::from_fn(|l| lanes[l].map_or(Vec3::ZERO, f)))
+        };
+        let matrices = |f: &dyn Fn(&JointConstraint) -> Mat3| {
+            Mat3x4::gather(std::array::from_fn(|l| lanes[l].map_or(Mat3::ZERO, f)))
+        };
+        self.joints = std::array::from_fn(|l| indices.get(l).copied());
+        self.bodies = [
+            std::array::from_fn(|l| real(l).0),
+            std::array::from_fn(|l| real(l).1),
+        ];
+        self.writes =
+            [0, 1].map(|k| std::array::from_fn(|l| lanes[l].is_some_and(|j| j.masses.dynamic[k])));
+        self.inverse_mass = [0, 1].map(|k| vectors(&|j| j.masses.inverse_mass[k]));
+        self.inverse_inertia = [0, 1].map(|k| matrices(&|j| j.masses.inverse_inertia[k]));
+        self.anchors = [0, 1].map(|k| vectors(&|j| j.anchors[k]));
+        self.delta_center = vectors(&|j| j.delta_center);
+        self.arms = [
+            vectors(&|j| j.point.anchors.0),
+            vectors(&|j| j.point.anchors.1),
+        ];
+        self.separation = vectors(&|j| j.point.separation);
+        self.k_inverse = matrices(&|j| j.point.inverse_mass);
+        self.impulse = vectors(&|j| j.impulses.point);
+        true
+    }
+
+    /// Writes the impulses back into the joints the lanes came from.
+    pub(super) fn unpack(&self, joints: &mut [JointConstraint]) {
+        for (lane, index) in self.joints.iter().enumerate() {
+            if let Some(i) = index {
+                joints[*i as usize].impulses.point = self.impulse.lane(lane);
+            }
+        }
+    }
+
+    /// Applies the accumulated impulses.
+    pub(super) fn warm_start(&self, states: &mut [BodyState]) {
+        let mut pair = Velocities::load(self, states);
+        pair.push(self, self.impulse);
+        pair.store(self, states);
+    }
+
+    /// One pass: biased (`soft` closes the gaps) or relaxing (rigid), as
+    /// [`JointConstraint::solve_point`] per lane.
+    pub(super) fn solve(&mut self, states: &mut [BodyState], soft: Softness, use_bias: bool) {
+        let mut pair = Velocities::load(self, states);
+        let [r_a, r_b] = self.arms;
+        let cdot = pair.vb + pair.wb.cross(r_b) - pair.va - pair.wa.cross(r_a);
+        let soft = if use_bias { soft } else { Softness::RIGID };
+        let target = if use_bias {
+            cdot + self.separation * Lanes::splat(soft.bias_rate)
+        } else {
+            cdot
+        };
+        let impulse = self.k_inverse.mul_vec(target) * Lanes::splat(-soft.mass_scale)
+            - self.impulse * Lanes::splat(soft.impulse_scale);
+        self.impulse = self.impulse + impulse;
+        pair.push(self, impulse);
+        pair.store(self, states);
+    }
+
+    /// Takes the rows where the bodies are now, from their motion since the step's start (as
+    /// [`JointConstraint::refresh`] per lane).
+    pub(super) fn refresh(&mut self, states: &[BodyState]) {
+        let [a, b] = self.bodies;
+        let turn = |slots: [usize; LANES]| Quatx4::gather(slots.map(|i| states[i].delta_rotation));
+        let moved = |slots: [usize; LANES]| Vec3x4::gather(slots.map(|i| states[i].delta_position));
+        let r_a = turn(a).rotate(self.anchors[0]);
+        let r_b = turn(b).rotate(self.anchors[1]);
+        self.arms = [r_a, r_b];
+        self.separation = self.delta_center + moved(b) - moved(a) + r_b - r_a;
+        let [ia, ib] = &self.inverse_inertia;
+        let k = Mat3x4::diagonal(self.inverse_mass[0] + self.inverse_mass[1])
+            .sub(&ia.skew_sandwich(r_a))
+            .sub(&ib.skew_sandwich(r_b));
+        self.k_inverse = k.inverse_mass();
+    }
+}
+
+/// The velocities of a batch's bodies, one pair per lane.
+struct Velocities {
+    va: Vec3x4,
+    wa: Vec3x4,
+    vb: Vec3x4,
+    wb: Vec3x4,
+}
+
+impl Velocities {
+    fn load(batch: &JointBatch, states: &[BodyState]) -> Self {
+        let [a, b] = batch.bodies;
+        Self {
+            va: Vec3x4::gather(a.map(|i| states[i].linear_velocity)),
+            wa: Vec3x4::gather(a.map(|i| states[i].angular_velocity)),
+            vb: Vec3x4::gather(b.map(|i| states[i].linear_velocity)),
+            wb: Vec3x4::gather(b.map(|i| states[i].angular_velocity)),
+        }
+    }
+
+    /// The impulse `p` on B at its anchor, `−p` on A.
+    fn push(&mut self, batch: &JointBatch, p: Vec3x4) {
+        let [ma, mb] = batch.inverse_mass;
+        let [ia, ib] = &batch.inverse_inertia;
+        let [r_a, r_b] = batch.arms;
+        self.va = self.va - per_axis(p, ma);
+        self.wa = self.wa - ia.mul_vec(r_a.cross(p));
+        self.vb = self.vb + per_axis(p, mb);
+        self.wb = self.wb + ib.mul_vec(r_b.cross(p));
+    }
+
+    fn store(self, batch: &JointBatch, states: &mut [BodyState]) {
+        let [va, wa, vb, wb] = [self.va, self.wa, self.vb, self.wb].map(Vec3x4::to_vecs);
+        for lane in 0..LANES {
+            if batch.writes[0][lane] {
+                let s = &mut states[batch.bodies[0][lane]];
+                s.linear_velocity = va[lane];
+                s.angular_velocity = wa[lane];
+            }
+            if batch.writes[1][lane] {
+                let s = &mut states[batch.bodies[1][lane]];
+                s.linear_velocity = vb[lane];
+                s.angular_velocity = wb[lane];
+            }
+        }
+    }
+}
+
+/// `p ⊙ w` per lane (an impulse over per-axis masses).
+fn per_axis(p: Vec3x4, w: Vec3x4) -> Vec3x4 {
+    Vec3x4 {
+        x: p.x * w.x,
+        y: p.y * w.y,
+        z: p.z * w.z,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::joint_list::JointList;
+    use super::*;
+    use crate::dynamics::solver::{BodyInput, JointFrame, JointInput, JointKind, SolverBodies};
+    use glam::Quat;
+
+    /// Ten turning bodies (slot 0 static, slot 9 heavy and lopsided) and ball joints between
+    /// random pairs with random anchors, carrying impulses.
+    fn net(seed: u64) -> (SolverBodies, Vec<JointInput>) {
+        let mut s = seed;
+        let mut next = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+        };
+        let mut bodies = SolverBodies::default();
+        for i in 0..10 {
+            let f = i as f32;
+            let inverse_mass = match i {
+                0 => 0.0,
+                9 => 0.01,
+                _ => 1.0 / (1.0 + f),
+            };
+            bodies.push(BodyInput {
+                center: Vec3::new(f, next(), next()),
+                orientation: Quat::from_rotation_z(next()) * Quat::from_rotation_x(next()),
+                linear_velocity: Vec3::new(next(), next(), next()),
+                angular_velocity: Vec3::new(next(), next(), next()) * 3.0,
+                inverse_mass,
+                inverse_principal_inertia: Vec3::new(2.0, 1.0 + next().abs(), 0.5) * inverse_mass,
+                ..Default::default()
+            });
+        }
+        let joints = (0..16u64)
+            .map(|k| {
+                let a = (next().abs() * 9.99) as u32;
+                let b = (a + 1 + (next().abs() * 8.99) as u32) % 10;
+                let frame = |anchor| JointFrame {
+                    anchor,
+                    basis: Quat::IDENTITY,
+                };
+                JointInput {
+                    a,
+                    b,
+                    frame_a: frame(Vec3::new(next(), next(), next())),
+                    frame_b: frame(Vec3::new(next(), next(), next())),
+                    kind: JointKind::Spherical {
+                        swing: None,
+                        twist: None,
+                    },
+                    key: k,
+                }
+            })
+            .collect();
+        (bodies, joints)
+    }
+
+    /// The scalar path over `joints` in key order: warm start, a biased pass, the bodies
+    /// moved, the rows refreshed, two relax passes.
+    fn scalar_sweep(joints: &mut [JointConstraint], states: &mut [BodyState], moves: &[BodyState]) {
+        let soft = Softness::new(60.0, 2.0, 1.0 / 240.0);
+        for j in joints.iter() {
+            j.apply_point_impulse(states, j.slots());
+        }
+        for j in joints.iter_mut() {
+            j.solve_point(states, soft, true);
+        }
+        move_bodies(states, moves);
+        for j in joints.iter_mut() {
+            let (a, b) = j.slots();
+            j.refresh(&states[a], &states[b]);
+        }
+        for _ in 0..2 {
+            for j in joints.iter_mut() {
+                j.solve_point(states, soft, false);
+            }
+        }
+    }
+
+    fn move_bodies(states: &mut [BodyState], moves: &[BodyState]) {
+        for (s, m) in states.iter_mut().zip(moves) {
+            s.delta_position = m.delta_position;
+            s.delta_rotation = m.delta_rotation;
+        }
+    }
+
+    #[test]
+    fn batched_ball_joints_equal_the_key_order_sweep_within_1e_4_on_20_nets() {
+        let soft = Softness::new(60.0, 2.0, 1.0 / 240.0);
+        let unbounded = (f32::INFINITY, f32::INFINITY);
+        let mut filled = 0;
+        for seed in 0..20 {
+            let (bodies, inputs) = net(seed);
+            let mut list = JointList::default();
+            list.prepare(&bodies, &inputs, unbounded);
+            list.set_impulses_all(|k| Vec3::new(0.3, -0.2, 0.1) * (k as f32 * 0.1 - 0.5));
+            let mut scalar = list.joints().to_vec();
+            filled += list.batch_lanes();
+            let moves: Vec<BodyState> = (0..10)
+                .map(|i| BodyState {
+                    delta_position: Vec3::new(0.01, -0.02, 0.005) * i as f32,
+                    delta_rotation: Quat::from_rotation_y(0.03 * i as f32),
+                    ..Default::default()
+                })
+                .collect();
+            let mut expected = bodies.states.clone();
+            scalar_sweep(&mut scalar, &mut expected, &moves);
+            let mut states = bodies.states.clone();
+            list.warm_start(&mut states);
+            list.solve(&mut states, soft, 1.0 / 240.0, true);
+            move_bodies(&mut states, &moves);
+            list.refresh(&states);
+            for _ in 0..2 {
+                list.solve(&mut states, soft, 1.0 / 240.0, false);
+            }
+            list.store();
+            for (e, s) in expected.iter().zip(&states) {
+                let scale = 1.0 + e.linear_velocity.length() + e.angular_velocity.length();
+                assert!(
+                    (e.linear_velocity - s.linear_velocity).length() < 1e-4 * scale,
+                    "seed {seed}"
+                );
+                assert!(
+                    (e.angular_velocity - s.angular_velocity).length() < 1e-4 * scale,
+                    "seed {seed}"
+                );
+            }
+            for (e, j) in scalar.iter().zip(list.joints()) {
+                let scale = 1.0 + e.impulses.point.length();
+                assert!((e.impulses.point - j.impulses.point).length() < 1e-4 * scale);
+            }
+            assert_ne!(states, bodies.states);
+        }
+        // The lanes did hold joints side by side.
+        assert!(filled > 20 * 16 / 2, "{filled} joints in lanes of 320");
+    }
+}
