@@ -15,7 +15,7 @@
 
 use super::body::BodyState;
 use super::contact::{ConstraintPoint, ContactConstraint, RowPart};
-use super::lanes::{LANES, Lanes, Quatx4, Vec3x4};
+use super::lanes::{LANES, Lanes, PairVelocities, Quatx4, Vec3x4, lanes_of};
 use crate::geometry::MAX_MANIFOLD_POINTS;
 use glam::Vec3;
 
@@ -116,17 +116,7 @@ impl ContactBatch {
     /// false, the batch left as it was, where `pack` gives `None`. Only the points some lane
     /// has are gathered: the passes never read past the batch's point count.
     pub fn repack(&mut self, indices: &[u32], constraints: &[ContactConstraint]) -> bool {
-        if indices.is_empty() || indices.len() > LANES {
-            return false;
-        }
-        let mut lanes: [Option<&ContactConstraint>; LANES] = [None; LANES];
-        for (lane, &i) in lanes.iter_mut().zip(indices) {
-            match constraints.get(i as usize) {
-                Some(c) => *lane = Some(c),
-                None => return false,
-            }
-        }
-        let Some(first) = lanes[0] else {
+        let Some((lanes, first)) = lanes_of(indices, constraints) else {
             return false;
         };
         let real = |l: usize| lanes[l].unwrap_or(first);
@@ -191,7 +181,7 @@ impl ContactBatch {
 
     /// Applies the accumulated impulses ([`ContactConstraint::warm_start`] per lane).
     pub fn warm_start(&self, states: &mut [BodyState]) {
-        let mut pair = PairX4::load(self, states);
+        let mut pair = PairVelocities::load(&self.bodies, states);
         for p in &self.points[..self.count] {
             pair.push(
                 self.inverse_mass,
@@ -204,7 +194,7 @@ impl ContactBatch {
                 pair.push(self.inverse_mass, t, row, p.tangent_impulse[k]);
             }
         }
-        pair.store(self, states);
+        pair.store(&self.bodies, &self.writes, states);
     }
 
     /// One pass over the rows ([`ContactConstraint::solve`] per lane; `flip` visits the points
@@ -217,19 +207,19 @@ impl ContactBatch {
         use_bias: bool,
         flip: bool,
     ) {
-        let mut pair = PairX4::load(self, states);
+        let mut pair = PairVelocities::load(&self.bodies, states);
         self.solve_normals(&mut pair, states, inv_h, max_push_out, use_bias, flip);
         if !use_bias && self.rubs {
             self.solve_friction(&mut pair);
         }
-        pair.store(self, states);
+        pair.store(&self.bodies, &self.writes, states);
     }
 
     /// The normal rows: speculative points close their gap, penetrating ones are pushed out
     /// softly when `use_bias`.
     fn solve_normals(
         &mut self,
-        pair: &mut PairX4,
+        pair: &mut PairVelocities,
         states: &[BodyState],
         inv_h: f32,
         max_push_out: f32,
@@ -279,7 +269,7 @@ impl ContactBatch {
     }
 
     /// Coulomb friction: both tangent rows clamped together to the disc `μ λ_n`.
-    fn solve_friction(&mut self, pair: &mut PairX4) {
+    fn solve_friction(&mut self, pair: &mut PairVelocities) {
         let (zero, one) = (Lanes::ZERO, Lanes::ONE);
         let [t0, t1] = self.tangents;
         for p in &mut self.points[..self.count] {
@@ -313,25 +303,8 @@ fn impact_speed(vn: Lanes, s: Lanes, closing: Lanes) -> Lanes {
     faster.select(-squared.sqrt(), vn)
 }
 
-/// The velocities of a batch's bodies, one pair per lane.
-struct PairX4 {
-    va: Vec3x4,
-    wa: Vec3x4,
-    vb: Vec3x4,
-    wb: Vec3x4,
-}
-
-impl PairX4 {
-    fn load(batch: &ContactBatch, states: &[BodyState]) -> Self {
-        let [a, b] = batch.bodies;
-        Self {
-            va: Vec3x4::gather(a.map(|i| states[i].linear_velocity)),
-            wa: Vec3x4::gather(a.map(|i| states[i].angular_velocity)),
-            vb: Vec3x4::gather(b.map(|i| states[i].linear_velocity)),
-            wb: Vec3x4::gather(b.map(|i| states[i].angular_velocity)),
-        }
-    }
-
+/// What a contact row reads of its bodies' velocities and adds to them.
+impl PairVelocities {
     /// The rate of a row: `d·(v_b − v_a) + (r_b × d)·ω_b − (r_a × d)·ω_a`.
     fn along(&self, dir: Vec3x4, row: &RowX4) -> Lanes {
         dir.dot(self.vb - self.va) + row.arm[1].dot(self.wb) - row.arm[0].dot(self.wa)
@@ -343,22 +316,6 @@ impl PairX4 {
         self.wa = self.wa - row.turn[0] * lambda;
         self.vb = self.vb + dir * (lambda * inverse_mass[1]);
         self.wb = self.wb + row.turn[1] * lambda;
-    }
-
-    fn store(self, batch: &ContactBatch, states: &mut [BodyState]) {
-        let [va, wa, vb, wb] = [self.va, self.wa, self.vb, self.wb].map(|v| v.to_vecs());
-        for lane in 0..LANES {
-            if batch.writes[0][lane] {
-                let s = &mut states[batch.bodies[0][lane]];
-                s.linear_velocity = va[lane];
-                s.angular_velocity = wa[lane];
-            }
-            if batch.writes[1][lane] {
-                let s = &mut states[batch.bodies[1][lane]];
-                s.linear_velocity = vb[lane];
-                s.angular_velocity = wb[lane];
-            }
-        }
     }
 }
 

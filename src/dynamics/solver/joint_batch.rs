@@ -13,7 +13,7 @@
 
 use super::body::BodyState;
 use super::joint::JointConstraint;
-use super::lanes::{LANES, Lanes, Mat3x4, Quatx4, Vec3x4};
+use super::lanes::{LANES, Lanes, Mat3x4, PairVelocities, Quatx4, Vec3x4, lanes_of};
 use super::softness::Softness;
 use glam::{Mat3, Vec3};
 
@@ -49,17 +49,7 @@ impl JointBatch {
     /// `joints` into this batch, with their rows where the bodies are now; false (the batch
     /// left as it was) for no index, too many or one out of range.
     pub(super) fn repack(&mut self, indices: &[u32], joints: &[JointConstraint]) -> bool {
-        if indices.is_empty() || indices.len() > LANES {
-            return false;
-        }
-        let mut lanes: [Option<&JointConstraint>; LANES] = [None; LANES];
-        for (lane, &i) in lanes.iter_mut().zip(indices) {
-            match joints.get(i as usize) {
-                Some(j) => *lane = Some(j),
-                None => return false,
-            }
-        }
-        let Some(first) = lanes[0] else {
+        let Some((lanes, first)) = lanes_of(indices, joints) else {
             return false;
         };
         let real = |l: usize| lanes[l].unwrap_or(first).slots();
@@ -101,15 +91,15 @@ impl JointBatch {
 
     /// Applies the accumulated impulses.
     pub(super) fn warm_start(&self, states: &mut [BodyState]) {
-        let mut pair = Velocities::load(self, states);
-        pair.push(self, self.impulse);
-        pair.store(self, states);
+        let mut pair = PairVelocities::load(&self.bodies, states);
+        pair.push_point(self, self.impulse);
+        pair.store(&self.bodies, &self.writes, states);
     }
 
     /// One pass: biased (`soft` closes the gaps) or relaxing (rigid), as
     /// [`JointConstraint::solve_point`] per lane.
     pub(super) fn solve(&mut self, states: &mut [BodyState], soft: Softness, use_bias: bool) {
-        let mut pair = Velocities::load(self, states);
+        let mut pair = PairVelocities::load(&self.bodies, states);
         let [r_a, r_b] = self.arms;
         let cdot = pair.vb + pair.wb.cross(r_b) - pair.va - pair.wa.cross(r_a);
         let soft = if use_bias { soft } else { Softness::RIGID };
@@ -121,8 +111,8 @@ impl JointBatch {
         let impulse = self.k_inverse.mul_vec(target) * Lanes::splat(-soft.mass_scale)
             - self.impulse * Lanes::splat(soft.impulse_scale);
         self.impulse = self.impulse + impulse;
-        pair.push(self, impulse);
-        pair.store(self, states);
+        pair.push_point(self, impulse);
+        pair.store(&self.bodies, &self.writes, states);
     }
 
     /// Takes the rows where the bodies are now, from their motion since the step's start (as
@@ -143,27 +133,10 @@ impl JointBatch {
     }
 }
 
-/// The velocities of a batch's bodies, one pair per lane.
-struct Velocities {
-    va: Vec3x4,
-    wa: Vec3x4,
-    vb: Vec3x4,
-    wb: Vec3x4,
-}
-
-impl Velocities {
-    fn load(batch: &JointBatch, states: &[BodyState]) -> Self {
-        let [a, b] = batch.bodies;
-        Self {
-            va: Vec3x4::gather(a.map(|i| states[i].linear_velocity)),
-            wa: Vec3x4::gather(a.map(|i| states[i].angular_velocity)),
-            vb: Vec3x4::gather(b.map(|i| states[i].linear_velocity)),
-            wb: Vec3x4::gather(b.map(|i| states[i].angular_velocity)),
-        }
-    }
-
+/// What the point rows add to their bodies' velocities.
+impl PairVelocities {
     /// The impulse `p` on B at its anchor, `−p` on A.
-    fn push(&mut self, batch: &JointBatch, p: Vec3x4) {
+    fn push_point(&mut self, batch: &JointBatch, p: Vec3x4) {
         let [ma, mb] = batch.inverse_mass;
         let [ia, ib] = &batch.inverse_inertia;
         let [r_a, r_b] = batch.arms;
@@ -171,22 +144,6 @@ impl Velocities {
         self.wa = self.wa - ia.mul_vec(r_a.cross(p));
         self.vb = self.vb + per_axis(p, mb);
         self.wb = self.wb + ib.mul_vec(r_b.cross(p));
-    }
-
-    fn store(self, batch: &JointBatch, states: &mut [BodyState]) {
-        let [va, wa, vb, wb] = [self.va, self.wa, self.vb, self.wb].map(Vec3x4::to_vecs);
-        for lane in 0..LANES {
-            if batch.writes[0][lane] {
-                let s = &mut states[batch.bodies[0][lane]];
-                s.linear_velocity = va[lane];
-                s.angular_velocity = wa[lane];
-            }
-            if batch.writes[1][lane] {
-                let s = &mut states[batch.bodies[1][lane]];
-                s.linear_velocity = vb[lane];
-                s.angular_velocity = wb[lane];
-            }
-        }
     }
 }
 

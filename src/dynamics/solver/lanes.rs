@@ -6,6 +6,7 @@
 //! ones, so a lane computes what the scalar solver computes for the same contact (up to the
 //! rounding of glam's quaternion rotation).
 
+use super::body::BodyState;
 use glam::{Mat3, Quat, Vec3};
 use std::ops::{Add, Mul, Neg, Sub};
 use wide::f32x4;
@@ -146,6 +147,69 @@ impl Quatx4 {
         let two = Lanes::splat(2.0);
         let t = self.v.cross(r) * two;
         r + t * self.w + self.v.cross(t)
+    }
+}
+
+/// The items at `indices` one per lane (`None` past them), and the first: `None` for no
+/// index, more than [`LANES`] or one out of range (what a batch's `repack` refuses).
+#[allow(clippy::type_complexity)]
+pub fn lanes_of<'a, T>(indices: &[u32], items: &'a [T]) -> Option<([Option<&'a T>; LANES], &'a T)> {
+    if indices.is_empty() || indices.len() > LANES {
+        return None;
+    }
+    let mut lanes: [Option<&T>; LANES] = [None; LANES];
+    for (lane, &i) in lanes.iter_mut().zip(indices) {
+        *lane = Some(items.get(i as usize)?);
+    }
+    Some((lanes, lanes[0]?))
+}
+
+/// The velocities of a batch's two bodies per lane (a contact's or a joint's A and B), gathered
+/// from the solver's states and scattered back to the slots a lane may write.
+#[derive(Clone, Copy, Debug)]
+pub struct PairVelocities {
+    /// A's linear velocities.
+    pub va: Vec3x4,
+    /// A's angular velocities.
+    pub wa: Vec3x4,
+    /// B's linear velocities.
+    pub vb: Vec3x4,
+    /// B's angular velocities.
+    pub wb: Vec3x4,
+}
+
+impl PairVelocities {
+    /// The velocities of slots `[a, b]` per lane.
+    pub fn load([a, b]: &[[usize; LANES]; 2], states: &[BodyState]) -> Self {
+        Self {
+            va: Vec3x4::gather(a.map(|i| states[i].linear_velocity)),
+            wa: Vec3x4::gather(a.map(|i| states[i].angular_velocity)),
+            vb: Vec3x4::gather(b.map(|i| states[i].linear_velocity)),
+            wb: Vec3x4::gather(b.map(|i| states[i].angular_velocity)),
+        }
+    }
+
+    /// Writes the velocities back to slots `bodies`, where `writes` allows (the dynamic bodies
+    /// of real lanes: padding lanes repeat lane 0's slots, and static bodies keep theirs).
+    pub fn store(
+        self,
+        bodies: &[[usize; LANES]; 2],
+        writes: &[[bool; LANES]; 2],
+        states: &mut [BodyState],
+    ) {
+        let [va, wa, vb, wb] = [self.va, self.wa, self.vb, self.wb].map(Vec3x4::to_vecs);
+        for lane in 0..LANES {
+            if writes[0][lane] {
+                let s = &mut states[bodies[0][lane]];
+                s.linear_velocity = va[lane];
+                s.angular_velocity = wa[lane];
+            }
+            if writes[1][lane] {
+                let s = &mut states[bodies[1][lane]];
+                s.linear_velocity = vb[lane];
+                s.angular_velocity = wb[lane];
+            }
+        }
     }
 }
 
