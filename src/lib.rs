@@ -75,6 +75,8 @@ pub mod settings;
 pub mod spatial;
 #[cfg(feature = "ecs")]
 pub mod stats;
+#[cfg(test)]
+mod test_rng;
 
 #[cfg(feature = "ecs")]
 pub use plugins::{UrtoPlugins, step, step_app};

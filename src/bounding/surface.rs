@@ -162,14 +162,9 @@ mod tests {
     use super::*;
 
     fn corners(seed: u32, n: usize) -> Vec<[Vec3; 3]> {
-        // A deterministic scatter of triangles (a small LCG, no dependency).
-        let mut state = seed;
-        let mut next = move || {
-            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (state >> 8) as f32 / (1u32 << 24) as f32 * 2.0 - 1.0
-        };
+        let mut rng = crate::test_rng::TestRng::new(u64::from(seed));
         (0..n)
-            .map(|_| std::array::from_fn(|_| Vec3::new(next(), next(), next())))
+            .map(|_| std::array::from_fn(|_| rng.vec3(-1.0, 1.0)))
             .collect()
     }
 

@@ -262,34 +262,12 @@ mod tests {
         assert!(refined.is_none(), "{refined:?}");
     }
 
-    /// A small seeded generator (a linear congruential one; the test needs spread, not quality).
-    struct Lcg(u64);
-
-    impl Lcg {
-        fn unit(&mut self) -> f32 {
-            self.0 = self
-                .0
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (self.0 >> 40) as f32 / (1u64 << 24) as f32
-        }
-
-        fn range(&mut self, lo: f32, hi: f32) -> f32 {
-            lo + (hi - lo) * self.unit()
-        }
-
-        fn rotation(&mut self) -> Quat {
-            let axis = Vec3::new(self.range(-1.0, 1.0), self.range(-1.0, 1.0), 0.5).normalize();
-            Quat::from_axis_angle(axis, self.range(0.0, std::f32::consts::TAU))
-        }
-    }
-
     #[test]
     fn every_shape_stops_within_1e_4_before_its_true_contact_never_1e_5_after_nor_inside_turned() {
         // Against the answer of bisection on the static contact test (measured: boxes early by
         // up to 3.4e-5 of the sweep, the others 1.1e-5; late by under 1e-6, bisection's
         // resolution).
-        let mut rng = Lcg(7);
+        let mut rng = crate::test_rng::TestRng::new(7);
         let shapes = [
             Shape::cuboid(Vec3::new(0.6, 0.2, 0.3)),
             Shape::capsule(0.8, 0.15),

@@ -404,17 +404,11 @@ mod tests {
 
     /// `n` boxes of sizes 0.1 to 1.1 scattered in a 20 m cube (a small LCG, fixed seed).
     fn scattered(n: usize, seed: u64) -> Vec<(u32, Aabb)> {
-        let mut s = seed;
-        let mut next = move || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rng = crate::test_rng::TestRng::new(seed);
         (0..n)
             .map(|i| {
-                let c = Vec3::new(next(), next(), next()) * 20.0 - 10.0;
-                let h = Vec3::new(next(), next(), next()) * 0.5 + 0.05;
+                let c = rng.vec3(-10.0, 10.0);
+                let h = rng.vec3(0.05, 0.55);
                 (i as u32 * 3 + 7, Aabb::from_center_half_extents(c, h))
             })
             .collect()

@@ -166,13 +166,8 @@ mod tests {
     /// Ten turning bodies (slot 0 static, slot 9 heavy and lopsided) and ball joints between
     /// random pairs with random anchors, carrying impulses.
     fn net(seed: u64) -> (SolverBodies, Vec<JointInput>) {
-        let mut s = seed;
-        let mut next = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
-        };
+        let mut rng = crate::test_rng::TestRng::new(seed);
+        let mut next = || rng.range(-1.0, 1.0);
         let mut bodies = SolverBodies::default();
         for i in 0..10 {
             let f = i as f32;

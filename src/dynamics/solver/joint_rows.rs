@@ -519,14 +519,10 @@ mod tests {
 
     #[test]
     fn the_skew_sandwich_equals_the_two_matrix_products_within_1e_5() {
-        let mut seed = 7u32;
-        let mut next = || {
-            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (seed >> 8) as f32 / (1u32 << 24) as f32 * 4.0 - 2.0
-        };
+        let mut rng = crate::test_rng::TestRng::new(7);
         for _ in 0..1000 {
-            let r = Vec3::new(next(), next(), next());
-            let i = Mat3::from_cols_array(&std::array::from_fn(|_| next()));
+            let r = rng.vec3(-2.0, 2.0);
+            let i = Mat3::from_cols_array(&std::array::from_fn(|_| rng.range(-2.0, 2.0)));
             let expected = skew(r) * i * skew(r);
             let got = skew_sandwich(r, i);
             let scale = 1.0

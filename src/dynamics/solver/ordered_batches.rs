@@ -193,14 +193,10 @@ mod tests {
 
     /// Pairs over slots 0..10 from a small generator: chains, stars and repeats.
     fn pairs(n: usize, seed: u64) -> Vec<(u32, u32)> {
-        let mut s = seed;
+        let mut rng = crate::test_rng::TestRng::new(seed);
         (0..n)
             .map(|_| {
-                s = s
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                let a = (s >> 33) as u32 % 10;
-                let b = (s >> 45) as u32 % 10;
+                let (a, b) = (rng.below(10), rng.below(10));
                 if a == b { (a, (b + 1) % 10) } else { (a, b) }
             })
             .collect()

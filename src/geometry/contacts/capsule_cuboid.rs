@@ -243,17 +243,11 @@ mod tests {
 
     #[test]
     fn segment_box_distance_matches_sampling_within_1e_4() {
-        let mut seed = 1u64;
-        let mut next = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((seed >> 40) as f32 / (1u64 << 24) as f32) * 6.0 - 3.0
-        };
+        let mut rng = crate::test_rng::TestRng::new(1);
         let h = Vec3::new(0.5, 1.0, 0.25);
         for _ in 0..500 {
-            let p0 = Vec3::new(next(), next(), next());
-            let p1 = Vec3::new(next(), next(), next());
+            let p0 = rng.vec3(-3.0, 3.0);
+            let p1 = rng.vec3(-3.0, 3.0);
             let (p, q) = closest_segment_box(p0, p1, h);
             let exact = (p - q).length();
             assert!(
