@@ -28,6 +28,11 @@ impl Rng {
         lo + (hi - lo) * self.unit()
     }
 
+    /// Each component uniform in `[lo, hi)`.
+    pub fn vec3(&mut self, lo: f32, hi: f32) -> Vec3 {
+        Vec3::new(self.range(lo, hi), self.range(lo, hi), self.range(lo, hi))
+    }
+
     /// `10^x` for `x` uniform in `[lo, hi)`: sizes and masses spread over decades.
     pub fn decades(&mut self, lo: f32, hi: f32) -> f32 {
         10f32.powf(self.range(lo, hi))

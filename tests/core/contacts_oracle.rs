@@ -27,7 +27,8 @@
 //!   along *our* normal must be within that bias of the reference depth. Those cases are
 //!   counted and printed.
 
-use glam::{DVec3, Quat, Vec3};
+use crate::common::rng::Rng;
+use glam::{DVec3, Vec3};
 use urto::geometry::contacts::contact;
 use urto::geometry::{Isometry, Shape};
 
@@ -36,46 +37,10 @@ const BAND: f32 = 1e-4;
 /// Random poses per pair kind.
 const SAMPLES: usize = 5000;
 
-/// SplitMix64 (Steele, Lea & Flood 2014): a tiny seeded generator, so the test needs no crate.
-struct Rng(u64);
-
+/// The shapes and poses the oracle tests draw.
 impl Rng {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in `[lo, hi)`.
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        let unit = (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32;
-        lo + (hi - lo) * unit
-    }
-
-    fn vec(&mut self, lo: f32, hi: f32) -> Vec3 {
-        Vec3::new(self.range(lo, hi), self.range(lo, hi), self.range(lo, hi))
-    }
-
-    /// A uniformly random rotation (rejection sampling in the unit 4-ball).
-    fn rotation(&mut self) -> Quat {
-        loop {
-            let q = Quat::from_xyzw(
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-            );
-            let n2 = q.length_squared();
-            if n2 > 1e-3 && n2 <= 1.0 {
-                return q.normalize();
-            }
-        }
-    }
-
     fn pose(&mut self, reach: f32) -> Isometry {
-        Isometry::new(self.vec(-reach, reach), self.rotation())
+        Isometry::new(self.vec3(-reach, reach), self.rotation())
     }
 
     fn sphere(&mut self) -> Shape {
@@ -83,7 +48,7 @@ impl Rng {
     }
 
     fn cuboid(&mut self) -> Shape {
-        Shape::cuboid(self.vec(0.1, 1.5))
+        Shape::cuboid(self.vec3(0.1, 1.5))
     }
 
     fn capsule(&mut self) -> Shape {
@@ -91,7 +56,7 @@ impl Rng {
     }
 
     fn half_space(&mut self) -> Shape {
-        Shape::half_space(self.vec(-1.0, 1.0))
+        Shape::half_space(self.vec3(-1.0, 1.0))
     }
 }
 
@@ -216,7 +181,7 @@ fn compare_with_parry(
     mut draw: impl FnMut(&mut Rng) -> (Shape, Isometry, Shape, Isometry),
     depth_tolerance: impl Fn(f32) -> f32,
 ) {
-    let mut rng = Rng(seed);
+    let mut rng = Rng::new(seed);
     let mut stats = Stats::default();
     for sample in 0..SAMPLES {
         let (a, pa, b, pb) = draw(&mut rng);
@@ -261,8 +226,10 @@ fn compare_with_parry(
     eprintln!("{name}: {stats:?}");
     // These pairs have a unique normal: it must agree everywhere.
     assert_eq!(stats.normals_differing, 0, "{name}: {stats:?}");
+    // Both classes drawn often enough to mean something (a box against a half-space within
+    // reach 1 is apart about one time in ten).
     assert!(
-        stats.intersecting > SAMPLES / 10 && stats.apart > SAMPLES / 10,
+        stats.intersecting > SAMPLES / 20 && stats.apart > SAMPLES / 20,
         "{stats:?}"
     );
 }
@@ -369,7 +336,7 @@ fn segment_closest_f64(a: (DVec3, DVec3), b: (DVec3, DVec3)) -> (DVec3, DVec3) {
 
 #[test]
 fn capsule_capsule_depths_match_an_f64_segment_distance_within_1e_5_and_normals_within_1e_3() {
-    let mut rng = Rng(17);
+    let mut rng = Rng::new(17);
     let mut compared = 0;
     for _ in 0..SAMPLES {
         let (a, pa, b, pb) = (rng.capsule(), rng.pose(1.5), rng.capsule(), rng.pose(1.5));
@@ -474,7 +441,7 @@ fn compare_boxes_with_parry(
     seed: u64,
     draw: impl Fn(&mut Rng) -> (Shape, Isometry, Shape, Isometry),
 ) {
-    let mut rng = Rng(seed);
+    let mut rng = Rng::new(seed);
     let mut stats = BoxBoxStats::default();
     for sample in 0..SAMPLES {
         let (a, pa, b, pb) = draw(&mut rng);
@@ -538,7 +505,7 @@ fn any_pair(r: &mut Rng) -> (Shape, Isometry, Shape, Isometry) {
         0 => r.sphere(),
         1 => Shape::sphere(0.0),
         2 => r.cuboid(),
-        3 => Shape::cuboid(r.vec(0.0, 1.0) * Vec3::new(1.0, (r.next_u64() % 2) as f32, 1.0)),
+        3 => Shape::cuboid(r.vec3(0.0, 1.0) * Vec3::new(1.0, (r.next_u64() % 2) as f32, 1.0)),
         4 => Shape::cuboid(Vec3::ZERO),
         5 => r.capsule(),
         6 => Shape::capsule(r.range(0.0, 1.0), 0.0),
@@ -558,7 +525,7 @@ fn any_pair(r: &mut Rng) -> (Shape, Isometry, Shape, Isometry) {
 
 #[test]
 fn swapping_the_pair_flips_the_normal_and_keeps_the_depth() {
-    let mut rng = Rng(8);
+    let mut rng = Rng::new(8);
     let mut compared = 0;
     for _ in 0..20_000 {
         let (a, pa, b, pb) = any_pair(&mut rng);
@@ -585,7 +552,7 @@ fn swapping_the_pair_flips_the_normal_and_keeps_the_depth() {
 
 #[test]
 fn manifolds_are_finite_and_their_points_lie_midway_between_the_surfaces() {
-    let mut rng = Rng(9);
+    let mut rng = Rng::new(9);
     let mut checked = 0;
     for _ in 0..20_000 {
         let (a, pa, b, pb) = any_pair(&mut rng);

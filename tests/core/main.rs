@@ -28,4 +28,5 @@ mod mesh_io;
 mod region_sweep;
 mod tri_tri_properties;
 mod tri_tri_vs_parry;
+mod triangle_box_vs_parry;
 mod trimesh_brute_force;

@@ -17,6 +17,7 @@
 //! - Zero-area triangles: urto tests them exactly as the segment or point they are; GJK does the
 //!   same up to its tolerance.
 
+use crate::common::rng::Rng;
 use glam::{DVec3, Quat, Vec3};
 use parry3d::math::{Pose, Vector};
 use parry3d::query::{self, PointQuery, Ray, RayCast};
@@ -27,28 +28,11 @@ use urto::geometry::{
     tri_tri_intersection,
 };
 
-struct Rng(u64);
-
+/// The random triangles the tests draw: corners in `[-1, 1)³` about an offset.
 impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-    /// Uniform in `[-1, 1]`.
-    fn unit(&mut self) -> f32 {
-        (self.next() >> 40) as f32 / (1u64 << 23) as f32 - 1.0
-    }
-    fn vec(&mut self) -> Vec3 {
-        Vec3::new(self.unit(), self.unit(), self.unit())
-    }
     fn triangle(&mut self, offset: Vec3) -> Triangle {
-        Triangle::new(
-            self.vec() + offset,
-            self.vec() + offset,
-            self.vec() + offset,
-        )
+        let mut corner = || self.vec3(-1.0, 1.0) + offset;
+        Triangle::new(corner(), corner(), corner())
     }
 }
 
@@ -141,11 +125,11 @@ const GJK_TOLERANCE: f64 = 1e-3;
 
 #[test]
 fn random_pairs_agree_with_parry_except_within_its_tolerance_of_touching() {
-    let mut rng = Rng(0x5eed_1234_abcd_0001);
+    let mut rng = Rng::new(0x5eed_1234_abcd_0001);
     let (mut meeting, mut disagreements, mut widest_gap) = (0, 0, 0.0f64);
     for _ in 0..20_000 {
         let t1 = rng.triangle(Vec3::ZERO);
-        let offset = rng.vec() * 0.4;
+        let offset = rng.vec3(-1.0, 1.0) * 0.4;
         let t2 = rng.triangle(offset);
         let ours = tri_tri_intersect(&t1, &t2);
         meeting += ours as usize;
@@ -422,11 +406,11 @@ fn reference_segment(t1: &Triangle, t2: &Triangle) -> Option<(Vec3, Vec3)> {
 
 #[test]
 fn segments_lie_on_both_triangles_and_match_the_edge_crossings() {
-    let mut rng = Rng(0x5eed_0000_0000_0002);
+    let mut rng = Rng::new(0x5eed_0000_0000_0002);
     let mut checked = 0;
     while checked < 5000 {
         let t1 = rng.triangle(Vec3::ZERO);
-        let offset = rng.vec() * 0.5;
+        let offset = rng.vec3(-1.0, 1.0) * 0.5;
         let t2 = rng.triangle(offset);
         let TriTriIntersection::Segment(a, b) = tri_tri_intersection(&t1, &t2) else {
             assert_eq!(
@@ -460,11 +444,11 @@ fn segments_lie_on_both_triangles_and_match_the_edge_crossings() {
 
 #[test]
 fn triangle_gaps_match_an_f64_oracle_within_1e_5_relative_and_bound_parrys_gjk() {
-    let mut rng = Rng(0x5eed_0000_0000_0007);
+    let mut rng = Rng::new(0x5eed_0000_0000_0007);
     let (mut compared, mut widest) = (0, 0.0f32);
     for i in 0..20_000 {
         let t1 = rng.triangle(Vec3::ZERO);
-        let offset = rng.vec() * 2.5;
+        let offset = rng.vec3(-1.0, 1.0) * 2.5;
         let mut t2 = rng.triangle(offset);
         if i % 10 == 0 {
             t2.c = t2.a + (t2.b - t2.a) * 0.25; // degenerate: a segment
@@ -505,13 +489,13 @@ fn triangle_gaps_match_an_f64_oracle_within_1e_5_relative_and_bound_parrys_gjk()
 
 #[test]
 fn closest_points_match_parry_projection() {
-    let mut rng = Rng(0x5eed_0000_0000_0003);
+    let mut rng = Rng::new(0x5eed_0000_0000_0003);
     for i in 0..20_000 {
         let mut t = rng.triangle(Vec3::ZERO);
         if i % 10 == 0 {
             t.c = t.a + (t.b - t.a) * 0.25; // degenerate: a segment
         }
-        let p = rng.vec() * 2.0;
+        let p = rng.vec3(-1.0, 1.0) * 2.0;
         let ours = t.closest_point(p);
         let theirs = uv(ptri(&t).project_local_point(pv(p), true).point);
         // Both are nearest points: equal distances, and equal points unless the triangle is
@@ -530,12 +514,12 @@ fn closest_points_match_parry_projection() {
 
 #[test]
 fn sphere_contacts_match_parry() {
-    let mut rng = Rng(0x5eed_0000_0000_0004);
+    let mut rng = Rng::new(0x5eed_0000_0000_0004);
     let mut compared = 0;
     for _ in 0..20_000 {
         let t = rng.triangle(Vec3::ZERO);
-        let center = rng.vec() * 1.5;
-        let radius = 0.1 + 0.5 * (rng.unit() + 1.0);
+        let center = rng.vec3(-1.0, 1.0) * 1.5;
+        let radius = 0.1 + 0.5 * (rng.range(-1.0, 1.0) + 1.0);
         let ours = contact_triangle_sphere(&t, center, &Sphere { radius });
         let theirs = query::contact(
             &Pose::IDENTITY,
@@ -573,14 +557,17 @@ fn sphere_contacts_match_parry() {
 
 #[test]
 fn box_overlap_matches_parry_except_when_grazing() {
-    let mut rng = Rng(0x5eed_0000_0000_0005);
+    let mut rng = Rng::new(0x5eed_0000_0000_0005);
     let (mut hits, mut disagreements) = (0, 0);
     for _ in 0..20_000 {
-        let offset = rng.vec() * 1.5;
+        let offset = rng.vec3(-1.0, 1.0) * 1.5;
         let t = rng.triangle(offset);
-        let half = Vec3::new(0.2, 0.3, 0.5) + rng.vec().abs() * 0.5;
-        let rotation = Quat::from_axis_angle(rng.vec().normalize_or(Vec3::Z), rng.unit() * 3.0);
-        let pose = Isometry::new(rng.vec() * 0.5, rotation);
+        let half = Vec3::new(0.2, 0.3, 0.5) + rng.vec3(-1.0, 1.0).abs() * 0.5;
+        let rotation = Quat::from_axis_angle(
+            rng.vec3(-1.0, 1.0).normalize_or(Vec3::Z),
+            rng.range(-1.0, 1.0) * 3.0,
+        );
+        let pose = Isometry::new(rng.vec3(-1.0, 1.0) * 0.5, rotation);
         let ours = intersects_triangle_cuboid(&t, &pose, &Cuboid { half_extents: half });
         let ppose = Pose::from_parts(pv(pose.translation), rotation_to_parry(rotation));
         let pbox = PCuboid::new(pv(half));
