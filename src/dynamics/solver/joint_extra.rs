@@ -126,7 +126,9 @@ impl JointExtra {
         point: &PointRows,
     ) {
         let (r_a, r_b) = point.anchors;
-        let separation = point.separation;
+        let (anchors, separation) = (point.anchors, point.separation);
+        // The point rows' effective mass, for the angular rows held at the anchors.
+        let k = &point.inverse_mass;
         let fa = sa.delta_rotation * self.frames[0];
         let fb = sb.delta_rotation * self.frames[1];
         let axis = fa * Vec3::X;
@@ -140,13 +142,13 @@ impl JointExtra {
             JointKind::Spherical { swing, twist } => {
                 let axis_b = fb * Vec3::X;
                 if swing.is_some() {
-                    let held = |(row, a): (AxisRow, f32)| (row.held_at(m, r_a, r_b), a);
+                    let held = |(row, a): (AxisRow, f32)| (row.held_at(m, anchors, k), a);
                     rows.swing = swing_row(axis, axis_b).map(held);
                 }
                 if twist.is_some() {
                     // Twist is about the axes' bisector, where both frames see it alike.
                     let bisector = (axis + axis_b).normalize_or(axis);
-                    let row = AxisRow::angular(bisector).held_at(m, r_a, r_b);
+                    let row = AxisRow::angular(bisector).held_at(m, anchors, k);
                     rows.axis = Some((row, twist_angle(fa, fb)));
                 }
             }
@@ -159,7 +161,7 @@ impl JointExtra {
                 rows.angular = Some((hinge, Vec3::new(c[0], c[1], 0.0)));
                 // The alignment rows turn with B: their effective mass is taken where they are.
                 rows.angular_inverse_mass = hinge.inverse_mass(m);
-                let row = AxisRow::angular(axis).held_at(m, r_a, r_b);
+                let row = AxisRow::angular(axis).held_at(m, anchors, k);
                 rows.axis = Some((row, twist_angle(fa, fb)));
             }
             JointKind::Prismatic { .. } => {

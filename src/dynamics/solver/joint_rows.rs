@@ -107,12 +107,18 @@ pub struct Pivot {
 
 impl Pivot {
     /// The pivot of the angular row `(u_a, u_b)` between bodies with masses `m` held together
-    /// at anchors `r_a`, `r_b`.
-    pub fn new(m: &PairMasses, (u_a, u_b): (Vec3, Vec3), r_a: Vec3, r_b: Vec3) -> Self {
+    /// at anchors `r_a`, `r_b` by point rows of effective mass `point_k_inverse` (the joint's
+    /// own, taken once per substep: [`point_mass`] inverted by [`inverse_mass`]).
+    pub fn new(
+        m: &PairMasses,
+        (u_a, u_b): (Vec3, Vec3),
+        (r_a, r_b): (Vec3, Vec3),
+        point_k_inverse: &Mat3,
+    ) -> Self {
         let [ia, ib] = m.inverse_inertia;
         let (w_a, w_b) = (-(ia * u_a), ib * u_b);
         let d = w_b.cross(r_b) - w_a.cross(r_a);
-        let p = -(inverse_mass(point_mass(m, r_a, r_b)) * d);
+        let p = -(*point_k_inverse * d);
         let [ma, mb] = m.inverse_mass;
         let dw_a = w_a - ia * r_a.cross(p);
         let dw_b = w_b + ib * r_b.cross(p);
@@ -140,10 +146,16 @@ impl AxisRow {
         }
     }
 
-    /// The angular row with its bodies held together at anchors `r_a`, `r_b` (see [`Pivot`]).
-    pub fn held_at(mut self, m: &PairMasses, r_a: Vec3, r_b: Vec3) -> Self {
+    /// The angular row with its bodies held together at anchors `(r_a, r_b)` by point rows of
+    /// effective mass `point_k_inverse` (see [`Pivot`]).
+    pub fn held_at(
+        mut self,
+        m: &PairMasses,
+        anchors: (Vec3, Vec3),
+        point_k_inverse: &Mat3,
+    ) -> Self {
         let dirs = (self.angular_a, self.angular_b);
-        self.pivot = Some(Pivot::new(m, dirs, r_a, r_b));
+        self.pivot = Some(Pivot::new(m, dirs, anchors, point_k_inverse));
         self
     }
 
@@ -504,7 +516,8 @@ mod tests {
         let mut states = [BodyState::default(); 2];
         states[1].angular_velocity = Vec3::Y * 2.0;
         states[1].linear_velocity = -(Vec3::Y * 2.0).cross(r_b);
-        let row = AxisRow::angular(Vec3::Y).held_at(&m, Vec3::ZERO, r_b);
+        let point = inverse_mass(point_mass(&m, Vec3::ZERO, r_b));
+        let row = AxisRow::angular(Vec3::Y).held_at(&m, (Vec3::ZERO, r_b), &point);
         let acc = solve_unbounded(&row, &m, &mut states);
         let s = states[1];
         assert!(s.angular_velocity.length() < 1e-5, "{}", s.angular_velocity);
