@@ -78,7 +78,7 @@ pub use warm_start::WarmStartCache;
 
 use crate::dynamics::forces::{ForceModel, Spring, SpringEnd};
 use crate::settings::{MAX_SUBSTEPS, SettingsError};
-use glam::Vec3;
+use glam::{Mat3, Vec3};
 use integrate::{capped, integrate_positions, integrate_velocities};
 use joint_list::JointList;
 use ordered_batches::OrderedBatches;
@@ -456,7 +456,12 @@ impl Solver {
         let static_soft = Softness::new(s.static_contact_hertz, s.damping_ratio, h);
         self.constraints.clear();
         self.constraints.extend(contacts.iter().map(|c| {
-            let immovable = |i: u32| !bodies.params[i as usize].dynamic;
+            // A dynamic body locked on every axis is as immovable as a static one, and its
+            // contacts as stiff.
+            let immovable = |i: u32| {
+                let p = &bodies.params[i as usize];
+                !p.dynamic || (p.inverse_mass == Vec3::ZERO && p.inverse_inertia == Mat3::ZERO)
+            };
             let softness = if immovable(c.a) || immovable(c.b) {
                 static_soft
             } else {
