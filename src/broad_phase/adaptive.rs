@@ -9,11 +9,12 @@
 //! log₂ n`: bodies moving far relative to their spacing, or bodies strung along one axis, whose
 //! intervals on the other two all overlap (a row of 10k boxes made 16M swaps a step).
 //!
-//! The rule: after each commit of the incremental SAP, a step with more than
+//! The rule: after each commit of the incremental SAP in which a box came, went or moved (a
+//! commit re-sending the same boxes says nothing about the motion), a step with more than
 //! [`AdaptiveSweep::SWAPS_PER_SORT_UNIT`]` · n log₂ n` swaps (times `√(n / 10k)` past 10k
 //! bodies, where the rebuild starts missing the cache) is a strike; two strikes in a row
-//! move every body into a sort and sweep. Every [`AdaptiveSweep::PROBE_PERIOD`] commits the
-//! bodies go back to the SAP to see whether the motion has calmed (if not, two commits later
+//! move every body into a sort and sweep. Every [`AdaptiveSweep::PROBE_PERIOD`] such commits
+//! the bodies go back to the SAP to see whether the motion has calmed (if not, two commits later
 //! they return). A switch costs one bulk insertion; it changes no pair, and the commit that
 //! switches reports the changes the old structure found.
 //!
@@ -104,7 +105,8 @@ impl AdaptiveSweep {
     /// (its random accesses miss the cache: 35 ns a unit at 10k bodies, 109 ns at 100k, while a
     /// swap stays near 3.3 ns), so the swap budget grows with it.
     pub const CACHE_SCENE: f64 = 10_000.0;
-    /// Losing commits in a row that trigger the fallback.
+    /// Losing commits in a row that trigger the fallback (commits that moved nothing are not
+    /// counted, here and below).
     pub const STRIKES: u32 = 2;
     /// Commits after which sorting from scratch hands the bodies back to the SAP to try again.
     pub const PROBE_PERIOD: u32 = 120;
@@ -208,10 +210,10 @@ impl BroadPhase for AdaptiveSweep {
 
     fn update(&mut self, id: ProxyId, aabb: Aabb) -> Result<(), BroadPhaseError> {
         // Only a box that moved counts (the lookup stops at the first one).
-        if !self.changed && self.engine.get().aabb(id) != Some(aabb) {
-            self.changed = true;
-        }
-        self.engine.get_mut().update(id, aabb)
+        let moved = !self.changed && self.engine.get().aabb(id) != Some(aabb);
+        self.engine.get_mut().update(id, aabb)?;
+        self.changed |= moved;
+        Ok(())
     }
 
     fn remove(&mut self, id: ProxyId) -> Result<(), BroadPhaseError> {

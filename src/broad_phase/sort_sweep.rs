@@ -3,7 +3,8 @@
 //! forward from each box over the boxes starting before it ends, testing the other two axes.
 //!
 //! No state survives a commit except the previous pair list (to report changes), so its cost
-//! does not depend on how far bodies moved: O(n log n + overlaps on the sweep axis). It is the
+//! does not depend on how far bodies moved: O(n log n + overlaps on the sweep axis). A commit
+//! in which no body came, went or moved keeps the pairs it had and rebuilds nothing. It is the
 //! yardstick the incremental version must beat under coherence, and the winner when motion is
 //! large.
 
@@ -36,7 +37,7 @@ impl SweepArrays {
     }
 }
 
-/// Sort-and-sweep broad phase, rebuilt every commit.
+/// Sort-and-sweep broad phase, rebuilt at every commit that changed something.
 #[derive(Debug, Default)]
 pub struct SortAndSweep {
     bodies: BodyStore,

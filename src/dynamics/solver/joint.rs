@@ -26,13 +26,14 @@
 //! row of its own: a velocity motor is rigid towards its speed, a position motor is a spring
 //! of the motor's stiffness, and both are bounded by the motor's force per substep.
 //!
-//!
 //! Each joint is stored in two parts, as Box2D v3 keeps its joints' solver data apart from
 //! their definitions: [`JointConstraint`], what every pass reads (the two slots, their masses,
-//! the point rows and the impulses, about 300 bytes), and its extra rows
-//! ([`joint_extra`](super::joint_extra)) only for the kinds that have them. On Box2D's
-//! `joint_grid` (10,000 balls, 19,800 ball joints) the whole joint was a kilobyte, and
-//! streaming it five times a substep was most of the step.
+//! the point rows and the impulses, about 300 bytes), and its extra rows (`joint_extra.rs`)
+//! only for the kinds that have them. On Box2D's `joint_grid` (10,000 balls, 19,800 ball
+//! joints) the whole joint was a kilobyte, and streaming it five times a substep was most of
+//! the step. Free ball joints are solved four at a time in SIMD lanes (`joint_batch.rs`).
+//!
+//! [`joint_rows`]: super::joint_rows
 
 use super::body::{BodyState, SolverBodies};
 use super::joint_rows::{PairMasses, inverse_mass, point_mass, solve_point};
@@ -79,7 +80,7 @@ impl JointImpulses {
 }
 
 /// What every pass over a joint reads: its bodies, their masses, its point rows and its
-/// impulses (the other rows are in its [`JointExtra`](super::joint_extra::JointExtra)).
+/// impulses (the other rows are in its `JointExtra`, `joint_extra.rs`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct JointConstraint {
     /// The caller's key (the ECS passes the joint entity's bits).
@@ -107,7 +108,7 @@ pub struct JointConstraint {
 
 /// A joint's anchors where the bodies are now, and the point rows' effective mass there.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct PointRows {
+pub(super) struct PointRows {
     /// `r_a`, `r_b`: the anchors from the centres of mass (world).
     pub anchors: (Vec3, Vec3),
     /// Anchor to anchor, `c_b + r_b − c_a − r_a`.

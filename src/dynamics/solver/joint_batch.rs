@@ -5,8 +5,8 @@
 //! Only joints that are nothing but their point rows ride in lanes: free ball joints, the
 //! joints of Box2D's `joint_grid`, of nets and of chains. The joints of a batch move no
 //! common body ([`OrderedBatches`](super::ordered_batches::OrderedBatches), so the batches in
-//! order give the key-order sweep of the scalar path), so no two lanes write the same
-//! velocities: a batch gathers its bodies' velocities, runs the scalar arithmetic of
+//! order give the scalar sweep over these joints in their order; the other joints are solved
+//! one at a time after the batches), so no two lanes write the same velocities: a batch gathers its bodies' velocities, runs the scalar arithmetic of
 //! [`joint_rows`](super::joint_rows) (`point_mass`, `inverse_mass`, `solve_point`) in every
 //! lane, and scatters them back. Padding lanes hold zero masses and impulses: their `K⁻¹` is
 //! zero and their impulses stay zero.

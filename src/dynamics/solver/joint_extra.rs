@@ -125,8 +125,8 @@ impl JointExtra {
         sb: &BodyState,
         point: &PointRows,
     ) {
-        let (r_a, r_b) = point.anchors;
         let (anchors, separation) = (point.anchors, point.separation);
+        let (r_a, r_b) = anchors;
         // The point rows' effective mass, for the angular rows held at the anchors.
         let k = &point.inverse_mass;
         let fa = sa.delta_rotation * self.frames[0];

@@ -4,8 +4,9 @@
 //! `b2WarmStartJoint` / `b2SolveJoint` passes).
 //!
 //! The free ball joints ride four at a time in [`JointBatch`]es, packed by the contacts'
-//! [`OrderedBatches`] so that the batches in order solve them as the key-order sweep would;
-//! the other joints are solved one at a time after the batches, in key order.
+//! [`OrderedBatches`] so that the batches in order solve them as the sweep in the order given
+//! would; the other joints are solved one at a time after the batches, in the order given
+//! (the ECS gives them by key).
 
 use super::body::{BodyState, SolverBodies};
 use super::joint::{JointConstraint, JointImpulses, JointInput};
@@ -45,7 +46,7 @@ impl JointList {
         (max_speed, max_spin): (f32, f32),
     ) -> usize {
         self.gather(bodies, inputs);
-        let bounded = self.bound_impulses(max_speed, max_spin);
+        let bounded = self.bound(max_speed, max_spin);
         self.pack(bodies.len());
         bounded
     }
@@ -87,8 +88,8 @@ impl JointList {
     /// grows its rigid passes' impulses step after step until they overflow. The bound is per
     /// joint: a sound joint can reach it too where a light, thin body carries a heavy one (a
     /// 0.2 kg rod holding 10 kg 10 cm off its axis), and is then held to it. Returns how many
-    /// joints it changed.
-    pub(super) fn bound_impulses(&mut self, max_speed: f32, max_spin: f32) -> usize {
+    /// joints it changed. Runs before the packing, which copies the impulses into the batches.
+    fn bound(&mut self, max_speed: f32, max_spin: f32) -> usize {
         let mut bounded = 0;
         for i in 0..self.joints.len() {
             if self.joints[i].impulses == JointImpulses::default() {
@@ -132,16 +133,8 @@ impl JointList {
             j.is_free_ball()
                 .then(|| moved.map(|(slot, dynamic)| dynamic.then_some(slot)))
         });
-        let mut used = 0;
-        for members in self.batching.batches() {
-            if used == self.batches.len() {
-                self.batches.push(JointBatch::default());
-            }
-            if self.batches[used].repack(members, joints) {
-                used += 1;
-            }
-        }
-        self.batches.truncate(used);
+        self.batching
+            .refill(&mut self.batches, |b, members| b.repack(members, joints));
     }
 
     /// Applies joint `i`'s accumulated impulses to the bodies in `states` at slots `ab`.
@@ -211,10 +204,20 @@ impl JointList {
         }
     }
 
-    /// Sets joint `i`'s carried point impulse (a test's stand-in for a bad warm start).
+    /// [`Self::bound`] on the joints' impulses as they are now, repacked after.
+    #[cfg(test)]
+    pub(super) fn bound_impulses(&mut self, max_speed: f32, max_spin: f32) -> usize {
+        let bounded = self.bound(max_speed, max_spin);
+        self.pack(self.batching.bodies());
+        bounded
+    }
+
+    /// Sets joint `i`'s carried point impulse (a test's stand-in for a bad warm start), in the
+    /// joint and its batch.
     #[cfg(test)]
     pub(super) fn set_impulses(&mut self, i: usize, point: glam::Vec3) {
         self.joints[i].impulses.point = point;
+        self.pack(self.batching.bodies());
     }
 
     /// Sets every joint's point impulse to `point(i)`, in the joints and their batches.

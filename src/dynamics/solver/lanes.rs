@@ -1,5 +1,5 @@
-//! Four of everything: the vector and quaternion arithmetic of the batched contact solver, one
-//! contact per SIMD lane (rapier's `SimdReal` over `wide::f32x4`, Box2D v3's `b2FloatW`).
+//! Four of everything: the vector, matrix and quaternion arithmetic of the batched contact and
+//! joint solvers, one contact or joint per SIMD lane (rapier's `SimdReal` over `wide::f32x4`, Box2D v3's `b2FloatW`).
 //!
 //! Each type holds one component per lane, so `a.dot(b)` is three multiplies and two adds that
 //! serve four contacts at once. The operations are written in the same order as glam's scalar
@@ -14,7 +14,7 @@ use wide::f32x4;
 /// One float per lane.
 pub type Lanes = f32x4;
 
-/// How many contacts a batch solves at once.
+/// How many contacts (or joints) a batch solves at once.
 pub const LANES: usize = 4;
 
 /// A 3-vector per lane.

@@ -9,17 +9,22 @@
 //!    last step's impulses ([`WarmStartCache`]), then packed up to four at a time into
 //!    [`ContactBatch`]es of contacts that share no moving body ([`ordered_batches`]); joints
 //!    seeded with theirs, held to what the speed and spin bounds allow
-//!    (`joint_list.rs`, `JointList::bound_impulses`);
+//!    (`joint_list.rs`, `JointList::bound_impulses`), the free ball joints packed four at a
+//!    time the same way (`joint_batch.rs`);
 //! 2. `substeps` times:
 //!    1. **integrate velocities** — springs, then gravity, forces, torques and damping, all
 //!       evaluated at the substep's starting state (so a stiff spring is as stable as the
 //!       substep is short, and a dashpot never resists gravity's kick);
-//!    2. **warm start** — apply the accumulated impulses (each contact's points are swept in
-//!       the opposite order from the last substep, so Gauss–Seidel favours none of them);
-//!    3. **solve** — one biased pass: penetration pushed out softly, speculative points closed;
+//!    2. **warm start** — apply the accumulated impulses, joints' then contacts' (each
+//!       contact's points are swept in the opposite order from the last substep, so
+//!       Gauss–Seidel favours none of them);
+//!    3. **solve** — one biased pass, joints before contacts (Box2D's order: the contacts, last,
+//!       win a conflict): penetration pushed out softly, speculative points closed, joint
+//!       errors closed at [`SoftStepSettings::joint_hertz`];
 //!    4. **integrate positions** — each body's motion since the step's start (`dp`, `dq`),
 //!       a dynamic body's speed at most [`SoftStepSettings::max_linear_speed`] and every
-//!       body's turn at most [`SoftStepSettings::max_rotation_per_substep`];
+//!       body's turn at most [`SoftStepSettings::max_rotation_per_substep`]; the joints' rows
+//!       are taken again where the bodies now are;
 //!    5. **relax** — passes without bias, friction and rolling resistance included (two by default, see
 //!       [`SoftStepSettings::relax_iterations`]);
 //! 3. **restitution** — bounces from the approach speeds at the step's start, then the speed
@@ -41,6 +46,13 @@
 //! the scalar rows, four contacts at a time where the contact graph allows it (a 210-box
 //! pyramid: 590 contacts in 169 batches). Contacts with rolling resistance are solved one at a
 //! time after the batches.
+//!
+//! Free ball joints (the point rows alone: nets, chains) ride in lanes the same way
+//! (`joint_batch.rs`), exactly their key-order sweep; the joints of other kinds (limits,
+//! hinges, welds, sliders, distances) are solved one at a time after the batches, in the order
+//! given. In a scene mixing both, the ball joints therefore go first in each pass, where the
+//! scalar sweep would have interleaved them by key: another Gauss–Seidel order, as
+//! deterministic.
 //!
 //! Bodies are in the caller's slot order and contacts in the caller's key order, and the
 //! batches follow the key order, so the result depends on nothing else (no hashing, no
@@ -348,9 +360,9 @@ impl Solver {
     }
 
     /// How many joints carried impulses into the last step that were not finite or could have
-    /// changed a body's velocity by more than twice the speed or spin bound,
-    /// and were dropped or scaled down (`joint_list.rs`, `JointList::bound_impulses`). Joints that keep
-    /// tripping it fight each other or carry far more than their bodies can take.
+    /// changed a body's velocity by more than twice the speed or spin bound, and were dropped
+    /// or scaled down (`joint_list.rs`, `JointList::bound_impulses`). Joints that keep tripping
+    /// it fight each other or carry far more than their bodies can take.
     pub fn bounded_joints(&self) -> usize {
         self.bounded_joints
     }
@@ -477,16 +489,10 @@ impl Solver {
             s.warm_start_distance,
         );
         self.batching.pack(&self.constraints, bodies.len());
-        let mut used = 0;
-        for indices in self.batching.batches() {
-            if used == self.batches.len() {
-                self.batches.push(ContactBatch::default());
-            }
-            let packed = self.batches[used].repack(indices, &self.constraints);
-            debug_assert!(packed, "the batching hands out 1 to 4 valid indices");
-            used += usize::from(packed);
-        }
-        self.batches.truncate(used);
+        let constraints = &self.constraints;
+        self.batching.refill(&mut self.batches, |b, indices| {
+            b.repack(indices, constraints)
+        });
     }
 }
 

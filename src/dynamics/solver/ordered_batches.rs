@@ -1,5 +1,5 @@
-//! Contacts packed [`LANES`] at a time without changing the result of solving them one by one
-//! in key order.
+//! Contacts (and free ball joints) packed [`LANES`] at a time without changing the result of
+//! solving them one by one in key order.
 //!
 //! Two contacts that move no common body commute: solving them in either order, or side by
 //! side, gives the same velocities. So each contact, taken in key order, may join any batch
@@ -117,6 +117,26 @@ impl OrderedBatches {
             .iter()
             .enumerate()
             .map(|(k, &n)| &self.members[k * LANES..k * LANES + n as usize])
+    }
+
+    /// Refills `batches` in place from the packing, one per batch of indices, through
+    /// `repack` (the solver reuses last step's batches: a batch is a few hundred bytes to a few
+    /// kilobytes, and building each anew copied it twice).
+    pub fn refill<B: Default>(
+        &self,
+        batches: &mut Vec<B>,
+        mut repack: impl FnMut(&mut B, &[u32]) -> bool,
+    ) {
+        let mut used = 0;
+        for indices in self.batches() {
+            if used == batches.len() {
+                batches.push(B::default());
+            }
+            let packed = repack(&mut batches[used], indices);
+            debug_assert!(packed, "the packing hands out 1 to 4 valid indices");
+            used += usize::from(packed);
+        }
+        batches.truncate(used);
     }
 
     /// The body slots of the last packing.
