@@ -14,6 +14,7 @@ use glam::Vec3;
 pub(crate) struct JointParams<'w, 's> {
     joints: Query<'w, 's, (Entity, &'static Joint), ActiveJoint>,
     quarantined: Query<'w, 's, (), With<Quarantined>>,
+    sleepers: Query<'w, 's, (), With<Sleeping>>,
 }
 
 impl JointParams<'_, '_> {
@@ -22,18 +23,26 @@ impl JointParams<'_, '_> {
         !self.joints.is_empty()
     }
 
-    /// Adds the joints' bodies to `entities` (a quarantined body is left out: its joints are
-    /// skipped).
+    /// Adds the joints' bodies that sorted `entities` lacks (a quarantined body is left out:
+    /// its joints are skipped), then sorts them in. Most jointed bodies are already there (the
+    /// awake movers): a net of 10,000 balls sorted its 50,000 entries every step when each
+    /// joint pushed both of its bodies.
     pub(crate) fn add_bodies(&self, entities: &mut Vec<Entity>) {
+        let known = entities.len();
         for (_, joint) in &self.joints {
             for e in [Some(joint.body_a), joint.body_b_entity()]
                 .into_iter()
                 .flatten()
             {
-                if !self.quarantined.contains(e) {
+                if entities[..known].binary_search(&e).is_err() && !self.quarantined.contains(e)
+                {
                     entities.push(e);
                 }
             }
+        }
+        if entities.len() > known {
+            entities.sort_unstable();
+            entities.dedup();
         }
     }
 
@@ -49,6 +58,11 @@ impl JointParams<'_, '_> {
         movers: &Query<Mover, MoverFilter>,
         waking: &mut Vec<Entity>,
     ) {
+        // Nothing asleep, nothing to wake: two lookups per joint saved (a 10,000-ball net
+        // made 40,000 a step).
+        if self.sleepers.is_empty() {
+            return;
+        }
         let state = |e: Entity| movers.get(e).ok().map(|m| (m.10, m.5.inverse() > 0.0));
         for (_, joint) in &self.joints {
             let Some(b) = joint.body_b_entity() else {

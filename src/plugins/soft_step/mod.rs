@@ -201,8 +201,6 @@ fn solve_soft_step(
     let awake = collect_entities(&awake, &contacts, &mut s.entities);
     if jointed {
         joints.add_bodies(&mut s.entities);
-        s.entities.sort_unstable();
-        s.entities.dedup();
     }
     s.bodies.clear();
     s.local_centers.clear();
