@@ -34,8 +34,7 @@ impl JointParams<'_, '_> {
                 .into_iter()
                 .flatten()
             {
-                if entities[..known].binary_search(&e).is_err() && !self.quarantined.contains(e)
-                {
+                if entities[..known].binary_search(&e).is_err() && !self.quarantined.contains(e) {
                     entities.push(e);
                 }
             }
