@@ -74,12 +74,6 @@ pub struct AdaptiveSweep {
     switched: Option<(Vec<Pair>, Vec<Pair>)>,
     /// Buffers for a switch.
     moving: Vec<(ProxyId, Aabb, BodyKind)>,
-    /// Whether a body was inserted, moved or removed since the last commit. Only such commits
-    /// count for the rule: a game's schedule may commit again with nothing moved (the ECS
-    /// commits at the step's start and in its substep, re-sending unchanged boxes), and such a
-    /// commit, swapping nothing, once cleared every strike, so a net of 10,000 balls making
-    /// 30M swaps a step never fell back.
-    changed: bool,
 }
 
 impl Default for AdaptiveSweep {
@@ -92,7 +86,6 @@ impl Default for AdaptiveSweep {
             fallbacks: 0,
             switched: None,
             moving: Vec::new(),
-            changed: false,
         }
     }
 }
@@ -186,7 +179,6 @@ impl AdaptiveSweep {
 impl BroadPhase for AdaptiveSweep {
     fn insert(&mut self, id: ProxyId, aabb: Aabb, kind: BodyKind) -> Result<(), BroadPhaseError> {
         self.engine.get_mut().insert(id, aabb, kind)?;
-        self.changed = true;
         let slot = id as usize;
         if self.kinds.len() <= slot {
             self.kinds.resize(slot + 1, None);
@@ -197,7 +189,6 @@ impl BroadPhase for AdaptiveSweep {
 
     fn insert_bulk(&mut self, bodies: &[(ProxyId, Aabb, BodyKind)]) -> Result<(), BroadPhaseError> {
         self.engine.get_mut().insert_bulk(bodies)?;
-        self.changed |= !bodies.is_empty();
         let top = bodies.iter().map(|b| b.0 as usize + 1).max().unwrap_or(0);
         if self.kinds.len() < top {
             self.kinds.resize(top, None);
@@ -209,16 +200,11 @@ impl BroadPhase for AdaptiveSweep {
     }
 
     fn update(&mut self, id: ProxyId, aabb: Aabb) -> Result<(), BroadPhaseError> {
-        // Only a box that moved counts (the lookup stops at the first one).
-        let moved = !self.changed && self.engine.get().aabb(id) != Some(aabb);
-        self.engine.get_mut().update(id, aabb)?;
-        self.changed |= moved;
-        Ok(())
+        self.engine.get_mut().update(id, aabb)
     }
 
     fn remove(&mut self, id: ProxyId) -> Result<(), BroadPhaseError> {
         self.engine.get_mut().remove(id)?;
-        self.changed = true;
         if let Some(kind) = self.kinds.get_mut(id as usize) {
             *kind = None;
         }
@@ -228,7 +214,12 @@ impl BroadPhase for AdaptiveSweep {
     fn commit(&mut self) {
         self.switched = None;
         self.engine.get_mut().commit();
-        if !std::mem::take(&mut self.changed) {
+        // Only commits in which a box came, went or moved count for the rule: a game's
+        // schedule may commit again with nothing moved (the ECS commits at the step's start
+        // and in its substep, re-sending unchanged boxes), and such a commit, swapping
+        // nothing, once cleared every strike, so a net of 10,000 balls making 30M swaps a step
+        // never fell back.
+        if !self.engine.get().stats().changed {
             return;
         }
         if let Some(next) = self.next_engine() {

@@ -49,10 +49,12 @@ impl BroadPhase for BruteForce {
             }
         }
         let n = ids.len() as u64;
+        // The oracle rebuilds whatever changed.
         self.stats = StepStats {
             rebuilt: true,
             endpoint_swaps: 0,
             pair_tests: n * n.saturating_sub(1) / 2,
+            changed: self.bodies.take_changed(),
         };
         self.history.finish();
     }

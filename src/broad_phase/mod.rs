@@ -166,6 +166,10 @@ pub struct StepStats {
     /// The pairs were found again from scratch (the rebuilders; [`AdaptiveSweep`] while it
     /// has fallen back to sorting), not kept up incrementally.
     pub rebuilt: bool,
+    /// A body came, went or changed its box since the commit before (an update with the same
+    /// box is no change): a commit without reports no pair change, and [`AdaptiveSweep`]
+    /// judges only commits with.
+    pub changed: bool,
 }
 
 /// The common interface of every broad phase.

@@ -462,8 +462,11 @@ impl BroadPhase for RegionSweep {
     fn update(&mut self, id: ProxyId, aabb: Aabb) -> Result<(), BroadPhaseError> {
         self.slot(id).ok_or(BroadPhaseError::UnknownId(id))?;
         check_aabb(id, &aabb)?;
-        self.slots[id as usize].aabb = aabb;
-        self.queue(id);
+        // The same box again is no change (the ECS re-sends every box in a second commit).
+        if self.slots[id as usize].aabb != aabb {
+            self.slots[id as usize].aabb = aabb;
+            self.queue(id);
+        }
         Ok(())
     }
 
@@ -476,7 +479,10 @@ impl BroadPhase for RegionSweep {
     }
 
     fn commit(&mut self) {
-        self.stats = StepStats::default();
+        self.stats = StepStats {
+            changed: !self.changed.is_empty(),
+            ..StepStats::default()
+        };
         self.added.clear();
         self.removed.clear();
         if self.wants_layout() {

@@ -331,7 +331,13 @@ impl<T: PairTracking> BroadPhase for IncrementalSap<T> {
     }
 
     fn commit(&mut self) {
-        self.stats = StepStats::default();
+        // `update` queues a body only when its box differs.
+        let changed =
+            !(self.to_insert.is_empty() && self.to_update.is_empty() && self.to_remove.is_empty());
+        self.stats = StepStats {
+            changed,
+            ..StepStats::default()
+        };
         self.apply_removals();
         self.apply_updates();
         self.apply_inserts();

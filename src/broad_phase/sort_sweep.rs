@@ -166,6 +166,7 @@ impl BroadPhase for SortAndSweep {
             rebuilt: true,
             endpoint_swaps: 0,
             pair_tests: tests,
+            changed: true,
         };
     }
 
