@@ -5,6 +5,7 @@
 //! incremental SAP allocates nothing per step once its buffers have grown (a counting
 //! allocator, issue 12).
 
+use crate::common::rng::Rng;
 use glam::Vec3;
 use proptest::prelude::*;
 use std::collections::{BTreeMap, BTreeSet};
@@ -315,25 +316,9 @@ proptest! {
 
 // ---------------------------------------------------------------- larger scenes
 
-/// A small deterministic generator (xorshift64*), so the scene test needs no extra crate.
-pub(super) struct Rng(pub u64);
-
-impl Rng {
-    pub fn next_f32(&mut self) -> f32 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 40) as f32 / (1u64 << 24) as f32
-    }
-
-    pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.next_f32()
-    }
-}
-
 #[test]
 fn a_thousand_moving_bodies_match_sort_and_sweep_and_orders_are_reproducible() {
-    let mut rng = Rng(0x1234_5678_9abc_def1);
+    let mut rng = Rng::new(0x1234_5678_9abc_def1);
     let side = 14.0;
     let bodies: Vec<(ProxyId, Aabb, BodyKind)> = (0..1000)
         .map(|i| {

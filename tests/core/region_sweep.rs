@@ -4,7 +4,8 @@
 //! far-away boxes; pairs, additions and removals must equal an independent broad phase's after
 //! every commit. And no allocation per step once its buffers have grown.
 
-use super::broad_phase_props::{Rng, steady_state_allocations, swinging_box};
+use super::broad_phase_props::{steady_state_allocations, swinging_box};
+use crate::common::rng::Rng;
 use glam::Vec3;
 use urto::bounding::Aabb;
 use urto::broad_phase::{
@@ -86,7 +87,7 @@ fn both<'a>(
 /// every twentieth step they jump, and some leave and come back.
 #[test]
 fn mixed_sizes_with_large_bodies_match_sort_and_sweep_exactly_for_120_steps() {
-    let mut rng = Rng(0x5eed_0f7e_5700);
+    let mut rng = Rng::new(0x5eed_0f7e_5700);
     let mut bodies: Vec<(ProxyId, Aabb, BodyKind)> = (0..3000)
         .map(|i| {
             let c = in_cube(&mut rng, 30.0);
@@ -138,7 +139,7 @@ fn mixed_sizes_with_large_bodies_match_sort_and_sweep_exactly_for_120_steps() {
 /// jumping): the regions sweep just their changed members and keep the other pairs.
 #[test]
 fn few_movers_among_many_match_sort_and_sweep_exactly_for_100_steps() {
-    let mut rng = Rng(0xfe00_5eed);
+    let mut rng = Rng::new(0xfe00_5eed);
     let bodies: Vec<(ProxyId, Aabb, BodyKind)> = (0..4000)
         .map(|i| {
             let c = in_cube(&mut rng, 25.0);
@@ -167,7 +168,7 @@ fn few_movers_among_many_match_sort_and_sweep_exactly_for_100_steps() {
 /// tuning rounds run out; the pairs stay exact throughout.
 #[test]
 fn a_sparse_cloud_grows_its_cells_at_least_4_fold_and_stays_exact() {
-    let mut rng = Rng(0xa115_9a45);
+    let mut rng = Rng::new(0xa115_9a45);
     let (mut subject, mut reference) = (RegionSweep::new(), SortAndSweep::new());
     let boxes: Vec<Aabb> = (0..1000)
         .map(|_| {
@@ -201,7 +202,7 @@ fn a_sparse_cloud_grows_its_cells_at_least_4_fold_and_stays_exact() {
 /// box's y and z intervals overlap every other's).
 #[test]
 fn a_row_of_5000_boxes_along_x_matches_sort_and_sweep_for_30_steps() {
-    let mut rng = Rng(0x05ee_d0f0);
+    let mut rng = Rng::new(0x05ee_d0f0);
     let (mut subject, mut reference) = (RegionSweep::new(), SortAndSweep::new());
     let row = |i: u32, d: Vec3| {
         Aabb::from_center_half_extents(Vec3::new(i as f32 * 0.9, 0.0, 0.0) + d, Vec3::splat(0.5))
@@ -313,7 +314,7 @@ fn region_sweep_makes_0_allocations_per_step_once_its_buffers_have_grown() {
 /// 64), and the pairs stay exact.
 #[test]
 fn forty_big_boxes_among_small_ones_grow_the_cells_until_few_are_large_and_stay_exact() {
-    let mut rng = Rng(0xb16_5a11);
+    let mut rng = Rng::new(0xb16_5a11);
     let bodies: Vec<(ProxyId, Aabb, BodyKind)> = (0..3040)
         .map(|i| {
             let c = in_cube(&mut rng, 16.0);
