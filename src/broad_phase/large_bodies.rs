@@ -30,6 +30,8 @@ pub(super) struct LargeBodies {
     owned: Vec<Pair>,
     /// This commit's pairs (scratch).
     found: Vec<Pair>,
+    /// The kept and the new pairs merged (scratch).
+    merged: Vec<Pair>,
 }
 
 impl LargeBodies {
@@ -61,11 +63,12 @@ impl LargeBodies {
         (added, removed): (&mut Vec<Pair>, &mut Vec<Pair>),
     ) -> u64 {
         let tests = if full {
-            self.find_all(view)
+            let tests = self.find_all(view);
+            self.found.sort_unstable();
+            tests
         } else {
             self.find_changed(view, changed)
         };
-        self.found.sort_unstable();
         super::pair_diff::diff_sorted(&self.owned, &self.found, added, removed);
         std::mem::swap(&mut self.owned, &mut self.found);
         tests
@@ -101,7 +104,10 @@ impl LargeBodies {
         tests
     }
 
-    /// The last pairs of unchanged bodies, and the changed bodies against the large ones.
+    /// The last pairs of unchanged bodies, and the changed bodies against the large ones,
+    /// sorted: the kept pairs are already (a ground slab owns about one pair a body, and
+    /// sorting them all again cost every commit `n log n`), so only the new ones are sorted
+    /// and merged in (no pair is in both: every new one has a changed body).
     fn find_changed(&mut self, view: &impl LargeView, changed: &[ProxyId]) -> u64 {
         self.found.clear();
         self.found.extend(
@@ -109,6 +115,7 @@ impl LargeBodies {
                 .iter()
                 .filter(|p| !view.changed(p.a) && !view.changed(p.b)),
         );
+        let kept = self.found.len();
         let mut tests = 0;
         for &id in changed {
             let Some((aabb, kind, false)) = view.body(id) else {
@@ -124,12 +131,17 @@ impl LargeBodies {
                 }
             }
         }
+        self.found[kept..].sort_unstable();
+        let (old, new) = self.found.split_at(kept);
+        super::pair_diff::merge_sorted(old, new, &mut self.merged);
+        std::mem::swap(&mut self.found, &mut self.merged);
         tests
     }
 
     /// Heap bytes held.
     pub fn memory_bytes(&self) -> usize {
         self.ids.capacity() * size_of::<ProxyId>()
-            + (self.owned.capacity() + self.found.capacity()) * size_of::<Pair>()
+            + (self.owned.capacity() + self.found.capacity() + self.merged.capacity())
+                * size_of::<Pair>()
     }
 }

@@ -370,12 +370,12 @@ impl RegionSweep {
 
     /// Moves a changed body from its old cells to its new ones, queuing every region touched.
     fn place(&mut self, id: ProxyId, inverse_size: f32) {
-        let slot = &self.slots[id as usize];
+        let slot = self.slots[id as usize];
         let range = CellRange::of(&slot.aabb, inverse_size);
-        let slot = *slot;
-        if slot.present && slot.home_count > 0 && slot.placed == Placement::Cells(range) {
-            // Moved within its cells, the common case under coherence: its remembered regions
-            // re-read it, and nothing is hashed.
+        if slot.present && slot.placed == Placement::Cells(range) {
+            // Moved within its cells, the common case under coherence: its regions re-read it
+            // (the remembered ones without hashing; a body over more cells than it remembers
+            // finds them once, where leaving and re-entering found them twice).
             self.leave(&slot, id);
             return;
         }
