@@ -136,9 +136,16 @@ impl ConvexHull {
     pub fn support(&self, dir: Vec3) -> Vec3 {
         let v = &self.vertices;
         let mut best = argmax(v.len().min(16), |i| v[i].dot(dir));
-        let up = |b: usize, n: &&u32| v[**n as usize].dot(dir) > v[b].dot(dir);
-        while let Some(&n) = self.neighbours[best].iter().find(|n| up(best, n)) {
-            best = n as usize;
+        if v.len() <= 16 {
+            return v[best]; // every vertex was looked at
+        }
+        let mut height = v[best].dot(dir);
+        while let Some((n, h)) = self.neighbours[best]
+            .iter()
+            .map(|&n| (n as usize, v[n as usize].dot(dir)))
+            .find(|&(_, h)| h > height)
+        {
+            (best, height) = (n, h);
         }
         v[best]
     }

@@ -6,22 +6,28 @@
 //! horizon to it, until the support point adds less than a tolerance. The last closest face
 //! gives the normal (from A to B), the depth, and by its barycentric weights the witnesses.
 //!
-//! Fixed-size arrays, no heap: the narrow phase runs EPA per resting pair per step. A simplex of
-//! fewer than four points (the cores touch) is first blown up to a tetrahedron with support
-//! points along directions off its span, as Bullet and Jolt do.
+//! Each face knows its three neighbours (across the edges `ids[k] → ids[k+1]`), so the faces a
+//! new vertex sees are flooded out from the closest face through those links and the horizon
+//! is read off where the flood stops: a step costs what it removes and adds, not a scan of
+//! every face per edge (as in van den Bergen's silhouette walk and Jolt's `EPAConvexHullBuilder`).
+//! The polytope lives in a per-thread scratch that is cleared, not zero-filled, per call: the
+//! narrow phase runs EPA per resting pair per step, and allocates nothing once the scratch has
+//! grown. A simplex of fewer than four points (the cores touch) is first blown up to a
+//! tetrahedron with support points along directions off its span, as Bullet and Jolt do.
 
 use super::gjk::{Simplex, SupportPoint, support};
 use super::support::ConvexPart;
 use glam::{DQuat, DVec3, Vec3};
+use std::cell::RefCell;
 
-/// Most polytope vertices.
+/// Most polytope vertices (their ids are `u8`).
 const MAX_VERTICES: usize = 128;
-/// Most polytope faces (a closed triangulated polytope of V vertices has 2V − 4).
-const MAX_FACES: usize = 2 * MAX_VERTICES;
 /// Iterations EPA may take before answering with its best face.
 const MAX_ITERATIONS: usize = MAX_VERTICES - 4;
 /// Converged when a support point adds at most this fraction of the pair's size.
 const RELATIVE_TOLERANCE: f64 = 1e-6;
+/// "No face" / "no fan face yet" in the adjacency and horizon tables.
+const NONE: u16 = u16::MAX;
 
 /// EPA's answer.
 #[derive(Clone, Copy, Debug)]
@@ -36,68 +42,115 @@ pub(crate) struct Penetration {
     pub on_b: Vec3,
 }
 
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug)]
 struct Face {
+    /// Corners, counter-clockwise seen from outside.
     ids: [u8; 3],
+    /// `adjacent[k]`: the face across the edge `ids[k] → ids[(k + 1) % 3]`.
+    adjacent: [u16; 3],
     normal: DVec3,
+    /// Distance of the face's plane from the origin; infinite for a sliver without a normal.
     distance: f64,
     alive: bool,
 }
 
+/// A horizon edge `(from, to)` of the faces being removed, and the face `outside` that stays
+/// across it, whose edge `outside_edge` runs `to → from`.
+#[derive(Clone, Copy)]
+struct HorizonEdge {
+    from: u8,
+    to: u8,
+    outside: u16,
+    outside_edge: u8,
+    /// The fan face made on this edge.
+    slot: u16,
+}
+
+/// The polytope and the scratch of its expansion, reused from call to call.
+#[derive(Default)]
 struct Polytope {
-    vertices: [SupportPoint; MAX_VERTICES],
-    vertex_count: usize,
-    faces: [Face; MAX_FACES],
-    face_count: usize,
+    vertices: Vec<SupportPoint>,
+    faces: Vec<Face>,
+    /// Slots of dead faces, reused by new ones.
+    free: Vec<u16>,
+    /// The flood's stack and the faces it removed.
+    stack: Vec<u16>,
+    removed: Vec<u16>,
+    horizon: Vec<HorizonEdge>,
+    /// Per vertex, the fan face whose horizon edge starts (ends) there; `NONE` between calls.
+    fan_from: Vec<u16>,
+    fan_to: Vec<u16>,
+}
+
+thread_local! {
+    static POLYTOPE: RefCell<Polytope> = RefCell::new(Polytope::default());
 }
 
 impl Polytope {
+    fn clear(&mut self) {
+        self.vertices.clear();
+        self.faces.clear();
+        self.free.clear();
+        self.fan_from.clear();
+        self.fan_from.resize(MAX_VERTICES, NONE);
+        self.fan_to.clear();
+        self.fan_to.resize(MAX_VERTICES, NONE);
+    }
+
     fn add_vertex(&mut self, p: SupportPoint) -> Option<u8> {
-        (self.vertex_count < MAX_VERTICES).then(|| {
-            self.vertices[self.vertex_count] = p;
-            self.vertex_count += 1;
-            (self.vertex_count - 1) as u8
+        (self.vertices.len() < MAX_VERTICES).then(|| {
+            self.vertices.push(p);
+            (self.vertices.len() - 1) as u8
         })
     }
 
-    /// Adds the face `ids` (counter-clockwise seen from outside); a sliver without a normal is
-    /// kept for the topology but never chosen.
-    fn add_face(&mut self, ids: [u8; 3]) -> bool {
-        let slot = if self.face_count < MAX_FACES {
-            self.face_count += 1;
-            self.face_count - 1
-        } else if let Some(dead) = self.faces.iter().position(|f| !f.alive) {
-            dead
-        } else {
-            return false;
-        };
+    /// Adds the face `ids` (counter-clockwise seen from outside) with its neighbours; a sliver
+    /// without a normal is kept for the topology but never chosen. `None` when the face slots
+    /// run out (`u16` indices).
+    fn add_face(&mut self, ids: [u8; 3], adjacent: [u16; 3]) -> Option<u16> {
         let [a, b, c] = ids.map(|i| self.vertices[i as usize].w);
         let (normal, distance) = match (b - a).cross(c - a).try_normalize() {
             Some(n) => (n, n.dot(a)),
             None => (DVec3::Z, f64::INFINITY),
         };
-        self.faces[slot] = Face {
+        let face = Face {
             ids,
+            adjacent,
             normal,
             distance,
             alive: true,
         };
-        true
+        if let Some(slot) = self.free.pop() {
+            self.faces[slot as usize] = face;
+            return Some(slot);
+        }
+        let slot = u16::try_from(self.faces.len())
+            .ok()
+            .filter(|&s| s != NONE)?;
+        self.faces.push(face);
+        Some(slot)
+    }
+
+    /// Links every face of a closed polytope to its neighbours by matching reversed edges
+    /// (only the starting tetrahedron: later faces are linked as they are made).
+    fn link_all(&mut self) {
+        for f in 0..self.faces.len() {
+            for k in 0..3 {
+                let (i, j) = edge(self.faces[f].ids, k);
+                self.faces[f].adjacent[k] = (0..self.faces.len())
+                    .find(|&g| g != f && (0..3).any(|m| edge(self.faces[g].ids, m) == (j, i)))
+                    .map_or(NONE, |g| g as u16);
+            }
+        }
     }
 
     fn closest_face(&self) -> Option<usize> {
-        (0..self.face_count)
-            .filter(|&f| self.faces[f].alive)
-            .min_by(|&x, &y| self.faces[x].distance.total_cmp(&self.faces[y].distance))
-    }
-
-    /// The alive face other than `f` that runs the edge `(j, i)`: `f`'s neighbour across
-    /// `(i, j)`.
-    fn neighbour(&self, f: usize, (i, j): (u8, u8)) -> Option<usize> {
-        (0..self.face_count).find(|&g| {
-            let ids = self.faces[g].ids;
-            g != f && self.faces[g].alive && (0..3).any(|k| (ids[k], ids[(k + 1) % 3]) == (j, i))
-        })
+        self.faces
+            .iter()
+            .enumerate()
+            .filter(|(_, f)| f.alive)
+            .min_by(|(_, x), (_, y)| x.distance.total_cmp(&y.distance))
+            .map(|(f, _)| f)
     }
 
     /// A sliver (no normal) counts as seen: replacing it costs nothing, and its stand-in
@@ -110,46 +163,116 @@ impl Polytope {
 
     /// Removes the faces the new vertex `new` sees, flooding out from `seed` (which sees it)
     /// across shared edges so that the removed region is connected, as on a convex polytope it
-    /// is; fans the horizon (the edges into faces that stay) to `new`.
+    /// is; fans the horizon (the edges into faces that stay) to `new`. `false`, with the
+    /// polytope as it was, when rounding made the horizon something other than simple loops.
     fn expand(&mut self, seed: usize, new: u8) -> bool {
-        let p = self.vertices[new as usize].w;
-        let mut visible = [false; MAX_FACES];
-        let mut stack = [0usize; MAX_FACES];
-        let mut top = 1;
-        stack[0] = seed;
-        visible[seed] = true;
-        let mut horizon = [(0u8, 0u8); MAX_FACES];
-        let mut edges = 0usize;
-        while top > 0 {
-            top -= 1;
-            let f = stack[top];
-            let ids = self.faces[f].ids;
-            for k in 0..3 {
-                let edge = (ids[k], ids[(k + 1) % 3]);
-                match self.neighbour(f, edge) {
-                    Some(g) if visible[g] => {}
-                    Some(g) if self.sees(g, p) && top < MAX_FACES => {
-                        visible[g] = true;
-                        stack[top] = g;
-                        top += 1;
-                    }
-                    _ if edges < MAX_FACES => {
-                        horizon[edges] = edge;
-                        edges += 1;
-                    }
-                    _ => return false,
-                }
+        if !self.flood(seed, new) || !self.index_fan() {
+            // Dead so far: the faces flooded and those still waiting on the stack.
+            for &f in self.removed.iter().chain(&self.stack) {
+                self.faces[f as usize].alive = true;
             }
+            self.reset_fan_index();
+            return false;
         }
-        for (f, &gone) in visible.iter().enumerate().take(self.face_count) {
-            if gone {
-                self.faces[f].alive = false;
-            }
-        }
-        horizon[..edges]
-            .iter()
-            .all(|&(i, j)| self.add_face([i, j, new]))
+        self.free.extend_from_slice(&self.removed);
+        let fanned = self.fan(new);
+        self.reset_fan_index();
+        fanned
     }
+
+    /// Marks dead the faces `new` sees, connected to `seed`, into `removed`, and collects the
+    /// horizon; `false` on a face with a missing neighbour (a broken topology).
+    fn flood(&mut self, seed: usize, new: u8) -> bool {
+        let p = self.vertices[new as usize].w;
+        self.stack.clear();
+        self.removed.clear();
+        self.horizon.clear();
+        self.faces[seed].alive = false;
+        self.stack.push(seed as u16);
+        while let Some(f) = self.stack.pop() {
+            self.removed.push(f);
+            let face = self.faces[f as usize];
+            for k in 0..3 {
+                let g = face.adjacent[k];
+                if g == NONE {
+                    return false;
+                }
+                if !self.faces[g as usize].alive {
+                    continue; // already removed
+                }
+                if self.sees(g as usize, p) {
+                    self.faces[g as usize].alive = false;
+                    self.stack.push(g);
+                    continue;
+                }
+                let (from, to) = edge(face.ids, k);
+                let Some(back) =
+                    (0..3).find(|&m| edge(self.faces[g as usize].ids, m) == (to, from))
+                else {
+                    return false;
+                };
+                self.horizon.push(HorizonEdge {
+                    from,
+                    to,
+                    outside: g,
+                    outside_edge: back as u8,
+                    slot: NONE,
+                });
+            }
+        }
+        true
+    }
+
+    /// Numbers the fan faces by the vertex their horizon edge starts and ends at; `false`
+    /// unless every horizon vertex starts exactly one edge and ends exactly one (simple loops).
+    fn index_fan(&mut self) -> bool {
+        for (n, e) in self.horizon.iter().enumerate() {
+            let (from, to) = (e.from as usize, e.to as usize);
+            if self.fan_from[from] != NONE || self.fan_to[to] != NONE {
+                return false;
+            }
+            self.fan_from[from] = n as u16;
+            self.fan_to[to] = n as u16;
+        }
+        self.horizon
+            .iter()
+            .all(|e| self.fan_from[e.to as usize] != NONE)
+    }
+
+    fn reset_fan_index(&mut self) {
+        for e in &self.horizon {
+            self.fan_from[e.from as usize] = NONE;
+            self.fan_to[e.to as usize] = NONE;
+        }
+    }
+
+    /// One face `(from, to, new)` per horizon edge, linked to the face outside and to its two
+    /// fan neighbours. Slots are taken first so that the links can name them; `false` when
+    /// the slots run out (the polytope is then left half-fanned, and EPA stops on its last
+    /// sound face).
+    fn fan(&mut self, new: u8) -> bool {
+        for n in 0..self.horizon.len() {
+            let e = self.horizon[n];
+            let Some(slot) = self.add_face([e.from, e.to, new], [e.outside, NONE, NONE]) else {
+                return false;
+            };
+            self.horizon[n].slot = slot;
+            self.faces[e.outside as usize].adjacent[e.outside_edge as usize] = slot;
+        }
+        for e in &self.horizon {
+            // Edge to → new borders the fan face starting at `to`; new → from, the one ending
+            // at `from`.
+            let next = self.horizon[self.fan_from[e.to as usize] as usize].slot;
+            let previous = self.horizon[self.fan_to[e.from as usize] as usize].slot;
+            self.faces[e.slot as usize].adjacent[1..].copy_from_slice(&[next, previous]);
+        }
+        true
+    }
+}
+
+/// The edge `k` of a face: `ids[k] → ids[(k + 1) % 3]`.
+fn edge(ids: [u8; 3], k: usize) -> (u8, u8) {
+    (ids[k], ids[(k + 1) % 3])
 }
 
 /// Blows a simplex of fewer than four points up to a tetrahedron; `None` when `A − B` is flat.
@@ -206,15 +329,26 @@ fn tetrahedron(a: &ConvexPart, b: &ConvexPart, s: &Simplex, eps: f64) -> Option<
 /// The penetration of the cores of `a` and `b`, from GJK's overlapping `simplex`; `None` only
 /// when `A − B` has no volume (two flat cores in one plane), where no depth is defined.
 pub(crate) fn epa(a: &ConvexPart, b: &ConvexPart, simplex: &Simplex) -> Option<Penetration> {
+    // A fresh polytope only if this thread's is in use or being torn down.
+    POLYTOPE
+        .try_with(|cell| match cell.try_borrow_mut() {
+            Ok(mut poly) => expand_to_depth(&mut poly, a, b, simplex),
+            Err(_) => expand_to_depth(&mut Polytope::default(), a, b, simplex),
+        })
+        .unwrap_or_else(|_| expand_to_depth(&mut Polytope::default(), a, b, simplex))
+}
+
+/// EPA proper (module docs) in the polytope `poly`, cleared first.
+fn expand_to_depth(
+    poly: &mut Polytope,
+    a: &ConvexPart,
+    b: &ConvexPart,
+    simplex: &Simplex,
+) -> Option<Penetration> {
     let scale = f64::from(a.size() + b.size());
     let tolerance = (RELATIVE_TOLERANCE * scale).max(f64::MIN_POSITIVE);
     let start = tetrahedron(a, b, simplex, tolerance)?;
-    let mut poly = Polytope {
-        vertices: [SupportPoint::default(); MAX_VERTICES],
-        vertex_count: 0,
-        faces: [Face::default(); MAX_FACES],
-        face_count: 0,
-    };
+    poly.clear();
     for p in start {
         poly.add_vertex(p)?;
     }
@@ -222,8 +356,9 @@ pub(crate) fn epa(a: &ConvexPart, b: &ConvexPart, simplex: &Simplex) -> Option<P
     for [i, j, k, opposite] in [[0u8, 1, 2, 3], [0, 3, 1, 2], [0, 2, 3, 1], [1, 3, 2, 0]] {
         let w = |i: u8| start[i as usize].w;
         let inward = (w(j) - w(i)).cross(w(k) - w(i)).dot(w(opposite) - w(i)) > 0.0;
-        poly.add_face(if inward { [i, k, j] } else { [i, j, k] });
+        poly.add_face(if inward { [i, k, j] } else { [i, j, k] }, [NONE; 3])?;
     }
+    poly.link_all();
     // A copy, not an index: a failed expansion may leave the slot dead or reused.
     let mut seed = poly.closest_face()?;
     let mut face = poly.faces[seed];
@@ -250,7 +385,7 @@ pub(crate) fn epa(a: &ConvexPart, b: &ConvexPart, simplex: &Simplex) -> Option<P
         }
     }
     finite(face.distance)?;
-    Some(witnesses(&poly, face))
+    Some(witnesses(poly, face))
 }
 
 fn finite(x: f64) -> Option<f64> {
@@ -289,6 +424,7 @@ mod tests {
     use super::*;
     use crate::geometry::convex::gjk::{Gjk, gjk};
     use crate::geometry::{Isometry, Shape};
+    use crate::test_rng::TestRng;
 
     #[test]
     fn overlapping_boxes_give_the_face_depth_within_1e_5() {
@@ -302,5 +438,54 @@ mod tests {
         let p = epa(&a, &b, &s).unwrap();
         assert!((p.depth - 0.1).abs() < 1e-5, "{p:?}");
         assert!(p.normal.dot(Vec3::Z) > 1.0 - 1e-5, "{p:?}");
+    }
+
+    /// The polytope after EPA on overlapping curved and polytope shapes: every alive face's
+    /// three neighbours are alive and name it back across the same edge reversed, and the
+    /// alive faces close a sphere (Euler: V − E + F = 2 over the vertices they use).
+    #[test]
+    fn expanded_polytopes_stay_closed_with_reciprocal_neighbours_on_300_pairs() {
+        let mut rng = TestRng::new(15);
+        let mut poly = Polytope::default();
+        let mut expanded = 0;
+        for _ in 0..300 {
+            let shape = |r: &mut TestRng| match r.below(4) {
+                0 => Shape::cylinder(r.range(0.05, 1.0), r.range(0.05, 1.0)),
+                1 => Shape::ellipsoid(r.vec3(0.05, 1.0)),
+                2 => Shape::cone(r.range(0.05, 1.0), r.range(0.05, 1.0)),
+                _ => Shape::cuboid(r.vec3(0.05, 1.0)),
+            };
+            let (sa, sb) = (shape(&mut rng), shape(&mut rng));
+            let at = Isometry::new(rng.vec3(-0.3, 0.3), rng.rotation());
+            let a = ConvexPart::of_shape(&sa, Isometry::IDENTITY).unwrap();
+            let b = ConvexPart::of_shape(&sb, at).unwrap();
+            let Gjk::Overlapping(s) = gjk(&a, &b) else {
+                continue;
+            };
+            assert!(expand_to_depth(&mut poly, &a, &b, &s).is_some());
+            expanded += usize::from(poly.vertices.len() > 4);
+            let alive: Vec<usize> = (0..poly.faces.len())
+                .filter(|&f| poly.faces[f].alive)
+                .collect();
+            for &f in &alive {
+                for k in 0..3 {
+                    let g = poly.faces[f].adjacent[k] as usize;
+                    let (i, j) = edge(poly.faces[f].ids, k);
+                    assert!(poly.faces[g].alive, "face {f} edge {k} borders a dead face");
+                    let back = (0..3).find(|&m| edge(poly.faces[g].ids, m) == (j, i));
+                    assert_eq!(back.map(|m| poly.faces[g].adjacent[m] as usize), Some(f));
+                }
+            }
+            let mut used = [false; MAX_VERTICES];
+            for &f in &alive {
+                for i in poly.faces[f].ids {
+                    used[i as usize] = true;
+                }
+            }
+            let v = used.iter().filter(|&&u| u).count() as i64;
+            let (e, f) = (3 * alive.len() as i64 / 2, alive.len() as i64);
+            assert_eq!(v - e + f, 2, "Euler characteristic");
+        }
+        assert!(expanded > 100, "only {expanded} pairs grew the polytope");
     }
 }
