@@ -136,16 +136,12 @@ impl ConvexHull {
     pub fn support(&self, dir: Vec3) -> Vec3 {
         let v = &self.vertices;
         let mut best = argmax(v.len().min(16), |i| v[i].dot(dir));
-        if v.len() <= 16 {
-            return v[best]; // every vertex was looked at
-        }
-        let mut height = v[best].dot(dir);
-        while let Some((n, h)) = self.neighbours[best]
-            .iter()
-            .map(|&n| (n as usize, v[n as usize].dot(dir)))
-            .find(|&(_, h)| h > height)
+        let higher = |b: usize| self.neighbours[b].iter().map(|&n| n as usize);
+        let higher = |b: usize| higher(b).find(|&n| v[n].dot(dir) > v[b].dot(dir));
+        while v.len() > 16
+            && let Some(n) = higher(best)
         {
-            (best, height) = (n, h);
+            best = n;
         }
         v[best]
     }

@@ -110,18 +110,20 @@ pub(crate) fn manifold(
         .map(|p| p.depth)
         .fold(f32::NEG_INFINITY, f32::max);
     let mut out = ContactManifold::new(n);
-    if best < deepest.depth - 1e-5 * (a.size() + b.size()) {
+    if found.is_empty() || best < deepest.depth - 1e-5 * (a.size() + b.size()) {
         // The clip missed the deepest point (a rim or corner against an edge of the
-        // reference, a subsampled face): keep it first.
+        // reference, a subsampled face) or found nothing: keep it first (once).
         out.push(deepest);
     }
-    if found.is_empty() {
-        out.push(deepest);
-        return out;
-    }
-    let (chosen, count) = spread_points(found, n);
+    spread_into(out, found)
+}
+
+/// `out` with at most its capacity of `points` added: the deepest, then the widest spread
+/// (`manifold_reduction.rs`).
+fn spread_into(mut out: ContactManifold, points: &[ContactPoint]) -> ContactManifold {
+    let (chosen, count) = spread_points(points, out.normal);
     for &i in &chosen[..count] {
-        out.push(found[i]);
+        out.push(points[i]);
     }
     out
 }
@@ -251,9 +253,5 @@ pub(crate) fn contact_convex_halfspace(
         });
         return Some(out);
     }
-    let (chosen, count) = spread_points(&points[..len], normal);
-    for &i in &chosen[..count] {
-        out.push(points[i]);
-    }
-    Some(out)
+    Some(spread_into(out, &points[..len]))
 }

@@ -10,9 +10,9 @@
 //! new vertex sees are flooded out from the closest face through those links and the horizon
 //! is read off where the flood stops: a step costs what it removes and adds, not a scan of
 //! every face per edge (as in van den Bergen's silhouette walk and Jolt's `EPAConvexHullBuilder`).
-//! The polytope lives in a per-thread scratch that is cleared, not zero-filled, per call: the
-//! narrow phase runs EPA per resting pair per step, and allocates nothing once the scratch has
-//! grown. A simplex of fewer than four points (the cores touch) is first blown up to a
+//! The polytope lives in a per-thread scratch whose arrays are cleared, not zero-filled, per
+//! call: the narrow phase runs EPA per resting pair per step, and allocates nothing once the
+//! scratch has grown. A simplex of fewer than four points (the cores touch) is first blown up to a
 //! tetrahedron with support points along directions off its span, as Bullet and Jolt do.
 
 use super::gjk::{Simplex, SupportPoint, support};
@@ -164,7 +164,7 @@ impl Polytope {
     /// Removes the faces the new vertex `new` sees, flooding out from `seed` (which sees it)
     /// across shared edges so that the removed region is connected, as on a convex polytope it
     /// is; fans the horizon (the edges into faces that stay) to `new`. `false`, with the
-    /// polytope as it was, when rounding made the horizon something other than simple loops.
+    /// polytope as it was, when rounding made the horizon something other than one loop.
     fn expand(&mut self, seed: usize, new: u8) -> bool {
         if !self.flood(seed, new) || !self.index_fan() {
             // Dead so far: the faces flooded and those still waiting on the stack.
@@ -224,7 +224,8 @@ impl Polytope {
     }
 
     /// Numbers the fan faces by the vertex their horizon edge starts and ends at; `false`
-    /// unless every horizon vertex starts exactly one edge and ends exactly one (simple loops).
+    /// unless every horizon vertex starts exactly one edge and ends exactly one, and the edges
+    /// make one loop.
     fn index_fan(&mut self) -> bool {
         for (n, e) in self.horizon.iter().enumerate() {
             let (from, to) = (e.from as usize, e.to as usize);
@@ -234,9 +235,20 @@ impl Polytope {
             self.fan_from[from] = n as u16;
             self.fan_to[to] = n as u16;
         }
-        self.horizon
-            .iter()
-            .all(|e| self.fan_from[e.to as usize] != NONE)
+        // One loop: the walk from the first edge through the edges that start where each
+        // ends comes back after visiting them all (two loops would pinch the polytope).
+        let (mut at, mut steps) = (0usize, 0usize);
+        loop {
+            let next = self.fan_from[self.horizon[at].to as usize];
+            steps += 1;
+            if next == NONE || steps > self.horizon.len() {
+                return false;
+            }
+            at = next as usize;
+            if at == 0 {
+                return steps == self.horizon.len();
+            }
+        }
     }
 
     fn reset_fan_index(&mut self) {
@@ -359,7 +371,7 @@ fn expand_to_depth(
         poly.add_face(if inward { [i, k, j] } else { [i, j, k] }, [NONE; 3])?;
     }
     poly.link_all();
-    // A copy, not an index: a failed expansion may leave the slot dead or reused.
+    // A copy, not an index: a fan that ran out of slots leaves the polytope half-built.
     let mut seed = poly.closest_face()?;
     let mut face = poly.faces[seed];
     for _ in 0..MAX_ITERATIONS {
