@@ -67,7 +67,7 @@ fn a_standing_cylinder_rests_on_ground_and_box_within_0_1_mm_and_on_a_mesh_withi
 }
 
 #[test]
-fn a_cylinder_rolling_across_a_tessellated_floor_keeps_its_line_within_2_mm_per_m_and_75_percent_of_its_speed()
+fn a_cylinder_rolling_across_a_tessellated_floor_keeps_its_line_within_2_mm_per_m_and_95_percent_of_its_speed()
  {
     let radius = 0.3;
     let floor = MeshCollider::new(TriMesh::grid_floor(20.0, 40).unwrap()).unwrap();
@@ -88,15 +88,16 @@ fn a_cylinder_rolling_across_a_tessellated_floor_keeps_its_line_within_2_mm_per_
     let b = &scene.bodies[c];
     let travelled = b.center.x + 6.0;
     assert!(travelled > 5.0, "rolled only {travelled} m");
-    // Across the seams: no hop, no veer. The speed is not kept: 12 seams take 20% of it
-    // (measured 2.39 m/s of 3; on a half-space 2.997), a known limit the README states.
+    // Across the seams: no hop, no veer. Not all the speed is kept: 2.87 m/s of 3 (on a
+    // half-space 2.997), a limit the README states. Before the seams handed a separated
+    // part beside them to the neighbour, 2.39.
     assert!((b.center.z - radius).abs() < 2e-3, "height {}", b.center.z);
     assert!(
         (b.center.y - 0.1).abs() < 2e-3 * travelled,
         "veered to y = {}",
         b.center.y
     );
-    assert!(b.v.x > 0.75 * 3.0, "speed {}", b.v.x);
+    assert!(b.v.x > 0.95 * 3.0, "speed {}", b.v.x);
 }
 
 /// The hull of a box's corners and its face centres (coplanar extras the hull must merge).
@@ -212,4 +213,49 @@ fn an_ellipsoid_rocking_on_the_ground_stays_in_touch_within_3_mm_and_climbs_unde
         worst_gap < 3e-3,
         "left or sank into the ground by {worst_gap} m"
     );
+}
+
+/// A mesh ridge folding by 4° (2° down each side, less than the 5° that makes its edge
+/// inactive):
+/// a shape resting on the ridge line is held by the seam itself, since neither triangle's
+/// face holds its lowest point. The contact rule that drops a seam's contact when the part is
+/// over the neighbour must not drop this one, even while the shape is still apart.
+#[test]
+fn an_ellipsoid_and_a_cylinder_on_a_4_degree_ridge_stay_on_its_surface_within_3_mm() {
+    let slope = 2f32.to_radians().tan();
+    let surface = |x: f32| -x.abs() * slope;
+    let mut vertices = Vec::new();
+    for x in [-2.0f32, 0.0, 2.0] {
+        for y in [-2.0f32, 2.0] {
+            vertices.push(Vec3::new(x, y, surface(x)));
+        }
+    }
+    let triangles = vec![[0, 2, 3], [0, 3, 1], [2, 4, 5], [2, 5, 3]];
+    let lying = Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
+    let shapes = [
+        (Shape::ellipsoid(Vec3::splat(0.5)), Quat::IDENTITY),
+        (Shape::cylinder(0.5, 0.5), lying),
+    ];
+    for (shape, orientation) in shapes {
+        for x0 in [0.0f32, 0.01, 0.03] {
+            let mesh = TriMesh::new(vertices.clone(), triangles.clone()).unwrap();
+            let mut scene = Scene::default();
+            let floor = Shape::TriMesh(MeshCollider::new(mesh).unwrap());
+            scene.add(floor, Vec3::ZERO, Quat::IDENTITY, 0.0);
+            // Dropped at 6 m/s from 5 cm up: only the seam's speculative contact stops it
+            // at the surface (10 cm a step).
+            let c = scene.add(shape.clone(), Vec3::new(x0, 0.0, 0.55), orientation, 1.0);
+            scene.bodies[c].v = Vec3::new(0.0, 0.0, -6.0);
+            let mut lowest = f32::MAX;
+            for _ in 0..60 {
+                scene.step();
+                let b = &scene.bodies[c];
+                lowest = lowest.min(b.center.z - surface(b.center.x));
+            }
+            assert!(
+                lowest > 0.497,
+                "{shape:?} from x = {x0}: {lowest} m above the surface"
+            );
+        }
+    }
 }
