@@ -500,4 +500,70 @@ mod tests {
         }
         assert!(expanded > 100, "only {expanded} pairs grew the polytope");
     }
+
+    /// A tetrahedron around the origin, wound outward and linked.
+    fn unit_tetrahedron() -> Polytope {
+        let mut poly = Polytope::default();
+        poly.clear();
+        let corners = [
+            DVec3::new(1.0, 1.0, 1.0),
+            DVec3::new(1.0, -1.0, -1.0),
+            DVec3::new(-1.0, 1.0, -1.0),
+            DVec3::new(-1.0, -1.0, 1.0),
+        ];
+        for w in corners {
+            poly.add_vertex(SupportPoint {
+                w,
+                a: w,
+                b: DVec3::ZERO,
+            });
+        }
+        for [i, j, k, opposite] in [[0u8, 1, 2, 3], [0, 3, 1, 2], [0, 2, 3, 1], [1, 3, 2, 0]] {
+            let w = |i: u8| corners[i as usize];
+            let inward = (w(j) - w(i)).cross(w(k) - w(i)).dot(w(opposite) - w(i)) > 0.0;
+            poly.add_face(if inward { [i, k, j] } else { [i, j, k] }, [NONE; 3]);
+        }
+        poly.link_all();
+        poly
+    }
+
+    /// A broken link met mid-flood (what rounding could leave): the expansion refuses and
+    /// every face it had marked dead is alive again, no slot freed, no fan left indexed.
+    #[test]
+    fn a_refused_expansion_leaves_every_face_as_it_was() {
+        let far = DVec3::splat(10.0); // sees three of the four faces
+        let point = SupportPoint {
+            w: far,
+            a: far,
+            b: DVec3::ZERO,
+        };
+        let seed = (0..4).find(|&f| unit_tetrahedron().sees(f, far)).unwrap();
+        // Either other seen face broken: met first, or met while the third waits on the
+        // flood's stack.
+        for broken in (0..4).filter(|&f| f != seed && unit_tetrahedron().sees(f, far)) {
+            let mut poly = unit_tetrahedron();
+            let new = poly.add_vertex(point).unwrap();
+            poly.faces[broken].adjacent = [NONE; 3];
+            let before: Vec<bool> = poly.faces.iter().map(|f| f.alive).collect();
+            assert!(!poly.expand(seed, new));
+            let after: Vec<bool> = poly.faces.iter().map(|f| f.alive).collect();
+            assert_eq!(after, before, "broken face {broken}");
+            assert!(poly.free.is_empty() && poly.faces.len() == 4);
+            assert!(poly.fan_from.iter().chain(&poly.fan_to).all(|&n| n == NONE));
+        }
+        // The same expansion on a sound tetrahedron goes through: the three faces the point
+        // sees give way to three fanned to it.
+        let mut sound = unit_tetrahedron();
+        let new = sound
+            .add_vertex(SupportPoint {
+                w: far,
+                a: far,
+                b: DVec3::ZERO,
+            })
+            .unwrap();
+        assert!(sound.expand(seed, new));
+        let fanned = |f: &&Face| f.alive && f.ids.contains(&new);
+        assert_eq!(sound.faces.iter().filter(fanned).count(), 3);
+        assert_eq!(sound.faces.iter().filter(|f| f.alive).count(), 4);
+    }
 }
