@@ -157,9 +157,8 @@ impl Entry {
 /// Reusable buffers of the sweeps.
 #[derive(Debug, Default)]
 pub(super) struct SweepScratch {
-    /// Which of a region's changed ids were found among its entries (few changed).
-    matched: Vec<bool>,
-    /// Per id, the number of the last region sweep that met it (many changed).
+    /// Per id, the number of the last region sweep that met it (many changed) or marked it
+    /// changed (few changed).
     met: Vec<u32>,
     /// This region sweep's number.
     sweep_number: u32,
@@ -188,8 +187,7 @@ impl SweepScratch {
 
     /// Heap bytes held.
     pub fn memory_bytes(&self) -> usize {
-        self.matched.capacity()
-            + self.met.capacity() * std::mem::size_of::<u32>()
+        self.met.capacity() * std::mem::size_of::<u32>()
             + (self.found.capacity() + self.dropped.capacity() + self.merged.capacity())
                 * std::mem::size_of::<Pair>()
     }
@@ -228,9 +226,7 @@ impl Region {
         let before = self.entries.len() as isize;
         let few = self.changed.len() * 4 < self.entries.len();
         if few {
-            self.changed.sort_unstable();
-            self.changed.dedup();
-            self.refresh_few(bodies, frame.axes, &mut scratch.matched);
+            self.refresh_few(bodies, frame.axes, scratch);
         } else {
             self.refresh_all(bodies, frame.axes, scratch);
         }
@@ -271,12 +267,13 @@ impl Region {
         scratch: &mut SweepScratch,
         (added, removed): (&mut Vec<Pair>, &mut Vec<Pair>),
     ) -> u64 {
-        let changed = &self.changed;
-        let unchanged = |id: &ProxyId| changed.binary_search(id).is_err();
+        // `refresh_few` has just marked the changed ids with the current sweep number.
+        let (met, changed) = (&scratch.met, scratch.sweep_number);
+        let unchanged = |id: ProxyId| met[id as usize] != changed;
         let dropped = &mut scratch.dropped;
         dropped.clear();
         self.owned.retain(|p| {
-            let keep = unchanged(&p.a) && unchanged(&p.b);
+            let keep = unchanged(p.a) && unchanged(p.b);
             if !keep {
                 dropped.push(*p);
             }
@@ -324,28 +321,38 @@ impl Region {
         }
     }
 
-    /// Few changed (sorted, without repeats): re-reads them (dropping those that left),
-    /// appends the arrivals, and clears the fresh mark of the others.
-    fn refresh_few(&mut self, bodies: &impl BodyView, axes: [usize; 3], matched: &mut Vec<bool>) {
-        let (cell, changed) = (self.cell, &self.changed);
-        matched.clear();
-        matched.resize(changed.len(), false);
-        self.entries
-            .retain_mut(|e| match changed.binary_search(&e.id()) {
-                Ok(at) => {
-                    matched[at] = true;
-                    bodies
-                        .entry(e.id(), cell, axes)
-                        .map(|fresh| *e = fresh)
-                        .is_some()
-                }
-                Err(_) => {
-                    e.owner &= !FRESH;
-                    true
-                }
-            });
-        for (&id, _) in changed.iter().zip(matched.iter()).filter(|(_, m)| !**m) {
-            self.entries.extend(bodies.entry(id, cell, axes));
+    /// Few changed: re-reads them (dropping those that left), appends the arrivals, and
+    /// clears the fresh mark of the others. The changed ids are told apart by two sweep
+    /// numbers in `met` (no sorting, no search): `pending` until found among the members or
+    /// appended, then `changed`, which is what [`Self::sweep_few`] reads.
+    fn refresh_few(
+        &mut self,
+        bodies: &impl BodyView,
+        axes: [usize; 3],
+        scratch: &mut SweepScratch,
+    ) {
+        let pending = scratch.next_sweep_number(bodies.id_bound());
+        let changed = scratch.next_sweep_number(bodies.id_bound());
+        let (cell, met) = (self.cell, &mut scratch.met);
+        for &id in &self.changed {
+            met[id as usize] = pending;
+        }
+        self.entries.retain_mut(|e| {
+            let id = e.id();
+            if met[id as usize] != pending {
+                e.owner &= !FRESH;
+                return true;
+            }
+            met[id as usize] = changed;
+            bodies
+                .entry(id, cell, axes)
+                .map(|fresh| *e = fresh)
+                .is_some()
+        });
+        for &id in &self.changed {
+            if std::mem::replace(&mut met[id as usize], changed) == pending {
+                self.entries.extend(bodies.entry(id, cell, axes));
+            }
         }
     }
 }
