@@ -22,7 +22,6 @@
 //!   vanish. Planes: Newell's normal (the area vector), and the largest `normal · v` as offset:
 //!   corners lie within `2 eps` below, input points within `2 eps` above (`eps` over the scale).
 
-use super::hull_lanes::{HullLanes, LANE_VERTICES};
 use super::predicates::orient3d;
 use super::shapes::MAX_SHAPE_EXTENT;
 use super::{MeshError, TriMesh};
@@ -41,8 +40,6 @@ pub struct ConvexHull {
     face_start: Vec<u32>,
     /// Per vertex, the vertices it shares an edge with.
     neighbours: Vec<Vec<u32>>,
-    /// The first vertices in SIMD lanes, where the support scan starts.
-    lanes: HullLanes,
 }
 
 /// One face of a hull: a convex polygon in the plane `normal · x == offset`.
@@ -138,10 +135,10 @@ impl ConvexHull {
     /// vertex graph a local maximum of a linear function is global; strict gains cannot cycle.
     pub fn support(&self, dir: Vec3) -> Vec3 {
         let v = &self.vertices;
-        let mut best = self.lanes.farthest(dir);
+        let mut best = argmax(v.len().min(16), |i| v[i].dot(dir));
         let higher = |b: usize| self.neighbours[b].iter().map(|&n| n as usize);
         let higher = |b: usize| higher(b).find(|&n| v[n].dot(dir) > v[b].dot(dir));
-        while v.len() > LANE_VERTICES
+        while v.len() > 16
             && let Some(n) = higher(best)
         {
             best = n;
@@ -437,14 +434,12 @@ impl<'a> Builder<'a> {
             face_start.push(face_indices.len() as u32);
         }
         let solid = faces.len() > 3; // else a thin tetrahedron whose faces merged
-        let lanes = HullLanes::new(&vertices);
         let hull = ConvexHull {
             vertices,
             faces,
             face_indices,
             face_start,
             neighbours,
-            lanes,
         };
         solid.then_some(hull).ok_or(HullError::Degenerate)
     }
