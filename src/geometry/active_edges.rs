@@ -24,9 +24,14 @@ pub const COPLANAR_DEGREES: f32 = 5.0;
 /// Every edge active: a lone triangle, or a contact test that does not know its mesh.
 pub const ALL_EDGES_ACTIVE: u8 = 0b111;
 
+/// Neighbours closer than this to coplanar share a *flat* edge (bit `3 + k` of
+/// [`active_edges`]'s byte): the surface continues past it without a fold worth a contact of
+/// its own, so a convex part beside it is its neighbour's alone (`trimesh_convex.rs`).
+pub const FLAT_DEGREES: f32 = 0.5;
+
 /// For each triangle, bit `k` set when its edge `k` (from corner `k` to corner `k + 1`) is
-/// active (see the module notes). Corners at the same position count as one vertex, so unwelded
-/// meshes are handled too.
+/// active (see the module notes), and bit `3 + k` when it is flat (within [`FLAT_DEGREES`]).
+/// Corners at the same position count as one vertex, so unwelded meshes are handled too.
 pub(crate) fn active_edges(mesh: &TriMesh) -> Vec<u8> {
     let ids = mesh.position_ids();
     let mut edges: Vec<(u32, u32, u32, u8)> = Vec::with_capacity(3 * mesh.triangle_count());
@@ -40,6 +45,7 @@ pub(crate) fn active_edges(mesh: &TriMesh) -> Vec<u8> {
     edges.sort_unstable();
     let mut active = vec![ALL_EDGES_ACTIVE; mesh.triangle_count()];
     let cos = COPLANAR_DEGREES.to_radians().cos();
+    let flat_cos = FLAT_DEGREES.to_radians().cos();
     let normal = |t: u32| mesh.triangle(t as usize).and_then(|tri| tri.normal());
     for group in edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
         if group.len() < 2 {
@@ -48,12 +54,16 @@ pub(crate) fn active_edges(mesh: &TriMesh) -> Vec<u8> {
         let Some(first) = normal(group[0].2) else {
             continue;
         };
-        let flat = group[1..]
-            .iter()
-            .all(|e| normal(e.2).is_some_and(|n| n.dot(first).abs() >= cos));
-        if flat {
+        let within = |cos: f32| {
+            group[1..]
+                .iter()
+                .all(|e| normal(e.2).is_some_and(|n| n.dot(first).abs() >= cos))
+        };
+        if within(cos) {
+            let flat = within(flat_cos);
             for &(_, _, t, k) in group {
                 active[t as usize] &= !(1 << k);
+                active[t as usize] |= u8::from(flat) << (3 + k);
             }
         }
     }
@@ -104,15 +114,34 @@ mod tests {
 
     #[test]
     fn a_flat_grid_has_only_its_rim_active_and_a_cube_only_its_twelve_edges() {
-        let grid = TriMesh::grid_floor(4.0, 4).unwrap();
-        let active = active_edges(&grid);
-        let count: u32 = active.iter().map(|m| m.count_ones()).sum();
-        // A 4×4 grid's rim is 16 cell sides, each the edge of one triangle.
-        assert_eq!(count, 16);
-        let cube = TriMesh::cuboid(Vec3::splat(0.5)).unwrap();
-        let count: u32 = active_edges(&cube).iter().map(|m| m.count_ones()).sum();
-        // 12 edges, each active in both its triangles; the face diagonals are inactive.
-        assert_eq!(count, 24);
+        let ones =
+            |marks: &[u8], mask: u8| -> u32 { marks.iter().map(|m| (m & mask).count_ones()).sum() };
+        let grid = active_edges(&TriMesh::grid_floor(4.0, 4).unwrap());
+        // A 4×4 grid's rim is 16 cell sides, each the edge of one triangle; the other 80
+        // triangle edges (32 triangles) are inactive and flat.
+        assert_eq!(ones(&grid, ALL_EDGES_ACTIVE), 16);
+        assert_eq!(ones(&grid, ALL_EDGES_ACTIVE << 3), 80);
+        let cube = active_edges(&TriMesh::cuboid(Vec3::splat(0.5)).unwrap());
+        // 12 edges, each active in both its triangles; the face diagonals are inactive, flat.
+        assert_eq!(ones(&cube, ALL_EDGES_ACTIVE), 24);
+        assert_eq!(ones(&cube, ALL_EDGES_ACTIVE << 3), 12);
+    }
+
+    #[test]
+    fn a_fold_of_2_degrees_is_inactive_but_not_flat_and_one_of_a_quarter_degree_is_flat() {
+        for (degrees, flat) in [(2.0f32, false), (0.25, true)] {
+            let z = degrees.to_radians().tan();
+            let vertices = vec![
+                Vec3::new(-1.0, 0.0, 0.0),
+                Vec3::new(0.0, -1.0, 0.0),
+                Vec3::new(0.0, 1.0, 0.0),
+                Vec3::new(1.0, 0.0, z),
+            ];
+            let marks = active_edges(&TriMesh::new(vertices, vec![[0, 1, 2], [2, 1, 3]]).unwrap());
+            // The shared edge is edge 1 (corners 1 → 2) of the first triangle.
+            assert_eq!(marks[0] & 0b010, 0, "{degrees}°: the fold is inactive");
+            assert_eq!(marks[0] & (0b010 << 3) != 0, flat, "{degrees}°");
+        }
     }
 
     #[test]

@@ -13,6 +13,7 @@
 
 use crate::bounding::{Aabb, Obb};
 use crate::bvh::{BuildOptions, Bvh, BvhError};
+use crate::geometry::active_edges::ALL_EDGES_ACTIVE;
 use crate::geometry::mesh_io::MeshLoadError;
 use crate::geometry::{Isometry, MeshError, TriMesh};
 use glam::{Mat3, Vec3};
@@ -79,7 +80,8 @@ struct MeshData {
     leaf_of_triangle: Vec<u32>,
     /// Farthest vertex from the local origin.
     bounding_radius: f32,
-    /// Per triangle, its active edges (see [`active_edges`](crate::geometry::active_edges)).
+    /// Per triangle, its active edges (bits 0–2) and flat edges (bits 3–5; see
+    /// [`active_edges`](crate::geometry::active_edges)).
     active_edges: Vec<u8>,
 }
 
@@ -211,12 +213,19 @@ impl MeshCollider {
     /// Triangle `t`'s active edges: bit `k` for its edge from corner `k` to corner `k + 1`
     /// (see [`active_edges`](crate::geometry::active_edges)); all three past the end.
     pub fn active_edges(&self, t: u32) -> u8 {
-        use crate::geometry::active_edges::ALL_EDGES_ACTIVE;
-        self.data
-            .active_edges
-            .get(t as usize)
-            .copied()
-            .unwrap_or(ALL_EDGES_ACTIVE)
+        self.edge_marks(t) & ALL_EDGES_ACTIVE
+    }
+
+    /// Triangle `t`'s flat edges, bit `k` as in [`Self::active_edges`]: inactive edges whose
+    /// neighbours are coplanar within
+    /// [`FLAT_DEGREES`](crate::geometry::active_edges::FLAT_DEGREES); none past the end.
+    pub fn flat_edges(&self, t: u32) -> u8 {
+        self.edge_marks(t) >> 3
+    }
+
+    fn edge_marks(&self, t: u32) -> u8 {
+        let marks = self.data.active_edges.get(t as usize).copied();
+        marks.unwrap_or(ALL_EDGES_ACTIVE)
     }
 
     /// Radius of the smallest origin-centred ball holding the triangles.

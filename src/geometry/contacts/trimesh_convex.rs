@@ -5,14 +5,15 @@
 //! inactive edges takes the face normal ([`active_edges`](crate::geometry::active_edges)), so a
 //! cylinder rolling across a tessellated floor does not bump on the seams.
 //!
-//! Such a seam hands a part that is still apart to the neighbour when it sees the part more
-//! steeply than any inactive fold could tilt a face
-//! ([`COPLANAR_DEGREES`](crate::geometry::active_edges::COPLANAR_DEGREES)): the part is then
-//! over the neighbour, which reports it, and read along this face's normal it would be a
-//! second, speculative point on the part's curved side ahead of where it rests, whose row
-//! (assuming the point keeps its downward speed for the whole step) brakes a rolling cylinder:
-//! 12 seams took 20 % of its speed, now 4 % (`scenarios/convex.rs`). A part resting on a
-//! slight ridge, which only the seam holds, is seen within that angle and keeps its contact.
+//! A *flat* seam (its triangles coplanar within
+//! [`FLAT_DEGREES`](crate::geometry::active_edges::FLAT_DEGREES)) hands a part that is still
+//! apart to the neighbour when it sees the part more than 5° off its face normal: the part is
+//! over the neighbour, which reports it. Read along this face's normal it would be a second,
+//! speculative point on the part's curved side ahead of where it rests, whose row (assuming
+//! the point keeps its downward speed for the whole step) brakes a rolling cylinder: 12 seams
+//! took 20 % of its speed, now 4 % (`scenarios/convex.rs`). Only flat seams: across a fold of
+//! a few degrees the neighbour may rise towards the part (a valley) or every face around a
+//! vertex may see it steeply (a low peak), and the seam's own reading is what holds it there.
 //!
 //! The triangle contacts are merged into one manifold as `mesh_manifold.rs` explains.
 
@@ -20,7 +21,7 @@ use super::convex_convex::manifold;
 use super::mesh_scratch::ContactScratch;
 use super::trimesh_cuboid::carried_box;
 use crate::bounding::{Bv, RelativePose};
-use crate::geometry::active_edges::face_normal_at_inactive_edge;
+use crate::geometry::active_edges::{ALL_EDGES_ACTIVE, face_normal_at_inactive_edge};
 use crate::geometry::convex::support::ConvexPart;
 use crate::geometry::convex::{SignedDistance, core_distance};
 use crate::geometry::{ContactManifold, Isometry, MeshCollider, Shape, Triangle};
@@ -48,7 +49,10 @@ pub(crate) fn contact_trimesh_convex(
     scratch.collect_triangle_contacts(
         mesh,
         |bv| bv.overlaps(&probe, &same_frame),
-        |t, tri| triangle_contact(tri, mesh.active_edges(t), &part, margin),
+        |t, tri| {
+            let edges = (mesh.active_edges(t), mesh.flat_edges(t));
+            triangle_contact(tri, edges, &part, margin)
+        },
     );
     scratch.merge(pose_mesh)
 }
@@ -60,10 +64,11 @@ fn local_half_extents(shape: &Shape) -> Vec3 {
     b.min.abs().max(b.max.abs())
 }
 
-/// One triangle (A) against the convex part (B), in the mesh's frame.
+/// One triangle (A) against the convex part (B), in the mesh's frame; `(active, flat)` are
+/// the triangle's edge marks (see [`MeshCollider::flat_edges`]).
 fn triangle_contact(
     tri: &Triangle,
-    active: u8,
+    (active, flat): (u8, u8),
     part: &ConvexPart,
     margin: f32,
 ) -> Option<ContactManifold> {
@@ -73,13 +78,21 @@ fn triangle_contact(
         return None;
     }
     let d = match face_normal_at_inactive_edge(tri, active, d.on_a, d.normal) {
-        // Apart, and seen from the seam more steeply than any fold of an inactive edge: the
-        // part is over the neighbour, which reports it (module notes).
-        Some(up) if d.distance > 0.0 && d.normal.dot(up) < BESIDE_THE_SEAM_COSINE => return None,
+        Some(up) if beside_a_flat_seam(tri, flat, &d, up) => return None,
         Some(up) => along_face(tri, up, &d),
         None => d,
     };
     (d.distance <= margin).then(|| manifold(&face, part, &d, margin))
+}
+
+/// Whether the part is apart and beside a flat seam, over the neighbour, which reports it
+/// (module notes): the closest pair lies only on flat edges, and the seam sees the part more
+/// steeply than 5°, ten times the fold a flat seam may have.
+fn beside_a_flat_seam(tri: &Triangle, flat: u8, d: &SignedDistance, up: Vec3) -> bool {
+    let only_flat = ALL_EDGES_ACTIVE & !flat; // the other edges taken as active
+    d.distance > 0.0
+        && d.normal.dot(up) < BESIDE_THE_SEAM_COSINE
+        && face_normal_at_inactive_edge(tri, only_flat, d.on_a, d.normal).is_some()
 }
 
 /// The contact read along the face normal `up` (towards the part) when the surface continues

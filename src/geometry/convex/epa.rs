@@ -237,6 +237,9 @@ impl Polytope {
         }
         // One loop: the walk from the first edge through the edges that start where each
         // ends comes back after visiting them all (two loops would pinch the polytope).
+        if self.horizon.is_empty() {
+            return false; // every face seen (slivers): nothing to fan
+        }
         let (mut at, mut steps) = (0usize, 0usize);
         loop {
             let next = self.fan_from[self.horizon[at].to as usize];
