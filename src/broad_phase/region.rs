@@ -224,19 +224,18 @@ impl Region {
         changes: (&mut Vec<Pair>, &mut Vec<Pair>),
     ) -> (isize, SweepCounts) {
         let before = self.entries.len() as isize;
-        let few = self.changed.len() * 4 < self.entries.len();
-        if few {
-            self.refresh_few(bodies, frame.axes, scratch);
-        } else {
+        // Few changed: the sweep number their ids carry in `met`.
+        let few = (self.changed.len() * 4 < self.entries.len())
+            .then(|| self.refresh_few(bodies, frame.axes, scratch));
+        if few.is_none() {
             self.refresh_all(bodies, frame.axes, scratch);
         }
         let swaps = sort_entries(&mut self.entries);
         let [axis, u, v] = frame.axes;
         let cell = [self.cell[axis], self.cell[u], self.cell[v]];
-        let tests = if few {
-            self.sweep_few(cell, scratch, changes)
-        } else {
-            self.sweep_all(cell, scratch, changes)
+        let tests = match few {
+            Some(changed) => self.sweep_few(cell, changed, scratch, changes),
+            None => self.sweep_all(cell, scratch, changes),
         };
         self.changed.clear();
         (
@@ -260,15 +259,16 @@ impl Region {
     }
 
     /// The changed members' pairs found again; the others kept. Only the changed members'
-    /// pairs are sorted and diffed (the kept ones stay sorted), then merged back.
+    /// pairs are sorted and diffed (the kept ones stay sorted), then merged back. `changed`
+    /// is the number [`Self::refresh_few`] marked the changed ids with.
     fn sweep_few(
         &mut self,
         cell: [i32; 3],
+        changed: u32,
         scratch: &mut SweepScratch,
         (added, removed): (&mut Vec<Pair>, &mut Vec<Pair>),
     ) -> u64 {
-        // `refresh_few` has just marked the changed ids with the current sweep number.
-        let (met, changed) = (&scratch.met, scratch.sweep_number);
+        let met = &scratch.met;
         let unchanged = |id: ProxyId| met[id as usize] != changed;
         let dropped = &mut scratch.dropped;
         dropped.clear();
@@ -324,13 +324,13 @@ impl Region {
     /// Few changed: re-reads them (dropping those that left), appends the arrivals, and
     /// clears the fresh mark of the others. The changed ids are told apart by two sweep
     /// numbers in `met` (no sorting, no search): `pending` until found among the members or
-    /// appended, then `changed`, which is what [`Self::sweep_few`] reads.
+    /// appended, then `changed`, which is returned for [`Self::sweep_few`].
     fn refresh_few(
         &mut self,
         bodies: &impl BodyView,
         axes: [usize; 3],
         scratch: &mut SweepScratch,
-    ) {
+    ) -> u32 {
         let pending = scratch.next_sweep_number(bodies.id_bound());
         let changed = scratch.next_sweep_number(bodies.id_bound());
         let (cell, met) = (self.cell, &mut scratch.met);
@@ -354,6 +354,7 @@ impl Region {
                 self.entries.extend(bodies.entry(id, cell, axes));
             }
         }
+        changed
     }
 }
 

@@ -83,29 +83,33 @@ pub(crate) fn face_normal_at_inactive_edge(
     if active == ALL_EDGES_ACTIVE {
         return None;
     }
+    let on = edges_holding(tri, on_triangle);
+    if on == 0 || on & active != 0 {
+        return None;
+    }
+    let face = tri.normal()?;
+    Some(if face.dot(normal) < 0.0 { -face } else { face })
+}
+
+/// The edges of `tri` that `point` lies on (bit `k` for the edge from corner `k` to `k + 1`),
+/// within `1e-5` of the longest edge; 0 for an interior point.
+pub(crate) fn edges_holding(tri: &Triangle, point: Vec3) -> u8 {
     let v = tri.vertices();
     let longest = (0..3)
         .map(|k| (v[(k + 1) % 3] - v[k]).length_squared())
         .fold(0.0f32, f32::max)
         .sqrt();
     let tolerance = 1e-5 * longest;
-    let mut on_boundary = false;
+    let mut on = 0;
     for k in 0..3 {
         let (a, b) = (v[k], v[(k + 1) % 3]);
         let ab = b - a;
-        let s = ((on_triangle - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0);
-        if (a + ab * s - on_triangle).length() <= tolerance {
-            if active & (1 << k) != 0 {
-                return None;
-            }
-            on_boundary = true;
+        let s = ((point - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0);
+        if (a + ab * s - point).length() <= tolerance {
+            on |= 1 << k;
         }
     }
-    if !on_boundary {
-        return None;
-    }
-    let face = tri.normal()?;
-    Some(if face.dot(normal) < 0.0 { -face } else { face })
+    on
 }
 
 #[cfg(test)]

@@ -322,11 +322,7 @@ fn a_thousand_moving_bodies_match_sort_and_sweep_and_orders_are_reproducible() {
     let side = 14.0;
     let bodies: Vec<(ProxyId, Aabb, BodyKind)> = (0..1000)
         .map(|i| {
-            let c = Vec3::new(
-                rng.range(0.0, side),
-                rng.range(0.0, side),
-                rng.range(0.0, side),
-            );
+            let c = rng.vec3(0.0, side);
             let kind = if i % 10 == 0 {
                 BodyKind::Static
             } else {
@@ -347,11 +343,7 @@ fn a_thousand_moving_bodies_match_sort_and_sweep_and_orders_are_reproducible() {
         let speed = if step % 10 == 9 { 3.0 } else { 0.1 };
         for &(id, _, _) in bodies.iter().filter(|b| (b.0 + step) % 3 == 0) {
             let b = sap.aabb(id).unwrap();
-            let d = Vec3::new(
-                rng.range(-speed, speed),
-                rng.range(-speed, speed),
-                rng.range(-speed, speed),
-            );
+            let d = rng.vec3(-speed, speed);
             let moved = Aabb::new(b.min + d, b.max + d);
             for bp in [&mut reference as &mut dyn BroadPhase, &mut sap, &mut twin] {
                 bp.update(id, moved).unwrap();

@@ -56,23 +56,10 @@ fn shake(
     reference: &mut SortAndSweep,
 ) {
     let b = reference.aabb(i).unwrap();
-    let d = Vec3::new(
-        rng.range(-speed, speed),
-        rng.range(-speed, speed),
-        rng.range(-speed, speed),
-    );
+    let d = rng.vec3(-speed, speed);
     for bp in both(subject, reference) {
         bp.update(i, Aabb::new(b.min + d, b.max + d)).unwrap();
     }
-}
-
-/// A point uniformly in the cube `[0, side]³`.
-fn in_cube(rng: &mut Rng, side: f32) -> Vec3 {
-    Vec3::new(
-        rng.range(0.0, side),
-        rng.range(0.0, side),
-        rng.range(0.0, side),
-    )
 }
 
 fn both<'a>(
@@ -90,12 +77,8 @@ fn mixed_sizes_with_large_bodies_match_sort_and_sweep_exactly_for_120_steps() {
     let mut rng = Rng::new(0x5eed_0f7e_5700);
     let mut bodies: Vec<(ProxyId, Aabb, BodyKind)> = (0..3000)
         .map(|i| {
-            let c = in_cube(&mut rng, 30.0);
-            let half = Vec3::new(
-                rng.range(0.1, 1.0),
-                rng.range(0.1, 1.0),
-                rng.range(0.1, 1.0),
-            );
+            let c = rng.vec3(0.0, 30.0);
+            let half = rng.vec3(0.1, 1.0);
             let kind = static_one_in(i, 20);
             (i, Aabb::from_center_half_extents(c, half), kind)
         })
@@ -142,7 +125,7 @@ fn few_movers_among_many_match_sort_and_sweep_exactly_for_100_steps() {
     let mut rng = Rng::new(0xfe00_5eed);
     let bodies: Vec<(ProxyId, Aabb, BodyKind)> = (0..4000)
         .map(|i| {
-            let c = in_cube(&mut rng, 25.0);
+            let c = rng.vec3(0.0, 25.0);
             let mut half = Vec3::splat(rng.range(0.2, 0.6));
             if i % 50 == 0 {
                 half[(i / 50 % 3) as usize] = 2.5;
@@ -172,7 +155,7 @@ fn a_sparse_cloud_grows_its_cells_at_least_4_fold_and_stays_exact() {
     let (mut subject, mut reference) = (RegionSweep::new(), SortAndSweep::new());
     let boxes: Vec<Aabb> = (0..1000)
         .map(|_| {
-            let c = in_cube(&mut rng, 200.0);
+            let c = rng.vec3(0.0, 200.0);
             Aabb::from_center_half_extents(c, Vec3::splat(0.5))
         })
         .collect();
@@ -317,7 +300,7 @@ fn forty_big_boxes_among_small_ones_grow_the_cells_until_few_are_large_and_stay_
     let mut rng = Rng::new(0xb16_5a11);
     let bodies: Vec<(ProxyId, Aabb, BodyKind)> = (0..3040)
         .map(|i| {
-            let c = in_cube(&mut rng, 16.0);
+            let c = rng.vec3(0.0, 16.0);
             let half = if i < 3000 { 0.25 } else { rng.range(5.0, 6.0) };
             (
                 i,

@@ -21,11 +21,7 @@ fn triangle_box_depth_agrees_with_parry() {
         let tri =
             urto::geometry::Triangle::new(rng.in_ball(1.2), rng.in_ball(1.2), rng.in_ball(1.2));
         let cuboid = Cuboid {
-            half_extents: Vec3::new(
-                rng.range(0.1, 0.8),
-                rng.range(0.1, 0.8),
-                rng.range(0.1, 0.8),
-            ),
+            half_extents: rng.vec3(0.1, 0.8),
         };
         let at = Isometry::new(rng.in_ball(1.0), rng.rotation());
         let ours = contact_triangle_cuboid(&tri, &at, &cuboid);

@@ -55,6 +55,14 @@ pub struct BodyParams {
     pub gyroscopic: Option<(Quat, Vec3)>,
 }
 
+impl BodyParams {
+    /// Whether no impulse can move or turn the body: static, kinematic, or dynamic and locked
+    /// on every axis (its contacts then take the static softness).
+    pub fn is_immovable(&self) -> bool {
+        !self.dynamic || (self.inverse_mass == Vec3::ZERO && self.inverse_inertia == Mat3::ZERO)
+    }
+}
+
 /// One body as the caller describes it at the step's start.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BodyInput {

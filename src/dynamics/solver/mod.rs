@@ -90,7 +90,7 @@ pub use warm_start::WarmStartCache;
 
 use crate::dynamics::forces::{ForceModel, Spring, SpringEnd};
 use crate::settings::{MAX_SUBSTEPS, SettingsError};
-use glam::{Mat3, Vec3};
+use glam::Vec3;
 use integrate::{capped, integrate_positions, integrate_velocities};
 use joint_list::JointList;
 use ordered_batches::OrderedBatches;
@@ -470,10 +470,7 @@ impl Solver {
         self.constraints.extend(contacts.iter().map(|c| {
             // A dynamic body locked on every axis is as immovable as a static one, and its
             // contacts as stiff.
-            let immovable = |i: u32| {
-                let p = &bodies.params[i as usize];
-                !p.dynamic || (p.inverse_mass == Vec3::ZERO && p.inverse_inertia == Mat3::ZERO)
-            };
+            let immovable = |i: u32| bodies.params[i as usize].is_immovable();
             let softness = if immovable(c.a) || immovable(c.b) {
                 static_soft
             } else {

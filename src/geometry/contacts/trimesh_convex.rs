@@ -21,16 +21,13 @@ use super::convex_convex::manifold;
 use super::mesh_scratch::ContactScratch;
 use super::trimesh_cuboid::carried_box;
 use crate::bounding::{Bv, RelativePose};
-use crate::geometry::active_edges::{ALL_EDGES_ACTIVE, face_normal_at_inactive_edge};
+use crate::geometry::active_edges::{
+    COPLANAR_DEGREES, edges_holding, face_normal_at_inactive_edge,
+};
 use crate::geometry::convex::support::ConvexPart;
 use crate::geometry::convex::{SignedDistance, core_distance};
 use crate::geometry::{ContactManifold, Isometry, MeshCollider, Shape, Triangle};
 use glam::Vec3;
-
-/// The cosine of [`COPLANAR_DEGREES`](crate::geometry::active_edges::COPLANAR_DEGREES): a
-/// separated part that a seam sees in a direction further than this from the face normal is
-/// beside the seam, not on it (module notes).
-const BESIDE_THE_SEAM_COSINE: f32 = 0.996_194_7;
 
 /// Contact between a mesh at `pose_mesh` (shape A) and the convex `shape` at `pose_shape`
 /// (shape B), with a speculative `margin`; `None` when `shape` is not convex or nothing is
@@ -86,13 +83,13 @@ fn triangle_contact(
 }
 
 /// Whether the part is apart and beside a flat seam, over the neighbour, which reports it
-/// (module notes): the closest pair lies only on flat edges, and the seam sees the part more
-/// steeply than 5°, ten times the fold a flat seam may have.
+/// (module notes): the seam sees the part more steeply than
+/// [`COPLANAR_DEGREES`] (5°, ten times the fold a flat seam may have), and the closest pair
+/// lies only on flat edges (it lies on some edge: the face normal was taken).
 fn beside_a_flat_seam(tri: &Triangle, flat: u8, d: &SignedDistance, up: Vec3) -> bool {
-    let only_flat = ALL_EDGES_ACTIVE & !flat; // the other edges taken as active
     d.distance > 0.0
-        && d.normal.dot(up) < BESIDE_THE_SEAM_COSINE
-        && face_normal_at_inactive_edge(tri, only_flat, d.on_a, d.normal).is_some()
+        && d.normal.dot(up) < COPLANAR_DEGREES.to_radians().cos()
+        && edges_holding(tri, d.on_a) & !flat == 0
 }
 
 /// The contact read along the face normal `up` (towards the part) when the surface continues
@@ -108,17 +105,5 @@ fn along_face(tri: &Triangle, up: Vec3, d: &SignedDistance) -> SignedDistance {
         distance: up.dot(d.on_b - tri.a),
         normal: up,
         ..*d
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::geometry::active_edges::COPLANAR_DEGREES;
-
-    #[test]
-    fn the_beside_the_seam_cosine_is_that_of_the_coplanar_angle_within_1e_7() {
-        let cosine = COPLANAR_DEGREES.to_radians().cos();
-        assert!((BESIDE_THE_SEAM_COSINE - cosine).abs() < 1e-7);
     }
 }

@@ -91,9 +91,8 @@ impl Polytope {
         self.vertices.clear();
         self.faces.clear();
         self.free.clear();
-        self.fan_from.clear();
+        // Sized once: every expansion resets the entries it set.
         self.fan_from.resize(MAX_VERTICES, NONE);
-        self.fan_to.clear();
         self.fan_to.resize(MAX_VERTICES, NONE);
     }
 

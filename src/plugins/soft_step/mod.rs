@@ -178,13 +178,17 @@ fn solve_soft_step(
     mut stats: ResMut<PhysicsStats>,
     mut waker: Waker,
     joints: JointParams,
+    sleepers: Query<(), With<Sleeping>>,
 ) {
     let start = Instant::now();
     let s = &mut *soft;
     let gyroscopic = rotation.is_none_or(|r| r.gyroscopic);
     s.waking.clear();
     let jointed = joints.any();
-    if let Some(sleep) = sleep.filter(|s| s.enabled) {
+    // Nothing asleep, nothing to wake: the joints' and the contacts' two lookups each saved
+    // (a 10,000-ball net made 40,000 a step).
+    let anyone_asleep = !sleepers.is_empty();
+    if let Some(sleep) = sleep.filter(|s| s.enabled && anyone_asleep) {
         if jointed {
             joints.wake_partners(&movers, &mut s.waking);
         }

@@ -215,6 +215,17 @@ fn an_ellipsoid_rocking_on_the_ground_stays_in_touch_within_3_mm_and_climbs_unde
     );
 }
 
+/// Two 4 m wide faces of two triangles each, between `xs[0]`, `xs[1]` and `xs[2]` along x, at
+/// the heights `surface(x)`: one fold along y at `xs[1]`.
+fn folded_strip(xs: [f32; 3], surface: impl Fn(f32) -> f32) -> TriMesh {
+    let vertices = xs
+        .into_iter()
+        .flat_map(|x| [-2.0, 2.0].map(|y| Vec3::new(x, y, surface(x))))
+        .collect();
+    let triangles = vec![[0, 2, 3], [0, 3, 1], [2, 4, 5], [2, 5, 3]];
+    TriMesh::new(vertices, triangles).unwrap()
+}
+
 /// A mesh ridge folding by 4° (2° down each side, less than the 5° that makes its edge
 /// inactive):
 /// a shape resting on the ridge line is held by the seam itself, since neither triangle's
@@ -224,13 +235,6 @@ fn an_ellipsoid_rocking_on_the_ground_stays_in_touch_within_3_mm_and_climbs_unde
 fn an_ellipsoid_and_a_cylinder_on_a_4_degree_ridge_stay_on_its_surface_within_3_mm() {
     let slope = 2f32.to_radians().tan();
     let surface = |x: f32| -x.abs() * slope;
-    let mut vertices = Vec::new();
-    for x in [-2.0f32, 0.0, 2.0] {
-        for y in [-2.0f32, 2.0] {
-            vertices.push(Vec3::new(x, y, surface(x)));
-        }
-    }
-    let triangles = vec![[0, 2, 3], [0, 3, 1], [2, 4, 5], [2, 5, 3]];
     let lying = Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
     let shapes = [
         (Shape::ellipsoid(Vec3::splat(0.5)), Quat::IDENTITY),
@@ -238,7 +242,7 @@ fn an_ellipsoid_and_a_cylinder_on_a_4_degree_ridge_stay_on_its_surface_within_3_
     ];
     for (shape, orientation) in shapes {
         for x0 in [0.0f32, 0.01, 0.03] {
-            let mesh = TriMesh::new(vertices.clone(), triangles.clone()).unwrap();
+            let mesh = folded_strip([-2.0, 0.0, 2.0], surface);
             let mut scene = Scene::default();
             let floor = Shape::TriMesh(MeshCollider::new(mesh).unwrap());
             scene.add(floor, Vec3::ZERO, Quat::IDENTITY, 0.0);
@@ -269,14 +273,7 @@ fn an_ellipsoid_and_a_cylinder_on_a_4_degree_ridge_stay_on_its_surface_within_3_
 fn a_hull_box_sliding_at_10_m_s_into_a_4_degree_valley_sinks_less_than_12_mm() {
     let slope = 4f32.to_radians().tan();
     let surface = |x: f32| x.max(0.0) * slope;
-    let mut vertices = Vec::new();
-    for x in [-2.0f32, 0.0, 12.0] {
-        for y in [-2.0f32, 2.0] {
-            vertices.push(Vec3::new(x, y, surface(x)));
-        }
-    }
-    let triangles = vec![[0, 2, 3], [0, 3, 1], [2, 4, 5], [2, 5, 3]];
-    let mesh = TriMesh::new(vertices, triangles).unwrap();
+    let mesh = folded_strip([-2.0, 0.0, 12.0], surface);
     let mut scene = Scene::default();
     let floor = scene.add(
         Shape::TriMesh(MeshCollider::new(mesh).unwrap()),
