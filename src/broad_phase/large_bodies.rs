@@ -30,8 +30,8 @@ pub(super) struct LargeBodies {
     owned: Vec<Pair>,
     /// This commit's pairs (scratch).
     found: Vec<Pair>,
-    /// The kept and the new pairs merged (scratch).
-    merged: Vec<Pair>,
+    /// The last pairs of changed bodies (scratch).
+    dropped: Vec<Pair>,
 }
 
 impl LargeBodies {
@@ -62,13 +62,11 @@ impl LargeBodies {
         full: bool,
         (added, removed): (&mut Vec<Pair>, &mut Vec<Pair>),
     ) -> u64 {
-        let tests = if full {
-            let tests = self.find_all(view);
-            self.found.sort_unstable();
-            tests
-        } else {
-            self.find_changed(view, changed)
-        };
+        if !full {
+            return self.find_changed(view, changed, (added, removed));
+        }
+        let tests = self.find_all(view);
+        self.found.sort_unstable();
         super::pair_diff::diff_sorted(&self.owned, &self.found, added, removed);
         std::mem::swap(&mut self.owned, &mut self.found);
         tests
@@ -104,17 +102,26 @@ impl LargeBodies {
         tests
     }
 
-    /// The last pairs of unchanged bodies, and the changed bodies against the large ones,
-    /// sorted: the kept pairs are already (a ground slab owns about one pair a body, and
-    /// sorting them all again cost every commit `n log n`), so only the new ones are sorted
-    /// and merged in (no pair is in both: every new one has a changed body).
-    fn find_changed(&mut self, view: &impl LargeView, changed: &[ProxyId]) -> u64 {
+    /// The last pairs of unchanged bodies kept, and the changed bodies against the large
+    /// ones. Only the changed bodies' pairs are sorted and diffed, the dropped against the new
+    /// (no kept pair is among either: each has a changed body), then merged into the kept
+    /// ones, which are sorted already (a ground slab owns about one pair a body, and sorting
+    /// or diffing them all again cost every commit), as `Region::sweep_few` does.
+    fn find_changed(
+        &mut self,
+        view: &impl LargeView,
+        changed: &[ProxyId],
+        (added, removed): (&mut Vec<Pair>, &mut Vec<Pair>),
+    ) -> u64 {
         self.found.clear();
-        self.found.extend(
-            self.owned
-                .iter()
-                .filter(|p| !view.changed(p.a) && !view.changed(p.b)),
-        );
+        self.dropped.clear();
+        for &p in &self.owned {
+            if view.changed(p.a) || view.changed(p.b) {
+                self.dropped.push(p);
+            } else {
+                self.found.push(p);
+            }
+        }
         let kept = self.found.len();
         let mut tests = 0;
         for &id in changed {
@@ -133,15 +140,15 @@ impl LargeBodies {
         }
         self.found[kept..].sort_unstable();
         let (old, new) = self.found.split_at(kept);
-        super::pair_diff::merge_sorted(old, new, &mut self.merged);
-        std::mem::swap(&mut self.found, &mut self.merged);
+        super::pair_diff::diff_sorted(&self.dropped, new, added, removed);
+        super::pair_diff::merge_sorted(old, new, &mut self.owned);
         tests
     }
 
     /// Heap bytes held.
     pub fn memory_bytes(&self) -> usize {
         self.ids.capacity() * size_of::<ProxyId>()
-            + (self.owned.capacity() + self.found.capacity() + self.merged.capacity())
+            + (self.owned.capacity() + self.found.capacity() + self.dropped.capacity())
                 * size_of::<Pair>()
     }
 }
