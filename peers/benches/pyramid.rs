@@ -141,6 +141,14 @@ impl Urto {
         urto::step(self.app.world_mut(), n).expect("UrtoPlugins");
     }
 
+    fn asleep(&self) -> usize {
+        let w = self.app.world();
+        self.bodies
+            .iter()
+            .filter(|&&b| w.get::<Sleeping>(b).is_some())
+            .count()
+    }
+
     fn positions(&self) -> Vec<Vec3> {
         let w = self.app.world();
         self.bodies
@@ -197,6 +205,11 @@ impl Rapier {
     }
 }
 
+/// The step from which every box slept, or "never" within the run.
+fn step_or_never(step: Option<u32>) -> String {
+    step.map_or_else(|| "never".to_string(), |s| s.to_string())
+}
+
 fn bench_pyramid(c: &mut Criterion) {
     let rows = rows();
     let start = boxes(rows);
@@ -205,7 +218,13 @@ fn bench_pyramid(c: &mut Criterion) {
     let mut default_run = None;
     for (label, relax, can_sleep) in URTO_VARIANTS {
         let mut v = Urto::new(&start, relax, can_sleep);
-        v.step(STEPS);
+        let mut all_asleep_at = None;
+        for step in 1..=STEPS {
+            v.step(1);
+            if all_asleep_at.is_none() && v.asleep() == n {
+                all_asleep_at = Some(step);
+            }
+        }
         let (drift, sag) = quality(&start, &v.positions());
         let turned = {
             let w = v.app.world();
@@ -220,30 +239,32 @@ fn bench_pyramid(c: &mut Criterion) {
                 })
                 .count()
         };
-        let asleep = {
-            let w = v.app.world();
-            v.bodies
-                .iter()
-                .filter(|&&b| w.get::<Sleeping>(b).is_some())
-                .count()
-        };
         eprintln!(
-            "[sanity] pyramid {rows} rows ({n} boxes) {label} after {STEPS} steps: largest drift {:.1} mm, top sag {:.1} mm, boxes turned > 0.01 rad {turned}, asleep {asleep}",
+            "[sanity] pyramid {rows} rows ({n} boxes) {label} after {STEPS} steps: largest drift {:.1} mm, top sag {:.1} mm, boxes turned > 0.01 rad {turned}, asleep {}, all asleep from step {}",
             drift * 1e3,
-            sag * 1e3
+            sag * 1e3,
+            v.asleep(),
+            step_or_never(all_asleep_at)
         );
         default_run.get_or_insert(v);
     }
     let u = default_run.expect("URTO_VARIANTS is not empty");
     for (label, can_sleep) in RAPIER_VARIANTS {
         let mut r = Rapier::new(&start, can_sleep);
-        r.step(STEPS);
+        let mut all_asleep_at = None;
+        for step in 1..=STEPS {
+            r.step(1);
+            if all_asleep_at.is_none() && r.asleep() == n {
+                all_asleep_at = Some(step);
+            }
+        }
         let (drift, sag) = quality(&start, &r.positions());
         eprintln!(
-            "[sanity] pyramid {rows} rows ({n} boxes) {label} after {STEPS} steps: largest drift {:.1} mm, top sag {:.1} mm, asleep {}",
+            "[sanity] pyramid {rows} rows ({n} boxes) {label} after {STEPS} steps: largest drift {:.1} mm, top sag {:.1} mm, asleep {}, all asleep from step {}",
             drift * 1e3,
             sag * 1e3,
-            r.asleep()
+            r.asleep(),
+            step_or_never(all_asleep_at)
         );
     }
     let stages = u.app.world().resource::<PhysicsStats>();
