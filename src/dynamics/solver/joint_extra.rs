@@ -360,11 +360,9 @@ fn solve_limit(
         row.solve(m, states, ab, bias, soft, lower, free);
         return;
     }
-    let reversed = row.reversed();
-    let push = (0.0, f32::INFINITY);
-    for (row, c, acc) in [
-        (row, coordinate - limit.min, lower),
-        (&reversed, limit.max - coordinate, upper),
+    for (side, c, acc) in [
+        (1.0, coordinate - limit.min, lower),
+        (-1.0, limit.max - coordinate, upper),
     ] {
         if c == f32::INFINITY {
             continue;
@@ -374,6 +372,6 @@ fn solve_limit(
         } else {
             bias_of(c)
         };
-        row.solve(m, states, ab, bias, soft, acc, push);
+        row.push_only(m, states, ab, side, bias, soft, acc);
     }
 }

@@ -159,20 +159,6 @@ impl AxisRow {
         self
     }
 
-    /// The same row, pushing the other way.
-    pub fn reversed(&self) -> Self {
-        let pivot = self.pivot.map(|p| Pivot {
-            response: p.response.map(|v| -v),
-            k: p.k,
-        });
-        Self {
-            linear: -self.linear,
-            angular_a: -self.angular_a,
-            angular_b: -self.angular_b,
-            pivot,
-        }
-    }
-
     /// A row along `direction` between anchors `r_a`, `r_b` (a slider's travel uses its own
     /// `u_a`, see the prismatic joint).
     pub fn linear(direction: Vec3, r_a: Vec3, r_b: Vec3) -> Self {
@@ -247,6 +233,40 @@ impl AxisRow {
         *accumulated = (old + impulse).clamp(range.0, range.1);
         let applied = *accumulated - old;
         self.apply(m, states, (a, b), applied);
+        applied
+    }
+
+    /// Solves the row pushing towards `side` only (`+1` along it, `−1` against it: the row
+    /// reversed, without building it): the accumulated impulse stays `≥ 0`. A
+    /// row carrying no impulse that is not closing faster than its bias allows takes none, so
+    /// its mass and the apply are skipped (a limit far from its bound: most of a ragdoll's
+    /// limit rows in most passes). Returns the impulse applied.
+    #[allow(clippy::too_many_arguments)]
+    pub fn push_only(
+        &self,
+        m: &PairMasses,
+        states: &mut [BodyState],
+        (a, b): (usize, usize),
+        side: f32,
+        bias: f32,
+        soft: Softness,
+        accumulated: &mut f32,
+    ) -> f32 {
+        let cdot = side * self.velocity(&states[a], &states[b]);
+        if *accumulated == 0.0 && cdot + bias >= 0.0 {
+            return 0.0;
+        }
+        let k = self.k(m);
+        if k.is_nan() || k <= 0.0 {
+            return 0.0;
+        }
+        let impulse = -soft.mass_scale * (cdot + bias) / k - soft.impulse_scale * *accumulated;
+        let old = *accumulated;
+        *accumulated = (old + impulse).max(0.0);
+        let applied = *accumulated - old;
+        if applied != 0.0 {
+            self.apply(m, states, (a, b), side * applied);
+        }
         applied
     }
 }
