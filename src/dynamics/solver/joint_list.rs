@@ -73,7 +73,7 @@ impl JointList {
             );
             if let Some(mut extra) = JointExtra::prepare(joint, &c.masses, turns) {
                 let start = BodyState::default();
-                extra.refresh(&c.masses, &start, &start, &c.point);
+                extra.refresh(&c.masses, (&start, &start), &c.point, &c.impulses);
                 c.extra = Some(self.extras.len() as u32);
                 self.extras.push(extra);
             }
@@ -177,6 +177,7 @@ impl JointList {
                 let ab = joint.slots();
                 let pass = Pass {
                     masses: &joint.masses,
+                    point: &joint.point,
                     ab,
                     soft,
                     h,
@@ -199,7 +200,8 @@ impl JointList {
             let (sa, sb) = (&states[a], &states[b]);
             joint.refresh(sa, sb);
             if let Some(x) = joint.extra {
-                self.extras[x as usize].refresh(&joint.masses, sa, sb, &joint.point);
+                let extra = &mut self.extras[x as usize];
+                extra.refresh(&joint.masses, (sa, sb), &joint.point, &joint.impulses);
             }
         }
     }
