@@ -67,6 +67,7 @@ pub mod debug;
 pub mod dynamics;
 pub mod geometry;
 pub mod hierarchy;
+mod pair_hash;
 #[cfg(feature = "ecs")]
 pub mod plugins;
 #[cfg(feature = "ecs")]

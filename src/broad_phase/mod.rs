@@ -36,7 +36,6 @@ pub mod grid;
 mod id_marks;
 mod large_bodies;
 mod pair_diff;
-mod pair_hash;
 mod pair_set;
 mod pair_tracking;
 mod positions;

@@ -7,8 +7,8 @@
 //! Every add and remove is also logged, so that the step boundary can report the *net*
 //! changes: a pair added and removed within one step cancels out.
 
-use super::pair_hash::{PairMap, hash_map_bytes};
 use super::{Pair, clear_buffer};
+use crate::pair_hash::{PairMap, hash_map_bytes};
 use std::mem::size_of;
 
 /// The current pair set and this step's change log.

@@ -39,9 +39,9 @@
 
 use super::Pair;
 use super::id_marks::IdMarks;
-use super::pair_hash::{PairMap, hash_map_bytes};
 use super::pair_set::PairSet;
 use super::positions::{EndpointSlots, Pass, cross_overlap_bit, cross_slots, owner_id};
+use crate::pair_hash::{PairMap, hash_map_bytes};
 use std::fmt::Debug;
 
 /// A way to keep the pair list in step with endpoint swaps (see the module doc): the type

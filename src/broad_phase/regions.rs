@@ -34,7 +34,6 @@
 //! [`large_bodies`]: super::large_bodies
 
 use super::large_bodies::{LargeBodies, LargeView};
-use super::pair_hash::{PairHashBuilder, hash_map_bytes};
 use super::pair_set::PairSet;
 use super::region::{BodyView, CellRange, Entry, Region, SweepFrame, SweepScratch};
 use super::{
@@ -42,6 +41,7 @@ use super::{
     check_id,
 };
 use crate::bounding::Aabb;
+use crate::pair_hash::{PairHashBuilder, hash_map_bytes};
 use std::collections::HashMap;
 use std::mem::size_of;
 

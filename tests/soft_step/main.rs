@@ -165,6 +165,45 @@ fn with_the_soft_step_an_unrelated_component_changes_no_bit_of_a_pile() {
 }
 
 #[test]
+fn a_box_resting_on_a_box_is_answered_from_the_cache_and_retested_when_thrown_sinking_under_1_cm() {
+    let mut app = soft_step_app_on_ground();
+    app.insert_resource(SleepSettings {
+        enabled: false,
+        ..Default::default()
+    });
+    let spawn_box = |app: &mut App, z: f32| {
+        app.world_mut()
+            .spawn((
+                Collider::cuboid(0.5, 0.5, 0.5),
+                Position::new(0.0, 0.0, z),
+                Velocity::default(),
+            ))
+            .id()
+    };
+    let lower = spawn_box(&mut app, 0.5);
+    let upper = spawn_box(&mut app, 1.5);
+    urto::step(app.world_mut(), 120).unwrap();
+    let cached = |app: &App| {
+        let stats = app.world().resource::<PhysicsStats>();
+        stats.counter("narrow_phase/cached_pairs").unwrap_or(-1.0)
+    };
+    // The box pair is answered from the cache (box–half-space pairs are not cached: a closed form).
+    assert_eq!(cached(&app), 1.0);
+    // Thrown down hard: a longer lookahead than the cached test's, so the pair is tested again
+    // and the upper box stopped on the lower one.
+    app.world_mut().get_mut::<Velocity>(upper).unwrap().0 = Vec3::new(0.0, 0.0, -30.0);
+    urto::step(app.world_mut(), 1).unwrap();
+    assert_eq!(cached(&app), 0.0);
+    urto::step(app.world_mut(), 10).unwrap();
+    let gap = get::<Position>(&app, upper).0.z - get::<Position>(&app, lower).0.z;
+    assert!(
+        gap > 0.99,
+        "the thrown box sank {} m into the other",
+        1.0 - gap
+    );
+}
+
+#[test]
 fn with_the_soft_step_a_tilted_dumbbell_compound_falls_onto_both_ends_within_1_cm() {
     let mut app = soft_step_app_on_ground();
     // A bar along x with a ball at each end, parts of one body; dropped tilted 0.4 rad.

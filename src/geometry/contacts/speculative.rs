@@ -246,16 +246,17 @@ mod tests {
         }
         let mut cache = super::super::ManifoldCache::default();
         cache.begin_step();
-        cache.insert((1, 2), &at, &sunk, touching.as_ref(), &[]);
+        cache.insert((1, 2), (&at, &sunk), 0.0, touching.as_ref(), &[]);
         assert!(
-            cache.get((1, 2), &at, &nan, 1.0).is_none(),
+            cache.get((1, 2), (&at, &nan), 1.0, 0.0).is_none(),
             "a NaN pose is never a hit"
         );
         assert!(
-            cache.get((1, 2), &at, &sunk, f32::NAN).is_none(),
+            cache.get((1, 2), (&at, &sunk), f32::NAN, 0.0).is_none(),
             "nor a NaN reach"
         );
-        assert!(cache.get((1, 2), &at, &sunk, 1.0).is_some());
+        assert!(cache.get((1, 2), (&at, &sunk), 1.0, f32::NAN).is_none());
+        assert!(cache.get((1, 2), (&at, &sunk), 1.0, 0.0).is_some());
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! A fixed, fast hasher for pair keys, and the memory estimate of a hash table.
 //!
-//! Pair maps are hit on every endpoint swap that changes an overlap, so the hash must be a few
-//! instructions; the keys are never adversarial, so SipHash's protection buys nothing. The hash
+//! Pair maps are hit on every endpoint swap that changes an overlap, and the narrow phase's
+//! manifold cache on every costly pair of every step, so the hash must be a few instructions; the keys are never adversarial, so SipHash's protection buys nothing. The hash
 //! is a folded multiply (the full 128-bit product of the key and an odd constant, high half xor
 //! low half: every key bit reaches both ends of the result, which the table's bucket index and
 //! tag use). It is fixed, so the same calls build the same table; its iteration order still
@@ -24,7 +24,7 @@ impl BuildHasher for PairHashBuilder {
     }
 }
 
-/// The folded-multiply hasher; meant for one `u64` key per hash.
+/// The folded-multiply hasher; meant for `u64` keys (a tuple of them folds each in turn).
 #[derive(Clone, Copy, Debug)]
 pub struct PairHasher(u64);
 
