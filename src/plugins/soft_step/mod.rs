@@ -35,7 +35,7 @@ mod lookahead;
 
 pub use lookahead::SpeculativeMargin;
 
-use contact_inputs::{Material, add_part_motion, gather_contacts, report_impulses};
+use contact_inputs::{KeyedContacts, Material, add_part_motion, gather_contacts, report_impulses};
 use joint_inputs::JointParams;
 pub(crate) use lookahead::{Lookahead, LookaheadParams};
 
@@ -108,7 +108,7 @@ pub struct SoftStepSolver {
     /// Each slot's centre of mass in its body frame (joint anchors are given from the origin).
     local_centers: Vec<Vec3>,
     waking: Vec<Entity>,
-    keyed: Vec<(ContactInput, u32)>,
+    keyed: KeyedContacts,
     sources: Vec<u32>,
     warned_stiff_springs: bool,
 }
