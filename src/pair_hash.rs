@@ -1,8 +1,9 @@
 //! A fixed, fast hasher for pair keys, and the memory estimate of a hash table.
 //!
 //! Pair maps are hit on every endpoint swap that changes an overlap, and the narrow phase's
-//! manifold cache on every costly pair of every step, so the hash must be a few instructions; the keys are never adversarial, so SipHash's protection buys nothing. The hash
-//! is a folded multiply (the full 128-bit product of the key and an odd constant, high half xor
+//! manifold cache on every costly pair of every step, so the hash must be a few instructions;
+//! the keys are never adversarial, so SipHash's protection buys nothing. The hash is a folded
+//! multiply (the full 128-bit product of the key and an odd constant, high half xor
 //! low half: every key bit reaches both ends of the result, which the table's bucket index and
 //! tag use). It is fixed, so the same calls build the same table; its iteration order still
 //! never reaches an output.
@@ -93,6 +94,22 @@ mod tests {
             low_buckets.len()
         );
         assert!(tags.len() > 100, "{} distinct tags", tags.len());
+    }
+
+    #[test]
+    fn tuple_keys_spread_and_their_order_matters() {
+        // The manifold cache's keys: two collider ids, folded in turn.
+        let hash = |a: u64, b: u64| PairHashBuilder.hash_one((a, b));
+        let low_buckets: std::collections::BTreeSet<u64> = (0..32u64)
+            .flat_map(|a| (0..32u64).map(move |b| hash(a, b) & 1023))
+            .collect();
+        // A random hash fills about 647 of the 1,024 buckets; one blind to either half, 32.
+        assert!(
+            low_buckets.len() > 550,
+            "{} distinct low buckets",
+            low_buckets.len()
+        );
+        assert!((1..32u64).all(|a| hash(a, 0) != hash(0, a)));
     }
 
     #[test]

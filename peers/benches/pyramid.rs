@@ -205,6 +205,26 @@ impl Rapier {
     }
 }
 
+/// Runs `STEPS` steps one at a time; returns the step from which all `n` boxes stayed asleep
+/// to the end of the run (`None` if some box was awake at the end).
+fn run_watching_sleep<T>(
+    engine: &mut T,
+    step: impl Fn(&mut T),
+    asleep: impl Fn(&T) -> usize,
+    n: usize,
+) -> Option<u32> {
+    let mut since = None;
+    for s in 1..=STEPS {
+        step(engine);
+        if asleep(engine) == n {
+            since.get_or_insert(s);
+        } else {
+            since = None;
+        }
+    }
+    since
+}
+
 /// The step from which every box slept, or "never" within the run.
 fn step_or_never(step: Option<u32>) -> String {
     step.map_or_else(|| "never".to_string(), |s| s.to_string())
@@ -218,13 +238,7 @@ fn bench_pyramid(c: &mut Criterion) {
     let mut default_run = None;
     for (label, relax, can_sleep) in URTO_VARIANTS {
         let mut v = Urto::new(&start, relax, can_sleep);
-        let mut all_asleep_at = None;
-        for step in 1..=STEPS {
-            v.step(1);
-            if all_asleep_at.is_none() && v.asleep() == n {
-                all_asleep_at = Some(step);
-            }
-        }
+        let all_asleep_at = run_watching_sleep(&mut v, |u| u.step(1), Urto::asleep, n);
         let (drift, sag) = quality(&start, &v.positions());
         let turned = {
             let w = v.app.world();
@@ -251,13 +265,7 @@ fn bench_pyramid(c: &mut Criterion) {
     let u = default_run.expect("URTO_VARIANTS is not empty");
     for (label, can_sleep) in RAPIER_VARIANTS {
         let mut r = Rapier::new(&start, can_sleep);
-        let mut all_asleep_at = None;
-        for step in 1..=STEPS {
-            r.step(1);
-            if all_asleep_at.is_none() && r.asleep() == n {
-                all_asleep_at = Some(step);
-            }
-        }
+        let all_asleep_at = run_watching_sleep(&mut r, |r| r.step(1), Rapier::asleep, n);
         let (drift, sag) = quality(&start, &r.positions());
         eprintln!(
             "[sanity] pyramid {rows} rows ({n} boxes) {label} after {STEPS} steps: largest drift {:.1} mm, top sag {:.1} mm, asleep {}, all asleep from step {}",

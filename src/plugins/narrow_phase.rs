@@ -14,7 +14,8 @@
 //!
 //! A costly pair (a mesh against anything; two shapes that are neither spheres, half-spaces
 //! nor two capsules: boxes, hulls, cylinders, cones, ellipsoids) that moved less than 1 mm
-//! relative to each other since its last test, looking no farther ahead, reuses that test
+//! relative to each other since its last test, looking ahead no more than 1 mm farther,
+//! reuses that test
 //! ([`ManifoldCache`], Jolt's body pair cache); `narrow_phase/cached_pairs` counts the pairs
 //! answered so in the last run.
 //!
@@ -184,7 +185,7 @@ pub struct OverlappingLeaves {
 #[derive(Resource, Default)]
 struct NarrowPhaseScratch {
     contact: ContactScratch,
-    /// Mesh pairs' contacts, reused while the pair barely moves (`manifold_cache.rs`).
+    /// Costly pairs' contacts, reused while the pair barely moves (`manifold_cache.rs`).
     cache: ManifoldCache,
     pairs: PairScratch<Entity, Entity>,
     leaf_pairs: Vec<(Entity, Entity)>,

@@ -77,6 +77,22 @@ impl JointImpulses {
             *x *= factor;
         }
     }
+
+    /// Drops the impulses of rows `kind` does not have (a motor switched off, a limit removed
+    /// since the impulses were kept): the warm start must not apply them, and a row that is
+    /// not there has no pivot to apply them at.
+    pub(super) fn keep_rows_of(&mut self, kind: &JointKind) {
+        let (limit, motor) = kind.limit_and_motor();
+        if motor.is_none() {
+            self.motor = 0.0;
+        }
+        if limit.is_none() {
+            (self.lower, self.upper) = (0.0, 0.0);
+        }
+        if !matches!(kind, JointKind::Spherical { swing: Some(_), .. }) {
+            self.swing = 0.0;
+        }
+    }
 }
 
 /// What every pass over a joint reads: its bodies, their masses, its point rows and its
@@ -236,4 +252,42 @@ pub struct HeldLoad {
     /// The motor's share, signed along the joint's coordinate (N·m for a hinge, N for a slider
     /// or a distance joint; 0 without a motor): what a game reads as the effort its motor makes.
     pub motor: f32,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_kept_impulse_of_a_row_the_joint_no_longer_has_is_dropped_and_the_others_kept() {
+        let carried = JointImpulses {
+            motor: 1.0,
+            lower: 2.0,
+            upper: 3.0,
+            swing: 4.0,
+            ..Default::default()
+        };
+        let rows = |kind: JointKind| {
+            let mut j = carried;
+            j.keep_rows_of(&kind);
+            (j.motor, j.lower, j.upper, j.swing)
+        };
+        // A hinge whose motor and limit were switched off since the impulses were kept.
+        let free = JointKind::Revolute {
+            limit: None,
+            motor: None,
+        };
+        assert_eq!(rows(free), (0.0, 0.0, 0.0, 0.0));
+        let limit = Some(JointLimit {
+            min: -1.0,
+            max: 1.0,
+        });
+        let limited = JointKind::Revolute { limit, motor: None };
+        assert_eq!(rows(limited), (0.0, 2.0, 3.0, 0.0));
+        let cone = JointKind::Spherical {
+            swing: Some(0.5),
+            twist: limit,
+        };
+        assert_eq!(rows(cone), (0.0, 2.0, 3.0, 4.0));
+    }
 }

@@ -66,6 +66,7 @@ impl JointList {
             let mut c = JointConstraint::prepare(joint, bodies);
             if let Ok(i) = self.cache.binary_search_by_key(&joint.key, |e| e.0) {
                 c.impulses = self.cache[i].1;
+                c.impulses.keep_rows_of(&joint.kind);
             }
             let turns = (
                 bodies.orientations[joint.a as usize],

@@ -223,12 +223,10 @@ impl AxisRow {
         accumulated: &mut f32,
         range: (f32, f32),
     ) -> f32 {
-        let k = self.k(m);
-        if k.is_nan() || k <= 0.0 {
-            return 0.0;
-        }
         let cdot = self.velocity(&states[a], &states[b]);
-        let impulse = -soft.mass_scale * (cdot + bias) / k - soft.impulse_scale * *accumulated;
+        let Some(impulse) = self.impulse(m, cdot + bias, soft, *accumulated) else {
+            return 0.0;
+        };
         let old = *accumulated;
         *accumulated = (old + impulse).clamp(range.0, range.1);
         let applied = *accumulated - old;
@@ -236,47 +234,39 @@ impl AxisRow {
         applied
     }
 
-    /// Whether [`Self::push_only`] would apply nothing without looking at the row's mass: it
-    /// carries no impulse and is not closing faster than its bias allows (a limit far from
-    /// its bound: 89 % of the ragdoll pile's bound solves).
-    pub fn is_idle(
-        &self,
-        states: &[BodyState],
-        (a, b): (usize, usize),
-        side: f32,
-        bias: f32,
-        accumulated: f32,
-    ) -> bool {
-        accumulated == 0.0 && side * self.velocity(&states[a], &states[b]) + bias >= 0.0
-    }
-
     /// Solves the row pushing towards `side` only (`+1` along it, `−1` against it: the row
-    /// reversed, without building it): the accumulated impulse stays `≥ 0`. Returns the
-    /// impulse applied.
+    /// reversed, without building it), its velocity that way `cdot` (`side · Ċ`, taken by the
+    /// caller, who skips a bound that carries nothing and is not closing faster than `bias`
+    /// allows before the row's mass is needed): the accumulated impulse stays `≥ 0`, and a NaN
+    /// impulse (from NaN velocities) leaves it carrying nothing. Returns the impulse applied.
     #[allow(clippy::too_many_arguments)]
     pub fn push_only(
         &self,
         m: &PairMasses,
         states: &mut [BodyState],
-        (a, b): (usize, usize),
-        side: f32,
+        ab: (usize, usize),
+        (side, cdot): (f32, f32),
         bias: f32,
         soft: Softness,
         accumulated: &mut f32,
     ) -> f32 {
-        let k = self.k(m);
-        if k.is_nan() || k <= 0.0 {
+        let Some(impulse) = self.impulse(m, cdot + bias, soft, *accumulated) else {
             return 0.0;
-        }
-        let cdot = side * self.velocity(&states[a], &states[b]);
-        let impulse = -soft.mass_scale * (cdot + bias) / k - soft.impulse_scale * *accumulated;
+        };
         let old = *accumulated;
         *accumulated = (old + impulse).max(0.0);
         let applied = *accumulated - old;
         if applied != 0.0 {
-            self.apply(m, states, (a, b), side * applied);
+            self.apply(m, states, ab, side * applied);
         }
         applied
+    }
+
+    /// The soft impulse `−mass_scale (Ċ + bias)/K − impulse_scale λ_acc` for `error = Ċ + bias`,
+    /// or none when the row has no usable mass (`K` zero or NaN: two immovable bodies).
+    fn impulse(&self, m: &PairMasses, error: f32, soft: Softness, accumulated: f32) -> Option<f32> {
+        let k = self.k(m);
+        (k > 0.0).then(|| -soft.mass_scale * error / k - soft.impulse_scale * accumulated)
     }
 }
 

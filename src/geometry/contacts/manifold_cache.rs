@@ -11,8 +11,10 @@
 //! turn), so the error stays below [`MAX_SHIFT`] however long the pair rests. A test looks
 //! ahead by a margin (the speculative contacts'); an entry answers only while the margin asked
 //! for is within [`MAX_SHIFT`] of the one it was tested with, so a pair at rest whose body is
-//! suddenly thrown (a longer margin) is tested again. Entries not asked for during a step are
-//! dropped at the start of the next.
+//! suddenly thrown (a longer margin) is tested again; a pair tested with a longer margin than
+//! it now asks for keeps the farther speculative points that test found (harmless to the
+//! solver: a point apart only bounds the approach) until it moves. Entries not asked for during
+//! a step are dropped at the start of the next.
 
 use crate::geometry::{ContactManifold, ContactPoint, Isometry};
 use crate::pair_hash::PairHashBuilder;
@@ -174,7 +176,7 @@ mod tests {
             let pose_b = pose_a * on_a;
             let tested = speculative_contact(&a, &pose_a, &b, &pose_b, margin);
             cache.insert((i, 0), (&pose_a, &pose_b), margin, tested.as_ref(), &[]);
-            // Then B moves, in A's frame, by at most 0.9 mm at its reach.
+            // Then B moves, in A's frame, by at most 0.8 mm at its reach.
             let reach = b.bounding_radius();
             let angle = rng.range(0.0, 0.0004 / reach);
             let nudge = Isometry::new(
