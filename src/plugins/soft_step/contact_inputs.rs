@@ -17,14 +17,17 @@ pub(super) type Material = (
     Option<&'static RollingResistance>,
 );
 
-/// [`gather_contacts`]' scratch: the manifolds as the narrow phase listed them, and their order
-/// by key. The keys are sorted with each manifold's place in the list (an index, not the
-/// hundred-byte contact: a thousand-ball pile sorts 3,000 manifolds a step, and moving whole
-/// contacts through a stable sort was a tenth of its step), which is the stable order by key.
+/// [`gather_contacts`]' scratch: the manifolds as the narrow phase listed them, their order by
+/// key, and each slot's material. The keys are sorted with each manifold's place in the list
+/// (an index, not the hundred-byte contact: a thousand-ball pile sorts 3,000 manifolds a step,
+/// and moving whole contacts through a stable sort was a tenth of its step), which is the stable
+/// order by key. A body's material is read from the world once a step, not once per contact.
 #[derive(Debug, Default)]
 pub(super) struct KeyedContacts {
     found: Vec<(ContactInput, u32)>,
     order: Vec<(u128, u32)>,
+    /// Per slot: restitution, friction, rolling resistance, once read.
+    materials: Vec<Option<(f32, f32, f32)>>,
 }
 
 /// The narrow phase's manifolds as solver contacts, keyed by collider pair (sorted), each with
@@ -39,13 +42,17 @@ pub(super) fn gather_contacts(
     sources: &mut Vec<u32>,
 ) {
     keyed.found.clear();
-    let material = |e: Entity| {
-        let (r, f, rolling) = materials.get(e).unwrap_or((None, None, None));
-        (
-            r.map_or(settings.default_restitution, |r| r.0),
-            f.map_or(settings.default_friction, |f| f.0),
-            rolling.map_or(0.0, |r| r.0),
-        )
+    keyed.materials.clear();
+    keyed.materials.resize(entities.len(), None);
+    let mut material = |slot: usize| {
+        *keyed.materials[slot].get_or_insert_with(|| {
+            let (r, f, rolling) = materials.get(entities[slot]).unwrap_or((None, None, None));
+            (
+                r.map_or(settings.default_restitution, |r| r.0),
+                f.map_or(settings.default_friction, |f| f.0),
+                rolling.map_or(0.0, |r| r.0),
+            )
+        })
     };
     for (source, pair) in contacts.pairs.iter().enumerate() {
         let (Ok(a), Ok(b)) = (
@@ -54,7 +61,7 @@ pub(super) fn gather_contacts(
         ) else {
             continue;
         };
-        let ((ea, fa, ra), (eb, fb, rb)) = (material(pair.a), material(pair.b));
+        let ((ea, fa, ra), (eb, fb, rb)) = (material(a), material(b));
         // The lower slot first, whatever order the broad phase found the pair in (it follows
         // insertion, hence archetype, order).
         let (a, b, normal) = if a <= b {
