@@ -44,11 +44,11 @@ use crate::geometry::contacts::{
 };
 use crate::geometry::{ContactManifold, Shape};
 use crate::hierarchy::{BvTree, HierarchyStats, PairScratch, descend_pairs};
+use crate::pair_hash::PairHashBuilder;
 use crate::plugins::broad_phase::BroadPhasePairs;
 use crate::plugins::joints::JointedPairs;
 use crate::plugins::required_resources::RequireResource;
 use crate::plugins::sleep::dormant;
-use crate::pair_hash::PairHashBuilder;
 use crate::plugins::soft_step::LookaheadParams;
 use crate::schedule::{SubstepSchedule, SubstepSet};
 use crate::settings::SleepSettings;

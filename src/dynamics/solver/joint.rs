@@ -62,6 +62,14 @@ pub struct JointImpulses {
     pub swing: f32,
 }
 
+/// Whether a joint of `kind` holds its anchors together with point rows.
+fn holds_point(kind: &JointKind) -> bool {
+    matches!(
+        kind,
+        JointKind::Fixed | JointKind::Spherical { .. } | JointKind::Revolute { .. }
+    )
+}
+
 impl JointImpulses {
     /// Every impulse times `factor`.
     pub(super) fn scale(&mut self, factor: f32) {
@@ -78,10 +86,24 @@ impl JointImpulses {
         }
     }
 
-    /// Drops the impulses of rows `kind` does not have (a motor switched off, a limit removed
-    /// since the impulses were kept): the warm start must not apply them, and a row that is
-    /// not there has no pivot to apply them at.
+    /// Drops the impulses of rows `kind` does not have (a motor switched off, a limit removed,
+    /// the kind changed since the impulses were kept): the warm start must not apply them, a
+    /// row that is not there has no pivot to apply them at, and a joint's reported load must
+    /// not carry them. (A bound moved to infinity drops its own when a pass meets it.)
     pub(super) fn keep_rows_of(&mut self, kind: &JointKind) {
+        if !holds_point(kind) {
+            self.point = Vec3::ZERO;
+        }
+        let angular = matches!(
+            kind,
+            JointKind::Fixed | JointKind::Revolute { .. } | JointKind::Prismatic { .. }
+        );
+        if !angular {
+            self.angular = Vec3::ZERO;
+        }
+        if !matches!(kind, JointKind::Prismatic { .. }) {
+            self.across = [0.0; 2];
+        }
         let (limit, motor) = kind.limit_and_motor();
         if motor.is_none() {
             self.motor = 0.0;
@@ -145,10 +167,7 @@ impl JointConstraint {
             impulses: JointImpulses::default(),
             slots: (joint.a, joint.b),
             extra: None,
-            holds_point: matches!(
-                joint.kind,
-                JointKind::Fixed | JointKind::Spherical { .. } | JointKind::Revolute { .. }
-            ),
+            holds_point: holds_point(&joint.kind),
             turns: matches!(
                 joint.kind,
                 JointKind::Revolute { .. } | JointKind::Spherical { .. }
@@ -289,5 +308,32 @@ mod tests {
             twist: limit,
         };
         assert_eq!(rows(cone), (0.0, 2.0, 3.0, 4.0));
+        let motor = Some(JointMotor {
+            target_velocity: 1.0,
+            target_position: None,
+            hertz: 0.0,
+            damping_ratio: 0.0,
+            max_force: 10.0,
+        });
+        let driven = JointKind::Prismatic { limit: None, motor };
+        assert_eq!(rows(driven), (1.0, 0.0, 0.0, 0.0));
+        // A distance always has its limit; a rope's missing bound drops its own in the pass.
+        let rope = JointKind::Distance {
+            limit: JointLimit { min: 0.0, max: 2.0 },
+            motor: None,
+        };
+        assert_eq!(rows(rope), (0.0, 2.0, 3.0, 0.0));
+        // Rows of another kind: a hinge turned into a distance keeps no point or angular impulse.
+        let mut j = JointImpulses {
+            point: Vec3::ONE,
+            angular: Vec3::ONE,
+            across: [1.0; 2],
+            ..carried
+        };
+        j.keep_rows_of(&rope);
+        assert_eq!(
+            (j.point, j.angular, j.across),
+            (Vec3::ZERO, Vec3::ZERO, [0.0; 2])
+        );
     }
 }

@@ -314,6 +314,8 @@ impl Pass<'_> {
             (-1.0, limit.max - coordinate, upper),
         ] {
             if c == f32::INFINITY {
+                // No bound there (a rope's, or one a game moved away): it carries nothing.
+                *acc = 0.0;
                 continue;
             }
             let (bias, soft) = if c > 0.0 {

@@ -10,11 +10,11 @@
 //! surface moved along the normal at that point (exact for a translation, first order for a
 //! turn), so the error stays below [`MAX_SHIFT`] however long the pair rests. A test looks
 //! ahead by a margin (the speculative contacts'); an entry answers only while the margin asked
-//! for is within [`MAX_SHIFT`] of the one it was tested with, so a pair at rest whose body is
-//! suddenly thrown (a longer margin) is tested again; a pair tested with a longer margin than
-//! it now asks for keeps the farther speculative points that test found (harmless to the
-//! solver: a point apart only bounds the approach) until it moves. Entries not asked for during
-//! a step are dropped at the start of the next.
+//! for is no more than [`MAX_SHIFT`] longer than the one it was tested with, so a pair at rest
+//! whose body is suddenly thrown (a longer margin) is tested again; a pair tested with a longer
+//! margin than it now asks for keeps the farther speculative points that test found (harmless
+//! to the solver: a point apart only bounds the approach) until it moves. Entries not asked for
+//! during a step are dropped at the start of the next.
 
 use crate::geometry::{ContactManifold, ContactPoint, Isometry};
 use crate::pair_hash::PairHashBuilder;

@@ -19,7 +19,7 @@ pub(super) type Material = (
 
 /// [`gather_contacts`]' scratch: the manifolds as the narrow phase listed them, their order by
 /// key, and each slot's material. The keys are sorted with each manifold's place in the list
-/// (an index, not the hundred-byte contact: a thousand-ball pile sorts 3,000 manifolds a step,
+/// (an index, not the 128-byte contact: a thousand-ball pile sorts 3,000 manifolds a step,
 /// and moving whole contacts through a stable sort was a tenth of its step), which is the stable
 /// order by key. A body's material is read from the world once a step, not once per contact.
 #[derive(Debug, Default)]
