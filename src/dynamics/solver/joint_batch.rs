@@ -240,6 +240,25 @@ mod tests {
     }
 
     #[test]
+    fn a_rope_drops_an_impulse_kept_on_its_missing_lower_bound_at_the_first_pass() {
+        let (bodies, mut inputs) = net(3);
+        inputs.truncate(1);
+        // A rope (no lower bound) whose kept impulses still hold a lower bound's, as after a
+        // game turned a rod of 1 m into a rope.
+        inputs[0].kind = JointKind::Distance {
+            limit: crate::dynamics::solver::JointLimit { min: 0.0, max: 5.0 },
+            motor: None,
+        };
+        let mut list = JointList::default();
+        list.prepare(&bodies, &inputs, (f32::INFINITY, f32::INFINITY));
+        list.impulses_mut(0).lower = 2.0;
+        let mut states = bodies.states.clone();
+        let soft = Softness::new(60.0, 2.0, 1.0 / 240.0);
+        list.solve(&mut states, soft, 1.0 / 240.0, false);
+        assert_eq!(list.joints()[0].impulses.lower, 0.0);
+    }
+
+    #[test]
     fn batched_ball_joints_equal_the_key_order_sweep_within_1e_4_on_20_nets() {
         let soft = Softness::new(60.0, 2.0, 1.0 / 240.0);
         let unbounded = (f32::INFINITY, f32::INFINITY);

@@ -223,6 +223,13 @@ impl JointList {
         self.pack(self.batching.bodies());
     }
 
+    /// Joint `i`'s impulses, to set by hand (a test's stand-in for a kept impulse); only for a
+    /// joint solved one at a time (a batch keeps its own copy of its joints' impulses).
+    #[cfg(test)]
+    pub(super) fn impulses_mut(&mut self, i: usize) -> &mut JointImpulses {
+        &mut self.joints[i].impulses
+    }
+
     /// Sets every joint's point impulse to `point(i)`, in the joints and their batches.
     #[cfg(test)]
     pub(super) fn set_impulses_all(&mut self, point: impl Fn(usize) -> glam::Vec3) {
