@@ -28,10 +28,12 @@ struct RowX4 {
 }
 
 impl RowX4 {
+    // Written out, not `[0, 1].map(..)`: the array map's drain stayed out of line.
     fn gather(rows: [&RowPart; LANES]) -> Self {
+        let side = |part: fn(&RowPart) -> Vec3| Vec3x4::gather(rows.map(part));
         Self {
-            arm: [0, 1].map(|k| Vec3x4::gather(rows.map(|r| r.arm[k]))),
-            turn: [0, 1].map(|k| Vec3x4::gather(rows.map(|r| r.turn[k]))),
+            arm: [side(|r| r.arm[0]), side(|r| r.arm[1])],
+            turn: [side(|r| r.turn[0]), side(|r| r.turn[1])],
             mass: Lanes::new(rows.map(|r| r.mass)),
         }
     }
@@ -59,7 +61,10 @@ impl PointX4 {
             anchor_b: Vec3x4::gather(points.map(|p| p.anchor_b)),
             base_separation: each(|p| p.base_separation),
             normal_row: RowX4::gather(points.map(|p| &p.normal_row)),
-            tangent_rows: [0, 1].map(|k| RowX4::gather(points.map(|p| &p.tangent_rows[k]))),
+            tangent_rows: [
+                RowX4::gather(points.map(|p| &p.tangent_rows[0])),
+                RowX4::gather(points.map(|p| &p.tangent_rows[1])),
+            ],
             normal_impulse: each(|p| p.normal_impulse),
             tangent_impulse: [
                 each(|p| p.tangent_impulse[0]),

@@ -36,13 +36,11 @@ impl Vec3x4 {
         z: Lanes::ZERO,
     };
 
-    /// Lane `i` holds `v[i]`.
+    /// Lane `i` holds `v[i]` (by a 4×4 transpose, as [`Self::transposed`]).
+    #[inline]
     pub fn gather(v: [Vec3; LANES]) -> Self {
-        Self {
-            x: Lanes::new(v.map(|v| v.x)),
-            y: Lanes::new(v.map(|v| v.y)),
-            z: Lanes::new(v.map(|v| v.z)),
-        }
+        let [x, y, z, _] = Lanes::transpose(v.map(|v| Lanes::new([v.x, v.y, v.z, 0.0])));
+        Self { x, y, z }
     }
 
     /// The vector of lane `i`.
@@ -58,6 +56,20 @@ impl Vec3x4 {
     pub fn to_vecs(self) -> [Vec3; LANES] {
         let [x, y, z] = [self.x, self.y, self.z].map(Lanes::to_array);
         std::array::from_fn(|i| Vec3::new(x[i], y[i], z[i]))
+    }
+
+    /// The vector of each lane, by a 4×4 transpose (one shuffle network instead of twelve
+    /// lane extractions: writing the batches' velocities back was a fifth of a pile's contact
+    /// passes).
+    #[inline]
+    pub fn transposed(self) -> [Vec3; LANES] {
+        let [a, b, c, d] = Lanes::transpose([self.x, self.y, self.z, Lanes::ZERO]);
+        // Written out, not `t.map(..)`: the array map stayed out of line in the passes.
+        let vec = |v: Lanes| {
+            let [x, y, z, _] = v.to_array();
+            Vec3::new(x, y, z)
+        };
+        [vec(a), vec(b), vec(c), vec(d)]
     }
 
     /// Per-lane dot product.
@@ -197,7 +209,8 @@ impl PairVelocities {
         writes: &[[bool; LANES]; 2],
         states: &mut [BodyState],
     ) {
-        let [va, wa, vb, wb] = [self.va, self.wa, self.vb, self.wb].map(Vec3x4::to_vecs);
+        let (va, wa) = (self.va.transposed(), self.wa.transposed());
+        let (vb, wb) = (self.vb.transposed(), self.wb.transposed());
         for lane in 0..LANES {
             if writes[0][lane] {
                 let s = &mut states[bodies[0][lane]];
