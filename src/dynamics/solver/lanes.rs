@@ -143,14 +143,13 @@ pub struct Quatx4 {
 
 impl Quatx4 {
     /// Lane `i` holds `q[i]`.
+    #[inline]
     pub fn gather(q: [Quat; LANES]) -> Self {
+        let lanes = |q: Quat| Lanes::new(q.to_array());
+        let [x, y, z, w] = Lanes::transpose([lanes(q[0]), lanes(q[1]), lanes(q[2]), lanes(q[3])]);
         Self {
-            v: Vec3x4 {
-                x: Lanes::new(q.map(|q| q.x)),
-                y: Lanes::new(q.map(|q| q.y)),
-                z: Lanes::new(q.map(|q| q.z)),
-            },
-            w: Lanes::new(q.map(|q| q.w)),
+            v: Vec3x4 { x, y, z },
+            w,
         }
     }
 
