@@ -571,6 +571,21 @@ mod tests {
     }
 
     #[test]
+    fn a_nan_velocity_leaves_a_one_sided_row_carrying_nothing_instead_of_nan() {
+        let m = masses(1.0, 2.0);
+        let mut states = [BodyState::default(); 2];
+        states[1].linear_velocity = Vec3::new(f32::NAN, 0.0, 0.0);
+        let row = AxisRow::linear(Vec3::X, Vec3::ZERO, Vec3::ZERO);
+        let mut acc = 0.5;
+        let cdot = row.velocity(&states[0], &states[1]);
+        let rigid = Softness::RIGID;
+        row.push_only(&m, &mut states, (0, 1), (1.0, cdot), 0.0, rigid, &mut acc);
+        assert_eq!(acc, 0.0);
+        // The good body takes back the row's impulse, a finite change.
+        assert!(states[0].linear_velocity.is_finite());
+    }
+
+    #[test]
     fn a_singular_mass_takes_no_impulse_on_its_empty_rows() {
         let k = Mat3::from_diagonal(Vec3::new(2.0, 0.0, 0.0));
         assert_eq!(inverse_mass(k) * Vec3::ONE, Vec3::new(0.5, 0.0, 0.0));
