@@ -81,23 +81,13 @@ fn sleeping_is_on_by_default_and_off_when_disabled() {
     assert_eq!(counter(&app, "integrate/bodies"), 1.0);
 }
 
-fn crate_box(app: &mut App, z: f32) -> Entity {
-    app.world_mut()
-        .spawn((
-            Collider::cuboid(0.5, 0.5, 0.5),
-            Position::new(0.0, 0.0, z),
-            Velocity::default(),
-        ))
-        .id()
-}
-
 /// A stack of three boxes falls asleep as one island (one key for all three, in the same step),
 /// and a push on the bottom box wakes the whole stack before the next step moves anything.
 #[test]
 fn a_stack_sleeps_and_wakes_as_one_island_within_one_step() {
     let mut app = sleepy_app();
     let stack: Vec<Entity> = (0..3)
-        .map(|i| crate_box(&mut app, 0.5 + i as f32))
+        .map(|i| common::crate_box(&mut app, 0.5 + i as f32))
         .collect();
     let states = |app: &App| -> Vec<SleepState> {
         stack
@@ -131,7 +121,7 @@ fn a_stack_sleeps_and_wakes_as_one_island_within_one_step() {
 fn despawning_the_bottom_of_a_sleeping_stack_wakes_the_whole_island() {
     let mut app = sleepy_app();
     let stack: Vec<Entity> = (0..3)
-        .map(|i| crate_box(&mut app, 0.5 + i as f32))
+        .map(|i| common::crate_box(&mut app, 0.5 + i as f32))
         .collect();
     urto::step(app.world_mut(), 180).unwrap();
     assert!(stack.iter().all(|&b| asleep(&app, b)), "the stack slept");
@@ -237,7 +227,7 @@ fn a_sleeping_pile_gets_zero_pairs_zero_solver_bodies_and_zero_sleep_candidates(
             )
         })
         .collect();
-    bodies.extend((0..3).map(|i| crate_box(&mut app, 0.5 + i as f32)));
+    bodies.extend((0..3).map(|i| common::crate_box(&mut app, 0.5 + i as f32)));
     for b in &mut bodies[12..] {
         app.world_mut().get_mut::<Position>(*b).unwrap().0.x = 10.0;
     }
@@ -266,7 +256,7 @@ fn a_sleeping_pile_gets_zero_pairs_zero_solver_bodies_and_zero_sleep_candidates(
 fn sleeping_stack() -> (App, Vec<Entity>) {
     let mut app = sleepy_app();
     let stack: Vec<Entity> = (0..3)
-        .map(|i| crate_box(&mut app, 0.5 + i as f32))
+        .map(|i| common::crate_box(&mut app, 0.5 + i as f32))
         .collect();
     urto::step(app.world_mut(), 240).unwrap();
     assert!(stack.iter().all(|&b| asleep(&app, b)));

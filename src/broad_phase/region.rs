@@ -224,18 +224,16 @@ impl Region {
         changes: (&mut Vec<Pair>, &mut Vec<Pair>),
     ) -> (isize, SweepCounts) {
         let before = self.entries.len() as isize;
-        // Few changed: the sweep number their ids carry in `met`.
-        let few = (self.changed.len() * 4 < self.entries.len())
-            .then(|| self.refresh_few(bodies, frame.axes, scratch));
-        if few.is_none() {
-            self.refresh_all(bodies, frame.axes, scratch);
-        }
+        let few = self.changed.len() * 4 < self.entries.len();
+        // The sweep number the changed ids carry in `met`.
+        let changed = self.refresh(bodies, frame.axes, scratch, few);
         let swaps = sort_entries(&mut self.entries);
         let [axis, u, v] = frame.axes;
         let cell = [self.cell[axis], self.cell[u], self.cell[v]];
-        let tests = match few {
-            Some(changed) => self.sweep_few(cell, changed, scratch, changes),
-            None => self.sweep_all(cell, scratch, changes),
+        let tests = if few {
+            self.sweep_few(cell, changed, scratch, changes)
+        } else {
+            self.sweep_all(cell, scratch, changes)
         };
         self.changed.clear();
         (
@@ -260,7 +258,7 @@ impl Region {
 
     /// The changed members' pairs found again; the others kept. Only the changed members'
     /// pairs are sorted and diffed (the kept ones stay sorted), then merged back. `changed`
-    /// is the number [`Self::refresh_few`] marked the changed ids with.
+    /// is the number [`Self::refresh`] marked the changed ids with.
     fn sweep_few(
         &mut self,
         cell: [i32; 3],
@@ -295,66 +293,44 @@ impl Region {
         self.owned.extend_from_slice(pairs);
     }
 
-    /// Many changed: re-reads every member (dropping those that left) and appends the
-    /// arrivals, telling them apart by the sweep number each id last met, without sorting the
-    /// changed ids.
-    fn refresh_all(
+    /// Re-reads the members (all of them, or, when `few`, the changed ones, clearing the
+    /// others' fresh mark), drops those that left, and appends the changed ids not among them.
+    /// The changed ids are told apart by two sweep numbers in `met` (no sorting, no search):
+    /// `pending` until found among the members or appended, then `seen`, which is returned for
+    /// [`Self::sweep_few`].
+    fn refresh(
         &mut self,
         bodies: &impl BodyView,
         axes: [usize; 3],
         scratch: &mut SweepScratch,
-    ) {
-        let number = scratch.next_sweep_number(bodies.id_bound());
-        let (cell, met) = (self.cell, &mut scratch.met);
-        self.entries.retain_mut(|e| {
-            let id = e.id();
-            met[id as usize] = number;
-            bodies
-                .entry(id, cell, axes)
-                .map(|fresh| *e = fresh)
-                .is_some()
-        });
-        for &id in &self.changed {
-            if std::mem::replace(&mut met[id as usize], number) != number {
-                self.entries.extend(bodies.entry(id, cell, axes));
-            }
-        }
-    }
-
-    /// Few changed: re-reads them (dropping those that left), appends the arrivals, and
-    /// clears the fresh mark of the others. The changed ids are told apart by two sweep
-    /// numbers in `met` (no sorting, no search): `pending` until found among the members or
-    /// appended, then `changed`, which is returned for [`Self::sweep_few`].
-    fn refresh_few(
-        &mut self,
-        bodies: &impl BodyView,
-        axes: [usize; 3],
-        scratch: &mut SweepScratch,
+        few: bool,
     ) -> u32 {
         let pending = scratch.next_sweep_number(bodies.id_bound());
-        let changed = scratch.next_sweep_number(bodies.id_bound());
+        let seen = scratch.next_sweep_number(bodies.id_bound());
         let (cell, met) = (self.cell, &mut scratch.met);
-        for &id in &self.changed {
-            met[id as usize] = pending;
+        if few {
+            for &id in &self.changed {
+                met[id as usize] = pending;
+            }
         }
         self.entries.retain_mut(|e| {
             let id = e.id();
-            if met[id as usize] != pending {
+            if few && met[id as usize] != pending {
                 e.owner &= !FRESH;
                 return true;
             }
-            met[id as usize] = changed;
+            met[id as usize] = seen;
             bodies
                 .entry(id, cell, axes)
                 .map(|fresh| *e = fresh)
                 .is_some()
         });
         for &id in &self.changed {
-            if std::mem::replace(&mut met[id as usize], changed) == pending {
+            if std::mem::replace(&mut met[id as usize], seen) != seen {
                 self.entries.extend(bodies.entry(id, cell, axes));
             }
         }
-        changed
+        seen
     }
 }
 

@@ -490,7 +490,14 @@ impl NarrowPhaseScratch {
         let scratch = &mut self.contact;
         let mut m = match cached {
             Some(m) => {
-                scratch.set_hits(self.cache.hits_of(key));
+                // The stored triangle pairs are kept only while recording: no second lookup
+                // otherwise (most cached pairs are plain convex ones, with none).
+                let hits = if debug.enabled {
+                    self.cache.hits_of(key)
+                } else {
+                    &[]
+                };
+                scratch.set_hits(hits);
                 m
             }
             None => {

@@ -129,6 +129,17 @@ pub fn ball(app: &mut App, at: Vec3) -> bevy_ecs::entity::Entity {
         .id()
 }
 
+/// A dynamic unit box (1 kg) centred `z` above the origin, at rest.
+pub fn crate_box(app: &mut App, z: f32) -> bevy_ecs::entity::Entity {
+    app.world_mut()
+        .spawn((
+            Collider::cuboid(0.5, 0.5, 0.5),
+            Position::new(0.0, 0.0, z),
+            Velocity::default(),
+        ))
+        .id()
+}
+
 /// An app at 60 Hz, one substep.
 pub fn app() -> App {
     app_with(1.0 / 60.0, 1)

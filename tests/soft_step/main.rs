@@ -2,6 +2,9 @@
 //! A tilted box tumbles and lies flat, a ball rolls at `5/7 g sin θ`, a compound falls onto both
 //! ends, an unrelated component changes no bit, and bad settings or materials stay contained.
 
+#[path = "../common/mod.rs"]
+mod common;
+
 mod bounces_and_springs;
 mod games;
 
@@ -171,17 +174,8 @@ fn a_box_resting_on_a_box_is_answered_from_the_cache_and_retested_when_thrown_si
         enabled: false,
         ..Default::default()
     });
-    let spawn_box = |app: &mut App, z: f32| {
-        app.world_mut()
-            .spawn((
-                Collider::cuboid(0.5, 0.5, 0.5),
-                Position::new(0.0, 0.0, z),
-                Velocity::default(),
-            ))
-            .id()
-    };
-    let lower = spawn_box(&mut app, 0.5);
-    let upper = spawn_box(&mut app, 1.5);
+    let lower = common::crate_box(&mut app, 0.5);
+    let upper = common::crate_box(&mut app, 1.5);
     urto::step(app.world_mut(), 120).unwrap();
     let cached = |app: &App| {
         let stats = app.world().resource::<PhysicsStats>();

@@ -361,12 +361,12 @@ impl Pass<'_> {
 /// `row` held at the joint's anchors at once when it `carries` an impulse into the substep
 /// (the warm start applies it) or drives a motor, else left for the first pass that needs it;
 /// with whether it is left pending.
-fn held_if(row: AxisRow, carries: bool, m: &PairMasses, point: &PointRows) -> (AxisRow, bool) {
+fn held_if(mut row: AxisRow, carries: bool, m: &PairMasses, point: &PointRows) -> (AxisRow, bool) {
+    let mut pending = true;
     if carries {
-        (row.held_at(m, point.anchors, &point.inverse_mass), false)
-    } else {
-        (row, true)
+        hold(&mut row, &mut pending, m, point);
     }
+    (row, pending)
 }
 
 /// Holds `row` at the joint's anchors ([`AxisRow::held_at`]) if its pivot is `pending`.

@@ -36,7 +36,7 @@ impl Vec3x4 {
         z: Lanes::ZERO,
     };
 
-    /// Lane `i` holds `v[i]` (by a 4×4 transpose, as [`Self::transposed`]).
+    /// Lane `i` holds `v[i]` (by a 4×4 transpose, as [`Self::to_vecs`]).
     #[inline]
     pub fn gather(v: [Vec3; LANES]) -> Self {
         let [x, y, z, _] = Lanes::transpose(v.map(|v| Lanes::new([v.x, v.y, v.z, 0.0])));
@@ -52,17 +52,11 @@ impl Vec3x4 {
         )
     }
 
-    /// The four vectors.
-    pub fn to_vecs(self) -> [Vec3; LANES] {
-        let [x, y, z] = [self.x, self.y, self.z].map(Lanes::to_array);
-        std::array::from_fn(|i| Vec3::new(x[i], y[i], z[i]))
-    }
-
-    /// The vector of each lane, by a 4×4 transpose (one shuffle network instead of twelve
-    /// lane extractions: writing the batches' velocities back was a fifth of a pile's contact
+    /// The four vectors, by a 4×4 transpose (one shuffle network instead of twelve lane
+    /// extractions: writing the batches' velocities back was a fifth of a pile's contact
     /// passes).
     #[inline]
-    pub fn transposed(self) -> [Vec3; LANES] {
+    pub fn to_vecs(self) -> [Vec3; LANES] {
         let [a, b, c, d] = Lanes::transpose([self.x, self.y, self.z, Lanes::ZERO]);
         // Written out, not `t.map(..)`: the array map stayed out of line in the passes.
         let vec = |v: Lanes| {
@@ -208,8 +202,8 @@ impl PairVelocities {
         writes: &[[bool; LANES]; 2],
         states: &mut [BodyState],
     ) {
-        let (va, wa) = (self.va.transposed(), self.wa.transposed());
-        let (vb, wb) = (self.vb.transposed(), self.wb.transposed());
+        let (va, wa) = (self.va.to_vecs(), self.wa.to_vecs());
+        let (vb, wb) = (self.vb.to_vecs(), self.wb.to_vecs());
         for lane in 0..LANES {
             if writes[0][lane] {
                 let s = &mut states[bodies[0][lane]];
