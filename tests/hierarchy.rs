@@ -95,7 +95,7 @@ fn assert_bounds_subtree(app: &mut App, root: Entity) {
         let node = bv(app, e);
         let world = app.world();
         if let (Some(c), Some(g)) = (world.get::<Collider>(e), world.get::<GlobalPose>(e)) {
-            let own = c.shape.world_aabb(&g.0);
+            let own = c.shape.world_aabb(&g.pose());
             assert!(
                 node.expanded(1e-4).contains(&own),
                 "{e}: own collider outside its volume"
@@ -144,7 +144,12 @@ fn deep_and_wide_hierarchies_bound_their_descendants_as_they_move() {
         assert_bounds_subtree(&mut app, base);
     }
     assert_bounds_subtree(&mut app, block);
-    let tip = app.world().get::<GlobalPose>(parent).unwrap().0.translation;
+    let tip = app
+        .world()
+        .get::<GlobalPose>(parent)
+        .unwrap()
+        .pose()
+        .translation;
     assert!(bv(&app, base).contains_point(tip));
     assert!(bv(&app, block).extents().x > 999.0);
 }

@@ -41,7 +41,7 @@ fn scanned(name: &str, radius: f32) -> Collider {
 /// The lowest vertex of a body's mesh in the world, at its pose (bodies turn).
 fn lowest_point(world: &World, body: Entity) -> f32 {
     let c = world.get::<Collider>(body).unwrap();
-    let pose = world.get::<GlobalPose>(body).unwrap().0;
+    let pose = world.get::<GlobalPose>(body).unwrap().pose();
     match &c.shape {
         Shape::TriMesh(m) => m
             .mesh()
@@ -159,8 +159,8 @@ fn a_mesh_ball_rolling_on_a_mesh_slab_touches_its_top_within_the_sink_tolerance_
         let world = app.world();
         // Both turn: measure in the slab's frame, the ball's lowest vertex against the slab's
         // top face, and where it lies on it.
-        let slab = world.get::<GlobalPose>(lower).unwrap().0;
-        let ball_pose = world.get::<GlobalPose>(upper).unwrap().0;
+        let slab = world.get::<GlobalPose>(lower).unwrap().pose();
+        let ball_pose = world.get::<GlobalPose>(upper).unwrap().pose();
         let Shape::TriMesh(ball_mesh) = &world.get::<Collider>(upper).unwrap().shape else {
             unreachable!("a mesh ball")
         };

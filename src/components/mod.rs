@@ -263,27 +263,43 @@ impl BoundingVolume {
 }
 
 /// The world pose of a body, derived each substep from [`Position`] and [`Rotation`]: a root's
-/// own, or its parent's world pose composed with its local one. Read it, don't write it.
+/// own, or its parent's world pose composed with its local one. Read-only to games (its field is
+/// the crate's): [`GlobalPose::pose`] reads it, and a game moves a body through its
+/// [`Position`] and [`Rotation`], which the next propagation turns into this.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
-pub struct GlobalPose(pub Isometry);
+pub struct GlobalPose(pub(crate) Isometry);
+
+impl GlobalPose {
+    /// The body's pose in the world, as of the last propagation.
+    pub fn pose(&self) -> Isometry {
+        self.0
+    }
+}
 
 /// Where a node of a compound body was at the start of the step (its [`GlobalPose`] then). A
 /// game turns a robot's joints by setting the parts' local poses; how a part moved relative to
 /// its root this step, divided by the step, is the velocity with which it pushes what it
-/// touches when its root is immovable. Kept by the physics for every node of a hierarchy; read
-/// it, don't write it.
+/// touches when its root is immovable. Kept by the physics for every node of a hierarchy and
+/// read-only to games ([`StepStartPose::pose`]).
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
-pub struct StepStartPose(pub Isometry);
+pub struct StepStartPose(pub(crate) Isometry);
+
+impl StepStartPose {
+    /// The node's world pose when the step began.
+    pub fn pose(&self) -> Isometry {
+        self.0
+    }
+}
 
 /// Continuous collision for a fast body: instead of testing only where the step ends (where a
 /// bullet may already be past a thin wall: tunnelling), the body's motion during the step is
 /// swept against static scenery and it stops at the first impact, then spends the rest of the
 /// step from there. Costs one sweep per step; bodies without it pay nothing.
 ///
-/// The sweep uses the body's bounding sphere (exact for balls), and a body of one convex
-/// collider is then brought on to where its own shape meets the obstacle
-/// ([`toi_shape_from`](crate::ccd::toi_shape_from)); compounds and meshes stop where their
-/// sphere does (early, never tunnelling).
+/// The sweep uses the body's bounding sphere (exact for balls), and a body of convex colliders
+/// (one, or the parts of a compound) is then brought on to where the first of them meets the
+/// obstacle ([`toi_parts_from`](crate::ccd::toi_parts_from)); a body with a mesh among its
+/// colliders stops where its sphere does (early, never tunnelling).
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Ccd;
 

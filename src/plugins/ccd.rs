@@ -6,9 +6,10 @@
 //! size in one substep. For each, the motion the integrator just produced (its centre of mass,
 //! start → end) is swept against the static scenery its swept volume meets ([`crate::ccd`]:
 //! exact time of impact of a sphere about the centre of mass holding the body, against spheres,
-//! boxes, planes and meshes; for a body of one convex collider, refined from there to the
-//! collider's own first contact by conservative advancement, [`toi_shape_from`], so a long thin
-//! body is not stopped where its bounding sphere met the wall). The centre of mass, not the origin, because that is what
+//! boxes, planes and meshes; for a body of convex colliders, one or the parts of a compound,
+//! refined from there to the earliest of the colliders' own first contacts by conservative
+//! advancement, [`toi_parts_from`], so a long thin body or a chair is not stopped where its
+//! bounding sphere met the wall). The centre of mass, not the origin, because that is what
 //! [`Velocity`] moves and what the solver turns the body about: sweeping the origin of a
 //! spinning body whose centre is off it (a cone, a compound) and reflecting the velocity there
 //! moved its centre of mass up to 1.17 × its speed bound in a step (the fuzz scenes). At the first
@@ -24,8 +25,8 @@
 
 use crate::bvh::QueryScratch;
 use crate::ccd::{
-    InitialOverlap, MAX_REFINED_TURN, ShapeOnSweep, SphereSweep, Toi, toi_shape_from,
-    toi_sphere_shape,
+    InitialOverlap, MAX_REFINED_PARTS, MAX_REFINED_TURN, ShapeOnSweep, SphereSweep, Toi,
+    toi_parts_from, toi_sphere_shape,
 };
 use crate::components::*;
 use crate::dynamics::response::reflect;
@@ -252,6 +253,7 @@ fn sweep_fast_bodies(
     let start = Instant::now();
     let dt = timestep.substep_dt();
     let s = &mut *scratch;
+    let mut parts = Vec::new();
     for i in 0..s.starts.len() {
         let SweepStart {
             body,
@@ -275,18 +277,20 @@ fn sweep_fast_bodies(
             // The integrator overflowed: leave the body where it is, for the refit to quarantine.
             continue;
         }
-        // A single convex collider is refined from its sphere's impact to its own (a compound's
-        // sphere also holds its parts, which are not refined; nor is a body spinning so fast
-        // that the slerp between its two orientations may not be the way it turned).
-        let mut refined = own
-            .filter(|o| o.3.is_none() && turn <= MAX_REFINED_TURN)
-            .and_then(|o| o.0)
-            .filter(|c| ShapeOnSweep::worth_refining(&c.shape))
-            .map(|c| ShapeOnSweep {
-                shape: &c.shape,
-                rotations: [rotation, now],
+        // The sphere's impacts are refined to the body's own convex parts (not for a body
+        // spinning so fast that the slerp between its two orientations may not be the way it
+        // turned).
+        parts.clear();
+        if turn <= MAX_REFINED_TURN {
+            parts_on_sweep(
+                body,
+                [rotation, now],
                 local_center,
-            });
+                &obstacles,
+                s,
+                &mut parts,
+            );
+        }
         let free = LockedAxes::of(locked).free_translation_axes();
         let (mut at, mut velocity, mut motion) = (from, v.0, to - from);
         let mut impacted = false;
@@ -301,7 +305,7 @@ fn sweep_fast_bodies(
             let sweep = sweep.with_initial_overlap(InitialOverlap::ApproachingOnly);
             let Some((hit, root, leaf, e_obstacle)) = first_impact(
                 &sweep,
-                (body, layers, jointed, refined.as_ref()),
+                (body, layers, jointed, &parts),
                 &obstacles,
                 &mut index,
                 s,
@@ -320,9 +324,9 @@ fn sweep_fast_bodies(
                 e
             };
             at = sweep.position_at(hit.t);
-            if let Some(shape) = refined.as_mut() {
+            for part in &mut parts {
                 // The next sweep turns on from where this one met the obstacle.
-                shape.rotations[0] = shape.rotation_at(hit.t);
+                part.rotations[0] = part.rotation_at(hit.t);
             }
             impacted = true;
             // A bounce off a tilted surface must not push a body along a locked axis.
@@ -353,22 +357,72 @@ fn sweep_fast_bodies(
     stats.count_run("ccd");
 }
 
+/// The convex colliders of `body` (its own and its descendants', sensors left out) placed in
+/// its frame on its sweep, into `parts`; left empty where refining cannot help: a body that is
+/// one sphere (its sweep is exact), or one with a part that has no finite convex gap (a mesh)
+/// or more than [`MAX_REFINED_PARTS`] parts. Each part's place in the body comes from the two
+/// world poses of the last propagation, which agree with each other.
+fn parts_on_sweep<'q>(
+    body: Entity,
+    rotations: [Quat; 2],
+    local_center: Vec3,
+    obstacles: &'q Query<Obstacle, Without<Quarantined>>,
+    s: &mut CcdScratch,
+    parts: &mut Vec<ShapeOnSweep<'q>>,
+) {
+    let Ok((collider, root, _, children, ..)) = obstacles.get(body) else {
+        return;
+    };
+    if children.is_none() {
+        if let Some(c) = collider.filter(|c| ShapeOnSweep::worth_refining(&c.shape)) {
+            parts.push(ShapeOnSweep {
+                shape: &c.shape,
+                rotations,
+                local_center,
+            });
+        }
+        return;
+    }
+    s.stack.clear();
+    s.stack.push(body);
+    while let Some(node) = s.stack.pop() {
+        let Ok((collider, pose, _, children, _, _, sensor)) = obstacles.get(node) else {
+            continue;
+        };
+        s.stack.extend(children.into_iter().flat_map(|c| c.iter()));
+        let Some(c) = collider.filter(|_| !sensor) else {
+            continue;
+        };
+        if !ShapeOnSweep::has_convex_gap(&c.shape) || parts.len() == MAX_REFINED_PARTS {
+            parts.clear();
+            return;
+        }
+        let in_body = root.0.inv_mul(&pose.0);
+        parts.push(ShapeOnSweep::part(
+            &c.shape,
+            &in_body,
+            rotations,
+            local_center,
+        ));
+    }
+}
+
 /// Motion into a surface already touched at the start of a sweep, as a fraction of the radius,
 /// below which it is rounding (a body sliding along its support), not an impact.
 const TOUCHING_TOLERANCE: f32 = 1e-4;
 
 /// The earliest impact of `sweep` (`body`, with `layers`) with the static scenery its swept
 /// volume meets, its layers interact with and no joint keeps it from colliding with: the hit,
-/// the obstacle's root, the collider hit, and that collider's restitution. With `shape`, each
-/// sphere impact is refined to the shape's own ([`toi_shape_from`]), and one the shape misses
-/// is none.
+/// the obstacle's root, the collider hit, and that collider's restitution. With `parts`, each
+/// sphere impact is refined to the earliest of the parts' own ([`toi_parts_from`]), and one
+/// they all miss is none.
 fn first_impact(
     sweep: &SphereSweep,
-    (body, layers, jointed, shape): (
+    (body, layers, jointed, parts): (
         Entity,
         CollisionLayers,
         Option<&JointedPairs>,
-        Option<&ShapeOnSweep>,
+        &[ShapeOnSweep],
     ),
     obstacles: &Query<Obstacle, Without<Quarantined>>,
     index: &mut BroadPhaseIndex,
@@ -402,14 +456,14 @@ fn first_impact(
             let Some(mut hit) = toi_sphere_shape(sweep, &c.shape, &global.0, &mut s.query) else {
                 continue;
             };
-            if let Some(shape) = shape {
-                // The shape's impact is never earlier than its sphere's: past the best so far,
+            if !parts.is_empty() {
+                // The parts' impact is never earlier than their sphere's: past the best so far,
                 // it cannot win.
                 if best.as_ref().is_some_and(|(b, ..)| b.t <= hit.t) {
                     continue;
                 }
                 let obstacle = (&c.shape, &global.0);
-                match toi_shape_from(sweep, shape, hit, obstacle, &mut s.contacts) {
+                match toi_parts_from(sweep, parts, hit, obstacle, &mut s.contacts) {
                     Some(own) => hit = own,
                     None => continue,
                 }
