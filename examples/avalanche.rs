@@ -1,27 +1,25 @@
-//! An avalanche: a thousand bodies of mixed shapes — spheres, boxes, and small triangle meshes
-//! (low-poly balls and tori) — poured in waves into a static mesh bowl, where they slide down the
-//! slope and pile up.
+//! An avalanche: a thousand bodies of the shapes games use — spheres, boxes, capsules and
+//! convex-hull rocks — poured in waves into a static mesh bowl, where they tumble and roll
+//! down the slope, pile up and fall asleep.
 //!
 //! The bowl is one triangle mesh, built here by revolving a profile (a paraboloid with a flat
 //! rim) around the vertical axis. It is [`Static`], so the broad phase puts it in the uniform
 //! grid (never in the sweep and prune), and every body touching it is tested against its OBB
-//! hierarchy, down to the few triangles under the body. The bodies meet each other through the
-//! incremental sweep and prune; mesh bodies meet boxes, balls and other meshes through their own
-//! hierarchies.
+//! hierarchy, down to the few triangles under the body, with its internal edges removed so that
+//! bodies roll over the seams without bumps. The bodies meet each other through the incremental
+//! sweep and prune, and convex pairs through closed forms (spheres, capsules, boxes) or GJK and
+//! EPA (rocks against anything). Dynamic triangle meshes (`--mesh-bodies`) are the slow way to
+//! model such props: each of their pairs is triangle against triangle.
 //!
 //! ```text
 //! cargo run --release --example avalanche -- --help
 //! rerun avalanche.rrd
 //! ```
 //!
-//! urto's bodies translate only: they keep the orientation they were spawned with (a random one,
-//! so boxes and tori land tilted) and slide rather than roll, Coulomb friction stopping them
-//! where the bowl is flat enough. Every body weighs 1 kg, sparing the contact solver large mass
-//! ratios. With masses by volume
-//! (`--mass-by-volume`, up to 20:1) the deepest overlaps about double: a heavy body landing on a
-//! light one that rests on the bowl rams it into the bowl, and a mesh is a thin two-sided shell,
-//! so a body whose centre gets past it is pushed on through (the report counts bodies below the
-//! surface). Everything the report prints is measured on the simulation.
+//! Bodies are spawned at random orientations and turn on contact; a 1 cm lever arm against
+//! rolling lets balls and capsules come to rest. Every body weighs 1 kg, sparing the contact
+//! solver large mass ratios; `--mass-by-volume` gives each its volume's mass at 600 kg/m³
+//! (ratios up to about 20:1). Everything the report prints is measured on the simulation.
 
 mod support;
 
@@ -31,7 +29,7 @@ use bevy_ecs::prelude::*;
 use clap::Parser;
 use glam::{EulerRot, Quat, Vec2, Vec3};
 use std::error::Error;
-use std::f32::consts::{PI, TAU};
+use std::f32::consts::TAU;
 use support::{Lcg, StepTimer};
 use urto::debug::{DebugColor, RerunConfig, RerunDebugPlugin};
 use urto::geometry::{MeshCollider, TriMesh};
@@ -47,8 +45,8 @@ struct Args {
     /// Waves they come in (one every half second).
     #[arg(long, default_value_t = 10)]
     waves: u32,
-    /// Physics steps (60 per simulated second).
-    #[arg(long, default_value_t = 540)]
+    /// Physics steps (60 per simulated second): the pile falls asleep at about 11 s.
+    #[arg(long, default_value_t = 720)]
     steps: u32,
     /// Substeps per step (with 1, overlaps between bodies triple and now and then a body falls
     /// through the bowl, e.g. with `--seed 1`).
@@ -60,6 +58,10 @@ struct Args {
     /// Give each body a mass by its volume (600 kg/m³) instead of 1 kg.
     #[arg(long)]
     mass_by_volume: bool,
+    /// Make the rocks' share of bodies low-poly triangle meshes (balls and tori) instead, as
+    /// this example did before convex shapes: slower, and the pile keeps jittering.
+    #[arg(long)]
+    mesh_bodies: bool,
     #[command(flatten)]
     recording: support::RecordingArgs,
 }
@@ -113,11 +115,13 @@ fn bowl_mesh() -> Result<MeshCollider, Box<dyn Error>> {
     )?)
 }
 
-/// The four kinds of body, coloured apart in the recording.
+/// The kinds of body, coloured apart in the recording.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 enum Kind {
     Sphere,
     Box,
+    Capsule,
+    Rock,
     MeshBall,
     MeshTorus,
 }
@@ -127,66 +131,77 @@ impl Kind {
         DebugColor(match self {
             Kind::Sphere => [231, 111, 81],
             Kind::Box => [42, 157, 143],
-            Kind::MeshBall => [233, 196, 106],
+            Kind::Capsule => [38, 70, 83],
+            Kind::Rock => [233, 196, 106],
+            Kind::MeshBall => [244, 162, 97],
             Kind::MeshTorus => [131, 56, 236],
         })
     }
 }
 
-/// A body to spawn: its kind, collider and volume (m³).
-type Body = (Kind, Collider, f32);
+/// A body to spawn: its kind and collider.
+type Body = (Kind, Collider);
 
-/// The small meshes bodies share (a handle each: the hierarchy is built once per mesh), with
-/// their volumes.
+/// The small meshes `--mesh-bodies` shares between bodies (a handle each: the hierarchy is built
+/// once per mesh).
 struct BodyMeshes {
-    balls: Vec<(MeshCollider, f32)>,
-    tori: Vec<(MeshCollider, f32)>,
+    balls: Vec<MeshCollider>,
+    tori: Vec<MeshCollider>,
 }
 
 impl BodyMeshes {
     /// Low-poly balls (36 triangles) and tori (64 triangles), two sizes each: mesh–mesh tests
     /// cost per pair of triangles, so a thousand-body pile wants coarse meshes.
     fn new() -> Result<Self, Box<dyn Error>> {
-        let ball = |r: f32| -> Result<(MeshCollider, f32), Box<dyn Error>> {
-            let mesh = MeshCollider::named("ball", TriMesh::uv_sphere(r, 6, 4)?)?;
-            Ok((mesh, 4.0 / 3.0 * PI * r.powi(3)))
-        };
-        let torus = |r: f32, t: f32| -> Result<(MeshCollider, f32), Box<dyn Error>> {
-            let mesh = MeshCollider::named("torus", TriMesh::torus(r, t, 8, 4)?)?;
-            Ok((mesh, 2.0 * PI * PI * r * t * t))
-        };
+        let ball = |r: f32| MeshCollider::named("ball", TriMesh::uv_sphere(r, 6, 4)?);
+        let torus = |r: f32, t: f32| MeshCollider::named("torus", TriMesh::torus(r, t, 8, 4)?);
         Ok(Self {
             balls: vec![ball(0.26)?, ball(0.36)?],
             tori: vec![torus(0.24, 0.09)?, torus(0.32, 0.11)?],
         })
     }
+}
 
-    /// A random body: 45% spheres, 40% boxes, 15% meshes, sizes varied.
-    fn pick(&self, rng: &mut Lcg) -> Body {
-        let roll = rng.next();
-        if roll < 0.45 {
-            sphere(rng.range(0.18, 0.4))
-        } else if roll < 0.85 {
-            let [x, y, z] = [0; 3].map(|_| rng.range(0.12, 0.26));
-            (Kind::Box, Collider::cuboid(x, y, z), 8.0 * x * y * z)
+/// A random body: 35% spheres, 30% boxes, 15% capsules and 20% rocks (with `meshes`, the rocks'
+/// share is mesh balls and tori instead), sizes varied, none reaching more than 0.45 m from its
+/// centre.
+fn pick(rng: &mut Lcg, meshes: Option<&BodyMeshes>) -> Result<Body, Box<dyn Error>> {
+    let roll = rng.next();
+    Ok(if roll < 0.35 {
+        sphere(rng.range(0.18, 0.4))
+    } else if roll < 0.65 {
+        let [x, y, z] = [0; 3].map(|_| rng.range(0.12, 0.26));
+        (Kind::Box, Collider::cuboid(x, y, z))
+    } else if roll < 0.8 {
+        let (half_length, radius) = (rng.range(0.1, 0.25), rng.range(0.08, 0.18));
+        (Kind::Capsule, Collider::capsule(half_length, radius))
+    } else if let Some(meshes) = meshes {
+        let (kind, list) = if roll < 0.9 {
+            (Kind::MeshBall, &meshes.balls)
         } else {
-            let (kind, list) = if roll < 0.93 {
-                (Kind::MeshBall, &self.balls)
-            } else {
-                (Kind::MeshTorus, &self.tori)
-            };
-            let (mesh, volume) = &list[rng.below(list.len())];
-            (kind, Collider::mesh(mesh.clone()), *volume)
-        }
-    }
+            (Kind::MeshTorus, &meshes.tori)
+        };
+        (kind, Collider::mesh(list[rng.below(list.len())].clone()))
+    } else {
+        (Kind::Rock, rock(rng)?)
+    })
+}
+
+/// A rock: the convex hull of 14 points scattered on an ellipsoid of semi-axes 0.18–0.36 m.
+fn rock(rng: &mut Lcg) -> Result<Collider, Box<dyn Error>> {
+    let axes = Vec3::from_array([0; 3].map(|_| rng.range(0.18, 0.36)));
+    let points: Vec<Vec3> = (0..14)
+        .map(|_| {
+            let (z, angle) = (rng.range(-1.0, 1.0), rng.range(0.0, TAU));
+            let ring = (1.0 - z * z).sqrt();
+            Vec3::new(ring * angle.cos(), ring * angle.sin(), z) * axes
+        })
+        .collect();
+    Ok(Collider::convex_hull(&points)?)
 }
 
 fn sphere(r: f32) -> Body {
-    (
-        Kind::Sphere,
-        Collider::sphere(r),
-        4.0 / 3.0 * PI * r.powi(3),
-    )
+    (Kind::Sphere, Collider::sphere(r))
 }
 
 fn main() -> Result<(), Box<dyn Error>> {
@@ -217,7 +232,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     let (mut tally, mut timer) = (Tally::default(), StepTimer::start());
     for step in 0..args.steps {
         if step % WAVE_EVERY == 0 {
-            pour.next_wave(&mut app);
+            pour.next_wave(&mut app)?;
         }
         urto::step(app.world_mut(), 1)?;
         timer.add(&app);
@@ -227,10 +242,11 @@ fn main() -> Result<(), Box<dyn Error>> {
     Ok(())
 }
 
-/// The pour: blocks of bodies released above the bowl's wall, each wave from a spout turned a
-/// fifth of a turn from the last, so the waves land on different sides and slide to the middle.
+/// The pour: blocks of bodies released above the bowl's wall, each wave from a spout turned two
+/// fifths of a turn from the last (clear of the last wave, still falling), so the waves land on
+/// different sides and slide to the middle.
 struct Pour {
-    meshes: BodyMeshes,
+    meshes: Option<BodyMeshes>,
     rng: Lcg,
     per_wave: u32,
     left: u32,
@@ -242,7 +258,7 @@ struct Pour {
 impl Pour {
     fn new(args: &Args) -> Result<Self, Box<dyn Error>> {
         Ok(Self {
-            meshes: BodyMeshes::new()?,
+            meshes: args.mesh_bodies.then(BodyMeshes::new).transpose()?,
             rng: Lcg::new(args.seed),
             per_wave: args.bodies.div_ceil(args.waves.max(1)),
             left: args.bodies,
@@ -256,20 +272,20 @@ impl Pour {
     /// takes, its bottom 1.5 m above the rim, thrown at 2 m/s down and towards the axis. Each
     /// body is turned at random; the last (top layer) is a sphere labelled with its wave's
     /// number, to show in the recording where each wave ended up.
-    fn next_wave(&mut self, app: &mut App) {
+    fn next_wave(&mut self, app: &mut App) -> Result<(), Box<dyn Error>> {
         let count = self.per_wave.min(self.left);
         if count == 0 {
-            return;
+            return Ok(());
         }
-        let spout = Vec2::from_angle(self.waves as f32 * TAU / 5.0) * 0.55 * BOWL_RADIUS;
+        let spout = Vec2::from_angle(self.waves as f32 * 2.0 * TAU / 5.0) * 0.55 * BOWL_RADIUS;
         let throw = (-spout.normalize()).extend(-1.7).normalize() * 2.0;
         let world = app.world_mut();
         for k in 0..count {
             let last = k + 1 == count;
-            let (kind, collider, volume) = if last {
+            let (kind, collider) = if last {
                 sphere(0.3)
             } else {
-                self.meshes.pick(&mut self.rng)
+                pick(&mut self.rng, self.meshes.as_ref())?
             };
             let cell = Vec3::new(
                 (k % 5) as f32 - 2.0,
@@ -280,7 +296,7 @@ impl Pour {
             let at = spout.extend(BOWL_DEPTH + 1.5) + cell * SPACING + jitter.extend(0.0);
             let turn = [0; 3].map(|_| self.rng.range(0.0, TAU));
             let mass = if self.mass_by_volume {
-                600.0 * volume
+                collider.shape.mass_properties(600.0).mass
             } else {
                 1.0
             };
@@ -301,6 +317,7 @@ impl Pour {
         }
         self.left -= count;
         self.waves += 1;
+        Ok(())
     }
 }
 
@@ -363,10 +380,12 @@ impl Tally {
         let stats = world.resource::<PhysicsStats>();
         let n = |kind| pour.bodies.iter().filter(|(_, k)| *k == kind).count();
         println!(
-            "avalanche: {} bodies ({} spheres, {} boxes, {} mesh balls, {} mesh tori) poured in {} waves into a {triangles}-triangle static mesh bowl, {} steps of {} substeps ({:.1} s simulated)",
+            "avalanche: {} bodies ({} spheres, {} boxes, {} capsules, {} rocks, {} mesh balls, {} mesh tori) poured in {} waves into a {triangles}-triangle static mesh bowl, {} steps of {} substeps ({:.1} s simulated)",
             pour.bodies.len(),
             n(Kind::Sphere),
             n(Kind::Box),
+            n(Kind::Capsule),
+            n(Kind::Rock),
             n(Kind::MeshBall),
             n(Kind::MeshTorus),
             pour.waves,

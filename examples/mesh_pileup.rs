@@ -1,22 +1,23 @@
-//! Triangle meshes piling up on a mesh floor: UV spheres, boxes and tori made procedurally, and
-//! the ant and the nut loaded from `examples/assets/` (PLY files from PyVista's example data,
-//! MIT licence, see `examples/assets/LICENSE-pyvista.txt`), dropped in columns onto a gently
-//! bumpy height-field floor. Every contact goes through the meshes' OBB hierarchies; the
-//! recording shows the meshes, the first levels of each hierarchy, and the leaves through which
-//! meshes touch.
+//! Triangle meshes and convex shapes piling up on a mesh floor: the ant and the nut loaded from
+//! `examples/assets/` (PLY files from PyVista's example data, MIT licence, see
+//! `examples/assets/LICENSE-pyvista.txt`) and a procedural torus as triangle meshes (none of
+//! them convex), next to the convex shapes a game would use for props: the ant's convex hull, a
+//! capsule and a box, dropped in columns onto a gently bumpy height-field floor. Mesh contacts
+//! go through the meshes' OBB hierarchies (triangle pairs within the contact margin); convex
+//! pairs through GJK and EPA or closed forms, and convex bodies meet the floor triangle by
+//! triangle with its internal edges removed. The recording shows the bodies, the first levels
+//! of each hierarchy, and the leaves through which meshes touch.
 //!
 //! ```text
 //! cargo run --release --example mesh_pileup -- --help
 //! rerun mesh_pileup.rrd
 //! ```
 //!
-//! Bodies translate only (urto's response has no rotation yet) and slide without friction: a
-//! linear drag stands in for friction so the pile settles, and the floor is a shallow bowl so
-//! nothing slides off its edge.
+//! Bodies tumble and rub with the default friction; a 1 cm lever arm against rolling lets them
+//! come to rest, and the floor is a shallow bowl so that nothing rolls off its edge.
 
 use bevy_app::App;
 use clap::Parser;
-use glam::Vec3;
 use std::error::Error;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -59,19 +60,26 @@ fn normalized(mesh: TriMesh, size: f32) -> Result<TriMesh, Box<dyn Error>> {
     Ok(TriMesh::new(vertices, mesh.triangles().to_vec())?)
 }
 
-/// The shapes that fall, each built once and shared by all the bodies using it.
-fn body_meshes() -> Result<Vec<MeshCollider>, Box<dyn Error>> {
+/// The shapes that fall, each built once and shared by all the bodies using it: three
+/// triangle meshes, then three convex shapes.
+fn body_shapes() -> Result<Vec<Collider>, Box<dyn Error>> {
     let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/assets");
     let load = |name: &str, size: f32| -> Result<MeshCollider, Box<dyn Error>> {
         let mesh = urto::geometry::mesh_io::load(assets.join(format!("{name}.ply")))?;
         Ok(MeshCollider::named(name, normalized(mesh, size)?)?)
     };
+    let ant = load("ant", 0.9)?;
+    let ant_hull = Collider::convex_hull(ant.mesh().vertices())?;
     Ok(vec![
-        MeshCollider::named("sphere", TriMesh::uv_sphere(0.35, 24, 12)?)?,
-        MeshCollider::named("box", TriMesh::cuboid(Vec3::new(0.4, 0.3, 0.2))?)?,
-        MeshCollider::named("torus", TriMesh::torus(0.35, 0.12, 32, 12)?)?,
-        load("ant", 0.9)?,
-        load("nut", 0.7)?,
+        Collider::mesh(ant),
+        Collider::mesh(load("nut", 0.7)?),
+        Collider::mesh(MeshCollider::named(
+            "torus",
+            TriMesh::torus(0.35, 0.12, 32, 12)?,
+        )?),
+        ant_hull,
+        Collider::capsule(0.25, 0.15),
+        Collider::cuboid(0.4, 0.3, 0.2),
     ])
 }
 
@@ -110,8 +118,8 @@ fn main() -> Result<(), Box<dyn Error>> {
             ..Default::default()
         });
     let world = app.world_mut();
-    world.spawn((Collider::mesh(floor()?), Static));
-    let meshes = body_meshes()?;
+    let floor_body = world.spawn((Collider::mesh(floor()?), Static)).id();
+    let shapes = body_shapes()?;
     // Columns on a 3 × 3 grid; each new body of a column falls from higher up, a little off the
     // column's axis so the pile does not stack perfectly.
     let mut bodies = Vec::new();
@@ -119,7 +127,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         let (column, level) = (i % 9, i / 9);
         let (cx, cy) = ((column % 3) as f32 - 1.0, (column / 3) as f32 - 1.0);
         let wobble = 0.15 * ((i * 7 % 5) as f32 - 2.0) / 2.0;
-        let mesh = meshes[i as usize % meshes.len()].clone();
+        let collider = shapes[i as usize % shapes.len()].clone();
         let position = Position::new(
             1.1 * cx + wobble,
             1.1 * cy - wobble,
@@ -128,10 +136,9 @@ fn main() -> Result<(), Box<dyn Error>> {
         bodies.push(
             world
                 .spawn((
-                    Collider::mesh(mesh),
+                    collider,
                     position,
                     Velocity::default(),
-                    LinearDrag(0.8),
                     RollingResistance(0.01),
                 ))
                 .id(),
@@ -165,12 +172,19 @@ fn main() -> Result<(), Box<dyn Error>> {
 
     let world = app.world();
     let stats = world.resource::<PhysicsStats>();
-    let triangles: usize = meshes.iter().map(|m| m.mesh().triangle_count()).sum();
+    let meshes: Vec<_> = shapes
+        .iter()
+        .filter_map(|c| match &c.shape {
+            Shape::TriMesh(m) => Some(m.mesh().triangle_count()),
+            _ => None,
+        })
+        .collect();
     println!(
-        "mesh_pileup: {} bodies ({} distinct meshes, {} triangles) on a {}-triangle floor, {} steps ({:.1} s simulated)",
+        "mesh_pileup: {} bodies ({} distinct meshes of {} triangles, {} convex shapes) on a {}-triangle floor, {} steps ({:.1} s simulated)",
         args.bodies,
         meshes.len(),
-        triangles,
+        meshes.iter().sum::<usize>(),
+        shapes.len() - meshes.len(),
         floor()?.mesh().triangle_count(),
         stats.step,
         stats.sim_time
@@ -210,7 +224,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         };
         if let Shape::TriMesh(m) = &c.shape {
             for v in m.mesh().vertices() {
-                let w = pose.0.transform_point(*v);
+                let w = pose.pose().transform_point(*v);
                 sunk = sunk.max(floor_height(w.x, w.y) - w.z);
             }
         }
@@ -218,9 +232,19 @@ fn main() -> Result<(), Box<dyn Error>> {
         asleep += usize::from(world.get::<Sleeping>(b).is_some());
         bad += usize::from(!p.0.is_finite() || world.get::<Quarantined>(b).is_some());
     }
+    // Convex bodies: the deepest of their contacts with the floor in the last step.
+    let floor_depth = world
+        .resource::<urto::plugins::Contacts>()
+        .pairs
+        .iter()
+        .filter(|c| c.a == floor_body || c.b == floor_body)
+        .map(|c| c.manifold.max_depth())
+        .fold(0.0f32, f32::max);
     println!(
-        "  at the end: deepest vertex {:.1} mm below the floor, fastest body {fastest:.2} m/s, {asleep} asleep, {bad} NaN or quarantined",
-        sunk * 1e3
+        "  at the end: deepest mesh vertex {:.1} mm below the floor, deepest floor contact {:.1} mm, fastest body {fastest:.2} m/s, {asleep} of {} asleep, {bad} NaN or quarantined",
+        sunk * 1e3,
+        floor_depth * 1e3,
+        bodies.len()
     );
     println!(
         "  recording: {}  (open it with `rerun {}`)",
