@@ -10,6 +10,7 @@ use bevy_ecs::prelude::*;
 use common::rng::Rng;
 use glam::Vec3;
 use std::collections::BTreeSet;
+use urto::geometry::Shape;
 use urto::plugins::{BroadPhasePairs, ResponsePlugin};
 use urto::prelude::*;
 
@@ -261,19 +262,46 @@ fn reported_pairs(app: &mut bevy_app::App) -> BTreeSet<(Entity, Entity)> {
     set
 }
 
+/// Every pair of a moving body with a body whose volume its own meets; a half-space (an
+/// infinite volume) only where the body's volume has a corner below its plane.
 fn brute_force_pairs(app: &mut bevy_app::App) -> BTreeSet<(Entity, Entity)> {
-    let mut q = app.world_mut().query_filtered::<
-        (Entity, &BoundingVolume, Has<Velocity>, Has<Static>),
-        (With<Collider>, Without<Quarantined>),
-    >();
+    let mut q = app.world_mut().query_filtered::<(
+        Entity,
+        &BoundingVolume,
+        &Collider,
+        &GlobalPose,
+        Has<Velocity>,
+        Has<Static>,
+    ), Without<Quarantined>>();
     let bodies: Vec<_> = q
         .iter(app.world())
-        .map(|(e, b, v, s)| (e, b.0, v && !s))
+        .map(|(e, b, c, g, v, s)| {
+            let plane = match &c.shape {
+                Shape::HalfSpace(h) => Some((g.pose().rotation * h.normal, g.pose().translation)),
+                _ => None,
+            };
+            (e, b.0, v && !s, plane)
+        })
         .collect();
+    let below = |(n, at): (Vec3, Vec3), b: &urto::bounding::Aabb| {
+        (0..8).any(|k| {
+            let corner = Vec3::select(
+                glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0),
+                b.max,
+                b.min,
+            );
+            n.dot(corner - at) <= 0.0
+        })
+    };
     let mut set = BTreeSet::new();
-    for (i, (a, ba, ma)) in bodies.iter().enumerate() {
-        for (b, bb, mb) in &bodies[i + 1..] {
-            if (*ma || *mb) && ba.intersects(bb) {
+    for (i, (a, ba, ma, pa)) in bodies.iter().enumerate() {
+        for (b, bb, mb, pb) in &bodies[i + 1..] {
+            let meet = match (pa, pb) {
+                (Some(p), None) => below(*p, bb),
+                (None, Some(p)) => below(*p, ba),
+                _ => ba.intersects(bb),
+            };
+            if (*ma || *mb) && meet {
                 set.insert(((*a).min(*b), (*a).max(*b)));
             }
         }
@@ -584,4 +612,42 @@ fn a_compound_reports_the_part_that_hit_and_both_sides_see_one_contact_normal_wi
         (c.impact_speed, c.normal_impulse),
         (w.impact_speed, w.normal_impulse)
     );
+}
+
+#[test]
+fn in_a_box_of_six_planes_a_ball_pairs_only_with_the_planes_its_grown_volume_reaches_0_1_or_2() {
+    // A 10 m box of half-spaces (each wall's solid outside it) and, without gravity, a ball of
+    // radius 0.5 in the middle, one 1 cm from the +x wall (within its 2 cm margin), one in the
+    // corner of +x and +y.
+    // Pairing every ball with every plane made 18 pairs; a wall pairs with a ball only where
+    // the ball's volume, grown by its speculative margin, reaches it.
+    let mut app = common::app();
+    app.insert_resource(Gravity::new(Vec3::ZERO).unwrap());
+    let mut walls = Vec::new();
+    for n in [Vec3::X, Vec3::Y, Vec3::Z, -Vec3::X, -Vec3::Y, -Vec3::Z] {
+        let wall = app
+            .world_mut()
+            .spawn((Collider::half_space(n), Position(-5.0 * n), Static))
+            .id();
+        walls.push(wall);
+    }
+    let middle = common::ball(&mut app, Vec3::ZERO);
+    let at_wall = common::ball(&mut app, Vec3::new(4.49, 0.0, 0.0));
+    let in_corner = common::ball(&mut app, Vec3::new(4.49, 4.49, 0.0));
+    urto::step(app.world_mut(), 1).unwrap();
+    let pairs = &app.world().resource::<BroadPhasePairs>().pairs;
+    let planes_of = |ball: Entity| {
+        pairs
+            .iter()
+            .filter(|(a, b)| *a == ball && walls.contains(b))
+            .count()
+    };
+    assert_eq!(planes_of(middle), 0);
+    assert_eq!(planes_of(at_wall), 1);
+    assert_eq!(planes_of(in_corner), 2);
+    // The ones it reaches are still met: the balls touch nothing yet, and nothing moved.
+    for ball in [middle, at_wall, in_corner] {
+        let v = app.world().get::<Velocity>(ball).unwrap().0;
+        assert!(v.length() < 1e-6, "{v}");
+    }
 }

@@ -7,7 +7,10 @@
 //!   changed, so bodies at rest cost nothing.
 //! - Bounded static scenery is in a hashed uniform grid (the slides' "object vs static scene"):
 //!   indexed once, queried with each moving body's volume; statics never enter the sort.
-//! - Unbounded scenery (grounds, walls) is paired with every moving body.
+//! - Unbounded scenery (grounds, walls) is paired with every moving body whose volume reaches
+//!   it: a half-space only with the bodies whose grown volume has a corner below its plane (a
+//!   ball in the middle of a box of six planes is paired with the floor alone), anything else
+//!   unbounded with every moving body.
 //! - Sleeping bodies stay indexed where they are but are paired with nothing (neither scenery
 //!   nor other sleepers) until they wake: the plugin hears of each body falling asleep or
 //!   waking from the [`Sleeping`] marker's hooks, so a sleeping pile costs no pass here.
@@ -27,6 +30,7 @@ use crate::broad_phase::{
     AdaptiveSweep, BodyKind, BroadPhase, ProxyId, StaticGrid, StaticGridConfig,
 };
 use crate::components::*;
+use crate::geometry::{Isometry, Shape};
 use crate::plugins::core::PrepareIndex;
 use crate::plugins::hierarchy::HierarchyInstalled;
 use crate::plugins::proxy_table::{Proxy, ProxyTable};
@@ -37,6 +41,7 @@ use crate::schedule::{BroadPhaseSystems, PhysicsSchedule, SubstepSchedule};
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
+use glam::Vec3;
 use std::time::Instant;
 
 /// Makes a fresh moving-body broad phase.
@@ -75,6 +80,36 @@ pub struct BroadPhasePairs {
     pub pairs: Vec<(Entity, Entity)>,
 }
 
+/// An unbounded static half-space (a ground, a wall) in world space: the points `x` with
+/// `normal·x <= offset` are inside it.
+#[derive(Clone, Copy, Debug)]
+struct WorldPlane {
+    normal: Vec3,
+    offset: f32,
+}
+
+impl WorldPlane {
+    /// The plane of a half-space collider at `pose`; `None` for any other shape.
+    fn of(shape: &Shape, pose: &Isometry) -> Option<Self> {
+        let Shape::HalfSpace(h) = shape else {
+            return None;
+        };
+        let normal = pose.rotation * h.normal;
+        Some(Self {
+            normal,
+            offset: normal.dot(pose.translation),
+        })
+    }
+
+    /// Whether some point of `aabb` lies inside the half-space (its lowest corner along the
+    /// normal is at or below the plane). A NaN plane or box reaches (the pair is left to the
+    /// narrow phase, as before).
+    fn reaches(&self, aabb: &Aabb) -> bool {
+        let lowest = self.normal.dot(aabb.center()) - self.normal.abs().dot(aabb.half_extents());
+        lowest.partial_cmp(&self.offset) != Some(std::cmp::Ordering::Greater)
+    }
+}
+
 /// The broad-phase structures and the entity ↔ id table.
 #[derive(Resource)]
 pub struct BroadPhaseIndex {
@@ -85,6 +120,9 @@ pub struct BroadPhaseIndex {
     static_batch: Vec<(ProxyId, Aabb)>,
     moving_batch: Vec<(ProxyId, Aabb, BodyKind)>,
     hits: Vec<u32>,
+    /// The world planes of the unbounded statics that are half-spaces (in their order),
+    /// taken each substep.
+    planes: Vec<Option<WorldPlane>>,
     /// Made since the last sync (first step, or made again after game code removed it): every
     /// root is indexed, not only the changed ones.
     fresh: bool,
@@ -103,6 +141,7 @@ impl BroadPhaseIndex {
             static_batch: Vec::new(),
             moving_batch: Vec::new(),
             hits: Vec::new(),
+            planes: Vec::new(),
             fresh: true,
         }
     }
@@ -337,15 +376,24 @@ impl BroadPhaseIndex {
 }
 
 /// Moving–moving pairs from the sweep and prune, then each moving body against the statics its
-/// volume's grid cells list, then against every unbounded collider.
+/// volume's grid cells list, then against the unbounded colliders its volume reaches.
 fn find_candidate_pairs(
     mut index: ResMut<BroadPhaseIndex>,
     mut out: ResMut<BroadPhasePairs>,
     mut stats: ResMut<PhysicsStats>,
+    planes: Query<(&Collider, &GlobalPose), Without<Children>>,
 ) {
     let start = Instant::now();
     let index = &mut *index;
     out.pairs.clear();
+    index.planes.clear();
+    let world_plane = |&e: &Entity| {
+        let (c, pose) = planes.get(e).ok()?;
+        WorldPlane::of(&c.shape, &pose.0)
+    };
+    index
+        .planes
+        .extend(index.proxies.unbounded().iter().map(world_plane));
     let proxies = &index.proxies;
     // Two sleeping bodies at rest against each other need no test until one wakes.
     out.pairs.extend(
@@ -371,8 +419,14 @@ fn find_candidate_pairs(
                 out.pairs
                     .extend(index.hits.iter().map(|&s| (e, proxies.entity(s))));
             }
-            out.pairs
-                .extend(proxies.unbounded().iter().map(|&u| (e, u)));
+            // A half-space pairs only with the bodies whose volume (grown by their margin)
+            // reaches below its plane: the walls of a box of planes, not every wall.
+            let unbounded = proxies.unbounded().iter().zip(&index.planes);
+            out.pairs.extend(
+                unbounded
+                    .filter(|(_, plane)| plane.is_none_or(|p| p.reaches(&aabb)))
+                    .map(|(&u, _)| (e, u)),
+            );
         }
     }
     stats.set_counter("broad_phase/pairs", moving_pairs as f64);
