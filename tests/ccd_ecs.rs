@@ -378,6 +378,56 @@ fn a_compound_of_a_box_a_ball_and_a_cylinder_flying_broadside_stops_at_the_wall_
     }
 }
 
+/// How far (the root's x) a compound of a 0.2 m box with `child` at y = 0.9 gets, flying
+/// broadside at 120 m/s towards the wall whose face is at x = 9.95.
+fn compound_reach(child: impl Bundle) -> f32 {
+    let mut app = common::app();
+    app.world_mut().spawn((
+        Collider::cuboid(0.05, 5.0, 5.0),
+        Position(Vec3::new(10.0, 0.0, 0.0)),
+        Static,
+        Restitution(0.0),
+    ));
+    let body = app
+        .world_mut()
+        .spawn((
+            Collider::cuboid(0.1, 0.3, 0.1),
+            Position(Vec3::ZERO),
+            Velocity(Vec3::new(120.0, 0.0, 0.0)),
+            Restitution(0.0),
+            Ccd,
+        ))
+        .id();
+    app.world_mut().spawn((child, ChildOf(body)));
+    let mut farthest = f32::MIN;
+    for _ in 0..8 {
+        urto::step(app.world_mut(), 1).unwrap();
+        farthest = farthest.max(app.world().get::<Position>(body).unwrap().0.x);
+    }
+    farthest
+}
+
+#[test]
+fn a_compound_with_a_mesh_part_stops_at_its_sphere_and_a_sensor_part_stops_nothing() {
+    // A mesh part has no convex gap to advance on: the body stops where its sphere (radius
+    // about 1) met the wall, a metre short of 9.85, early as before. A sensor ball reaching
+    // 0.4 m ahead of the body is no part of its shape: it touches first, and the body still
+    // gets to 9.85.
+    let mesh = Collider::trimesh(TriMesh::cuboid(Vec3::splat(0.1)).unwrap()).unwrap();
+    let with_mesh = compound_reach((mesh, Position(Vec3::new(0.0, 0.9, 0.0))));
+    assert!(with_mesh < 9.0, "with a mesh part it got to {with_mesh}");
+    let sensor = (
+        Collider::sphere(0.3),
+        Position(Vec3::new(0.2, 0.9, 0.0)),
+        Sensor,
+    );
+    let with_sensor = compound_reach(sensor);
+    assert!(
+        with_sensor <= 9.85 + 1e-3 && with_sensor > 9.85 - 1e-3,
+        "with a sensor part it got to {with_sensor}"
+    );
+}
+
 #[test]
 fn a_translation_locked_bullet_bounces_off_a_tilted_wall_without_leaving_its_axis() {
     // A ball free along x only hits, at 150 m/s, a wall turned 30° about z: the bounce's

@@ -244,3 +244,44 @@ fn every_one_of_the_17_plugins_can_be_disabled_and_a_busy_scene_steps_without_a_
         }
     }
 }
+
+#[test]
+fn in_a_box_of_six_planes_a_ball_pairs_only_with_the_planes_its_grown_volume_reaches_0_1_or_2() {
+    // A wall a body does not reach costs it no narrow-phase pair. A 10 m box of half-spaces (each wall's solid outside it) and, without gravity, a ball of
+    // radius 0.5 in the middle, one 1 cm from the +x wall (within its 2 cm margin), one in the
+    // corner of +x and +y.
+    // Pairing every ball with every plane made 18 pairs; a wall pairs with a ball only where
+    // the ball's volume, grown by its speculative margin, reaches it.
+    let mut app = common::app();
+    app.insert_resource(Gravity::new(Vec3::ZERO).unwrap());
+    let mut walls = Vec::new();
+    for n in [Vec3::X, Vec3::Y, Vec3::Z, -Vec3::X, -Vec3::Y, -Vec3::Z] {
+        let wall = app
+            .world_mut()
+            .spawn((Collider::half_space(n), Position(-5.0 * n), Static))
+            .id();
+        walls.push(wall);
+    }
+    let middle = common::ball(&mut app, Vec3::ZERO);
+    let at_wall = common::ball(&mut app, Vec3::new(4.49, 0.0, 0.0));
+    let in_corner = common::ball(&mut app, Vec3::new(4.49, 4.49, 0.0));
+    urto::step(app.world_mut(), 1).unwrap();
+    let pairs = &app
+        .world()
+        .resource::<urto::plugins::BroadPhasePairs>()
+        .pairs;
+    let planes_of = |ball: bevy_ecs::entity::Entity| {
+        pairs
+            .iter()
+            .filter(|(a, b)| *a == ball && walls.contains(b))
+            .count()
+    };
+    assert_eq!(planes_of(middle), 0);
+    assert_eq!(planes_of(at_wall), 1);
+    assert_eq!(planes_of(in_corner), 2);
+    // The ones it reaches are still met: the balls touch nothing yet, and nothing moved.
+    for ball in [middle, at_wall, in_corner] {
+        let v = app.world().get::<Velocity>(ball).unwrap().0;
+        assert!(v.length() < 1e-6, "{v}");
+    }
+}

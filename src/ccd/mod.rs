@@ -7,7 +7,8 @@
 //! sphere, which is conservative whatever it turns); the obstacle is static (two moving spheres
 //! use their relative motion). Every query answers: the first fraction `t ∈ [0, 1]` of `d` at
 //! which the sphere touches the obstacle, or `None`. [`toi_shape_from`] then brings a convex
-//! body on from its sphere's impact to its own, turning as it goes (conservative advancement).
+//! body on from its sphere's impact to its own, turning as it goes (conservative advancement),
+//! and [`toi_parts_from`] a compound of convex parts to the first of theirs.
 //!
 //! # How each TOI is found
 //!

@@ -265,7 +265,8 @@ impl BoundingVolume {
 /// The world pose of a body, derived each substep from [`Position`] and [`Rotation`]: a root's
 /// own, or its parent's world pose composed with its local one. Read-only to games (its field is
 /// the crate's): [`GlobalPose::pose`] reads it, and a game moves a body through its
-/// [`Position`] and [`Rotation`], which the next propagation turns into this.
+/// [`Position`] and [`Rotation`], which the next propagation turns into this
+/// ([`GlobalPose::propagated`] is for a stage that replaces the propagation).
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 pub struct GlobalPose(pub(crate) Isometry);
 
@@ -273,6 +274,14 @@ impl GlobalPose {
     /// The body's pose in the world, as of the last propagation.
     pub fn pose(&self) -> Isometry {
         self.0
+    }
+
+    /// A world pose as the propagation writes it: only for a stage that replaces
+    /// [`HierarchyPlugin`](crate::plugins::HierarchyPlugin)'s (game code moves bodies through
+    /// [`Position`] and [`Rotation`]; a pose written here by anything else is overwritten at
+    /// the next propagation).
+    pub fn propagated(pose: Isometry) -> Self {
+        Self(pose)
     }
 }
 

@@ -110,6 +110,25 @@ impl WorldPlane {
     }
 }
 
+/// Whether a node among `children` or below them has a collider (`stack`: scratch; a deep
+/// `ChildOf` chain is walked without recursion).
+fn has_collider_below(
+    children: &Children,
+    nodes: &Query<(Has<Collider>, Option<&Children>)>,
+    stack: &mut Vec<Entity>,
+) -> bool {
+    stack.clear();
+    stack.extend(children.iter());
+    while let Some(node) = stack.pop() {
+        match nodes.get(node) {
+            Ok((true, _)) => return true,
+            Ok((false, Some(below))) => stack.extend(below.iter()),
+            _ => {}
+        }
+    }
+    false
+}
+
 /// The broad-phase structures and the entity ↔ id table.
 #[derive(Resource)]
 pub struct BroadPhaseIndex {
@@ -243,7 +262,7 @@ fn sync_broad_phase(
         log::warn!(
             "urto: no HierarchyPlugin: poses and bounding volumes are never updated, so the \
              broad phase sees bodies where they were spawned and nothing collides; replace it \
-             with a stage that writes GlobalPose and BoundingVolume"
+             with a stage that writes GlobalPose (GlobalPose::propagated) and BoundingVolume"
         );
     }
     let start = Instant::now();
@@ -381,15 +400,20 @@ fn find_candidate_pairs(
     mut index: ResMut<BroadPhaseIndex>,
     mut out: ResMut<BroadPhasePairs>,
     mut stats: ResMut<PhysicsStats>,
-    planes: Query<(&Collider, &GlobalPose), Without<Children>>,
+    planes: Query<(&Collider, &GlobalPose, Option<&Children>)>,
+    nodes: Query<(Has<Collider>, Option<&Children>)>,
+    mut stack: Local<Vec<Entity>>,
 ) {
     let start = Instant::now();
     let index = &mut *index;
     out.pairs.clear();
     index.planes.clear();
+    // A plane with colliders below it (a compound) is paired with everything; children without
+    // one (a ground's render meshes) do not count.
     let world_plane = |&e: &Entity| {
-        let (c, pose) = planes.get(e).ok()?;
-        WorldPlane::of(&c.shape, &pose.0)
+        let (c, pose, children) = planes.get(e).ok()?;
+        let parts = children.is_some_and(|c| has_collider_below(c, &nodes, &mut stack));
+        (!parts).then(|| WorldPlane::of(&c.shape, &pose.0))?
     };
     index
         .planes

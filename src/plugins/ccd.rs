@@ -30,8 +30,8 @@ use crate::ccd::{
 };
 use crate::components::*;
 use crate::dynamics::response::reflect;
-use crate::geometry::ContactManifold;
 use crate::geometry::contacts::ContactScratch;
+use crate::geometry::{ContactManifold, Isometry, Shape};
 use crate::plugins::broad_phase::BroadPhaseIndex;
 use crate::plugins::integration::IntegrateBodies;
 use crate::plugins::joints::JointedPairs;
@@ -131,6 +131,8 @@ struct CcdScratch {
     starts: Vec<SweepStart>,
     candidates: Vec<Entity>,
     stack: Vec<Entity>,
+    /// The nodes of a compound still to visit, with their poses in its frame.
+    part_stack: Vec<(Entity, Isometry)>,
     query: QueryScratch,
     contacts: ContactScratch,
 }
@@ -232,6 +234,7 @@ type Swept<'a> = (
 fn sweep_fast_bodies(
     mut bodies: Query<Swept, MovingRoot>,
     obstacles: Query<Obstacle, Without<Quarantined>>,
+    locals: Query<NodePose, With<ChildOf>>,
     index: Option<ResMut<BroadPhaseIndex>>,
     settings: Res<CcdSettings>,
     contact_settings: Res<ContactSettings>,
@@ -284,10 +287,10 @@ fn sweep_fast_bodies(
         if turn <= MAX_REFINED_TURN {
             parts_on_sweep(
                 body,
-                [rotation, now],
-                local_center,
+                ([rotation, now], local_center),
                 &obstacles,
-                s,
+                &locals,
+                &mut s.part_stack,
                 &mut parts,
             );
         }
@@ -357,39 +360,34 @@ fn sweep_fast_bodies(
     stats.count_run("ccd");
 }
 
+/// A node's pose in its parent's frame.
+type NodePose<'a> = (Option<&'a Position>, Option<&'a Rotation>);
+
 /// The convex colliders of `body` (its own and its descendants', sensors left out) placed in
 /// its frame on its sweep, into `parts`; left empty where refining cannot help: a body that is
-/// one sphere (its sweep is exact), or one with a part that has no finite convex gap (a mesh)
-/// or more than [`MAX_REFINED_PARTS`] parts. Each part's place in the body comes from the two
-/// world poses of the last propagation, which agree with each other.
+/// one ball about its swept centre (its sweep is exact), or one with a part that has no finite
+/// convex gap (a mesh) or more than [`MAX_REFINED_PARTS`] parts. Each part's place in the body
+/// is composed from the nodes' local poses down from the root, not taken from world poses (whose
+/// f32 rounding far from the origin would move a part by millimetres).
 fn parts_on_sweep<'q>(
     body: Entity,
-    rotations: [Quat; 2],
-    local_center: Vec3,
+    (rotations, local_center): ([Quat; 2], Vec3),
     obstacles: &'q Query<Obstacle, Without<Quarantined>>,
-    s: &mut CcdScratch,
+    locals: &Query<NodePose, With<ChildOf>>,
+    stack: &mut Vec<(Entity, Isometry)>,
     parts: &mut Vec<ShapeOnSweep<'q>>,
 ) {
-    let Ok((collider, root, _, children, ..)) = obstacles.get(body) else {
-        return;
-    };
-    if children.is_none() {
-        if let Some(c) = collider.filter(|c| ShapeOnSweep::worth_refining(&c.shape)) {
-            parts.push(ShapeOnSweep {
-                shape: &c.shape,
-                rotations,
-                local_center,
-            });
-        }
-        return;
-    }
-    s.stack.clear();
-    s.stack.push(body);
-    while let Some(node) = s.stack.pop() {
-        let Ok((collider, pose, _, children, _, _, sensor)) = obstacles.get(node) else {
+    stack.clear();
+    stack.push((body, Isometry::IDENTITY));
+    while let Some((node, in_body)) = stack.pop() {
+        let Ok((collider, _, _, children, _, _, sensor)) = obstacles.get(node) else {
             continue;
         };
-        s.stack.extend(children.into_iter().flat_map(|c| c.iter()));
+        for child in children.into_iter().flat_map(|c| c.iter()) {
+            let (p, r) = locals.get(child).unwrap_or((None, None));
+            let local = Isometry::new(p.map_or(Vec3::ZERO, |p| p.0), Rotation::of(r));
+            stack.push((child, in_body * local));
+        }
         let Some(c) = collider.filter(|_| !sensor) else {
             continue;
         };
@@ -397,13 +395,18 @@ fn parts_on_sweep<'q>(
             parts.clear();
             return;
         }
-        let in_body = root.0.inv_mul(&pose.0);
         parts.push(ShapeOnSweep::part(
             &c.shape,
             &in_body,
             rotations,
             local_center,
         ));
+    }
+    if let [only] = parts.as_slice()
+        && matches!(only.shape, Shape::Sphere(_))
+        && only.local_center == Vec3::ZERO
+    {
+        parts.clear();
     }
 }
 

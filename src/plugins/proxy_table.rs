@@ -1,7 +1,8 @@
 //! Which broad-phase structure holds each collider, under which id.
 //!
 //! Moving bodies live in the sweep and prune, bounded static scenery in the uniform grid, and
-//! unbounded scenery (half-spaces) in a plain list paired with every moving body. Ids are dense
+//! unbounded scenery (half-spaces) in a plain list checked against every moving body (a
+//! half-space pairs with those whose volume reaches below its plane). Ids are dense
 //! slot numbers (the structures size arrays by the largest id), and an id freed during a step is
 //! reused only after the step's commit, as the sweep and prune requires. Each id also says
 //! whether its moving body sleeps, so that pairs are found only where a body is awake.
