@@ -22,6 +22,7 @@
 //!   vanish. Planes: Newell's normal (the area vector), and the largest `normal · v` as offset:
 //!   corners lie within `2 eps` below, input points within `2 eps` above (`eps` over the scale).
 
+use super::hull_lanes::{SCANNED_VERTICES, SupportLanes};
 use super::predicates::orient3d;
 use super::shapes::MAX_SHAPE_EXTENT;
 use super::{MeshError, TriMesh};
@@ -40,6 +41,8 @@ pub struct ConvexHull {
     face_start: Vec<u32>,
     /// Per vertex, the vertices it shares an edge with.
     neighbours: Vec<Vec<u32>>,
+    /// The first vertices laid out for the support scan.
+    lanes: SupportLanes,
 }
 
 /// One face of a hull: a convex polygon in the plane `normal · x == offset`.
@@ -131,14 +134,15 @@ impl ConvexHull {
     }
 
     /// The vertex farthest along `dir` (any on a tie), for GJK: the best of the first 16 vertices
-    /// (all of a small hull), then a better neighbour while there is one. On a convex polytope's
+    /// (all of a small hull; scanned four at a time, `hull_lanes.rs`), then a better neighbour
+    /// while there is one. On a convex polytope's
     /// vertex graph a local maximum of a linear function is global; strict gains cannot cycle.
     pub fn support(&self, dir: Vec3) -> Vec3 {
         let v = &self.vertices;
-        let mut best = argmax(v.len().min(16), |i| v[i].dot(dir));
+        let mut best = self.lanes.farthest(dir);
         let higher = |b: usize| self.neighbours[b].iter().map(|&n| n as usize);
         let higher = |b: usize| higher(b).find(|&n| v[n].dot(dir) > v[b].dot(dir));
-        while v.len() > 16
+        while v.len() > SCANNED_VERTICES
             && let Some(n) = higher(best)
         {
             best = n;
@@ -435,6 +439,7 @@ impl<'a> Builder<'a> {
         }
         let solid = faces.len() > 3; // else a thin tetrahedron whose faces merged
         let hull = ConvexHull {
+            lanes: SupportLanes::new(&vertices),
             vertices,
             faces,
             face_indices,

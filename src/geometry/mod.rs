@@ -6,6 +6,7 @@ mod contact;
 pub mod contacts;
 pub mod convex;
 mod convex_hull;
+mod hull_lanes;
 mod isometry;
 mod mass_properties;
 mod mesh_collider;
