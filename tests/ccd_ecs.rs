@@ -276,6 +276,46 @@ fn spinning_cones_off_their_centre_bounce_off_the_wall_their_centre_moving_at_mo
     }
 }
 
+/// A 10 cm wall whose face is at x = 9.95 and, flying at it at 120 m/s (2 m a step),
+/// turned by `rotation` and spinning at `spin` rad/s about y, a body of `collider`.
+fn broadside(collider: Collider, rotation: Quat, spin: f32) -> (App, Entity) {
+    let mut app = common::app();
+    app.world_mut().spawn((
+        Collider::cuboid(0.05, 5.0, 5.0),
+        Position(Vec3::new(10.0, 0.0, 0.0)),
+        Static,
+        Restitution(0.0),
+    ));
+    let body = app
+        .world_mut()
+        .spawn((
+            collider,
+            Position(Vec3::ZERO),
+            Rotation(rotation),
+            Velocity(Vec3::new(120.0, 0.0, 0.0)),
+            AngularVelocity(Vec3::new(0.0, spin, 0.0)),
+            Restitution(0.0),
+            Ccd,
+        ))
+        .id();
+    (app, body)
+}
+
+/// [`broadside`] for a compound's root: a 0.2 m thick box, 0.6 m long along y.
+fn broadside_root(spin: f32) -> (App, Entity) {
+    broadside(Collider::cuboid(0.1, 0.3, 0.1), Quat::IDENTITY, spin)
+}
+
+/// The farthest the body's x gets in 8 steps.
+fn farthest_x(app: &mut App, body: Entity) -> f32 {
+    let mut farthest = f32::MIN;
+    for _ in 0..8 {
+        urto::step(app.world_mut(), 1).unwrap();
+        farthest = farthest.max(app.world().get::<Position>(body).unwrap().0.x);
+    }
+    farthest
+}
+
 #[test]
 fn a_capsule_box_or_cylinder_flying_broadside_stops_at_the_wall_within_1_mm_not_its_sphere() {
     // A 2.2 m capsule 0.2 m thick, lying across its motion at 120 m/s (2 m a step) towards a
@@ -287,30 +327,10 @@ fn a_capsule_box_or_cylinder_flying_broadside_stops_at_the_wall_within_1_mm_not_
         (Collider::cuboid(0.1, 1.0, 0.1), 9.85),
         (Collider::cylinder(1.0, 0.1), 9.85),
     ] {
-        let mut app = common::app();
-        app.world_mut().spawn((
-            Collider::cuboid(0.05, 5.0, 5.0),
-            Position(Vec3::new(10.0, 0.0, 0.0)),
-            Static,
-            Restitution(0.0),
-        ));
-        let body = app
-            .world_mut()
-            .spawn((
-                shape.clone(),
-                Position(Vec3::ZERO),
-                // The capsule's and cylinder's axis (z) turned to lie along y.
-                Rotation(Quat::from_rotation_x(std::f32::consts::FRAC_PI_2)),
-                Velocity(Vec3::new(120.0, 0.0, 0.0)),
-                Restitution(0.0),
-                Ccd,
-            ))
-            .id();
-        let mut farthest = f32::MIN;
-        for _ in 0..8 {
-            urto::step(app.world_mut(), 1).unwrap();
-            farthest = farthest.max(app.world().get::<Position>(body).unwrap().0.x);
-        }
+        // The capsule's and cylinder's axis (z) turned to lie along y.
+        let lying = Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
+        let (mut app, body) = broadside(shape.clone(), lying, 0.0);
+        let farthest = farthest_x(&mut app, body);
         assert!(
             farthest <= touch + 1e-3 && farthest > touch - 1e-3,
             "{shape:?} got to {farthest}"
@@ -322,29 +342,13 @@ fn a_capsule_box_or_cylinder_flying_broadside_stops_at_the_wall_within_1_mm_not_
 fn a_compound_of_a_box_a_ball_and_a_cylinder_flying_broadside_stops_at_the_wall_within_1_mm() {
     // A 2 m compound, every part 0.2 m thick along its motion: a box at its root, a ball and an
     // upright cylinder (axis along y after the turn) on children at y = ±0.9, a grandchild box
-    // at y = -0.6 under the cylinder's child. At 120 m/s (2 m a step) towards the wall whose
-    // face is at x = 9.95 it must meet the wall at x = 9.85; the sphere holding all of it
-    // (radius about 1) met it a metre short. Spun about its long axis at 3 rad/s, the boxes
-    // reach up to 0.1·√2 ahead of it: it meets the wall between x = 9.80 and 9.85.
+    // at y = -0.6 under the cylinder's child. It must meet the wall at x = 9.85; the sphere
+    // holding all of it (radius about 1) met it a metre short. Spun about its long axis at
+    // 3 rad/s, the boxes reach up to 0.1·√2 ahead of it: it meets the wall between x = 9.80
+    // and 9.85 (where its end orientation, kept at the impact, would put a corner inside the
+    // wall, it stops where that orientation first touches, not at its sphere).
     for (spin, nearest) in [(0.0, 9.85 - 1e-3), (3.0, 9.80)] {
-        let mut app = common::app();
-        app.world_mut().spawn((
-            Collider::cuboid(0.05, 5.0, 5.0),
-            Position(Vec3::new(10.0, 0.0, 0.0)),
-            Static,
-            Restitution(0.0),
-        ));
-        let body = app
-            .world_mut()
-            .spawn((
-                Collider::cuboid(0.1, 0.3, 0.1),
-                Position(Vec3::ZERO),
-                Velocity(Vec3::new(120.0, 0.0, 0.0)),
-                AngularVelocity(Vec3::new(0.0, spin, 0.0)),
-                Restitution(0.0),
-                Ccd,
-            ))
-            .id();
+        let (mut app, body) = broadside_root(spin);
         let world = app.world_mut();
         world.spawn((
             Collider::sphere(0.1),
@@ -366,11 +370,7 @@ fn a_compound_of_a_box_a_ball_and_a_cylinder_flying_broadside_stops_at_the_wall_
             Position(Vec3::new(0.0, 0.0, -0.3)),
             ChildOf(arm),
         ));
-        let mut farthest = f32::MIN;
-        for _ in 0..8 {
-            urto::step(app.world_mut(), 1).unwrap();
-            farthest = farthest.max(app.world().get::<Position>(body).unwrap().0.x);
-        }
+        let farthest = farthest_x(&mut app, body);
         assert!(
             farthest <= 9.85 + 1e-3 && farthest > nearest,
             "spin {spin}: got to {farthest}"
@@ -378,33 +378,11 @@ fn a_compound_of_a_box_a_ball_and_a_cylinder_flying_broadside_stops_at_the_wall_
     }
 }
 
-/// How far (the root's x) a compound of a 0.2 m box with `child` at y = 0.9 gets, flying
-/// broadside at 120 m/s towards the wall whose face is at x = 9.95.
+/// How far (the root's x) the compound of [`broadside_root`] with `child` gets.
 fn compound_reach(child: impl Bundle) -> f32 {
-    let mut app = common::app();
-    app.world_mut().spawn((
-        Collider::cuboid(0.05, 5.0, 5.0),
-        Position(Vec3::new(10.0, 0.0, 0.0)),
-        Static,
-        Restitution(0.0),
-    ));
-    let body = app
-        .world_mut()
-        .spawn((
-            Collider::cuboid(0.1, 0.3, 0.1),
-            Position(Vec3::ZERO),
-            Velocity(Vec3::new(120.0, 0.0, 0.0)),
-            Restitution(0.0),
-            Ccd,
-        ))
-        .id();
+    let (mut app, body) = broadside_root(0.0);
     app.world_mut().spawn((child, ChildOf(body)));
-    let mut farthest = f32::MIN;
-    for _ in 0..8 {
-        urto::step(app.world_mut(), 1).unwrap();
-        farthest = farthest.max(app.world().get::<Position>(body).unwrap().0.x);
-    }
-    farthest
+    farthest_x(&mut app, body)
 }
 
 #[test]
