@@ -386,7 +386,7 @@ fn compound_reach(child: impl Bundle) -> f32 {
 }
 
 #[test]
-fn a_compound_with_a_mesh_part_stops_at_its_sphere_and_a_sensor_part_stops_nothing() {
+fn a_compound_with_a_mesh_part_stops_at_its_sphere_and_a_sensor_or_ghost_part_stops_nothing() {
     // A mesh part has no convex gap to advance on: the body stops where its sphere (radius
     // about 1) met the wall, a metre short of 9.85, early as before. A sensor ball reaching
     // 0.4 m ahead of the body is no part of its shape: it touches first, and the body still
@@ -403,6 +403,18 @@ fn a_compound_with_a_mesh_part_stops_at_its_sphere_and_a_sensor_part_stops_nothi
     assert!(
         with_sensor <= 9.85 + 1e-3 && with_sensor > 9.85 - 1e-3,
         "with a sensor part it got to {with_sensor}"
+    );
+    // A part 0.3 m ahead in layers the wall does not interact with passes it, as the narrow
+    // phase would let it: the body stops where its root meets the wall, not 0.3 m short.
+    let ghost = (
+        Collider::cuboid(0.1, 0.1, 0.1),
+        Position(Vec3::new(0.3, 0.9, 0.0)),
+        CollisionLayers::new(LayerMask(1 << 2), !LayerMask(1)),
+    );
+    let with_ghost = compound_reach(ghost);
+    assert!(
+        with_ghost <= 9.85 + 1e-3 && with_ghost > 9.85 - 1e-3,
+        "with a ghost part it got to {with_ghost}"
     );
 }
 

@@ -45,6 +45,7 @@ use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
+use std::borrow::Cow;
 use std::time::Instant;
 
 /// Sweeps fast bodies against static scenery each substep.
@@ -256,7 +257,7 @@ fn sweep_fast_bodies(
     let start = Instant::now();
     let dt = timestep.substep_dt();
     let s = &mut *scratch;
-    let mut parts = Vec::new();
+    let (mut parts, mut part_layers) = (Vec::new(), Vec::new());
     for i in 0..s.starts.len() {
         let SweepStart {
             body,
@@ -284,6 +285,7 @@ fn sweep_fast_bodies(
         // spinning so fast that the slerp between its two orientations may not be the way it
         // turned).
         parts.clear();
+        part_layers.clear();
         if turn <= MAX_REFINED_TURN {
             parts_on_sweep(
                 body,
@@ -291,7 +293,7 @@ fn sweep_fast_bodies(
                 &obstacles,
                 &locals,
                 &mut s.part_stack,
-                &mut parts,
+                (&mut parts, &mut part_layers),
             );
         }
         let free = LockedAxes::of(locked).free_translation_axes();
@@ -308,7 +310,7 @@ fn sweep_fast_bodies(
             let sweep = sweep.with_initial_overlap(InitialOverlap::ApproachingOnly);
             let Some((hit, root, leaf, e_obstacle)) = first_impact(
                 &sweep,
-                (body, layers, jointed, &parts),
+                (body, layers, jointed, (&parts, &part_layers)),
                 &obstacles,
                 &mut index,
                 s,
@@ -375,12 +377,13 @@ fn parts_on_sweep<'q>(
     obstacles: &'q Query<Obstacle, Without<Quarantined>>,
     locals: &Query<NodePose, With<ChildOf>>,
     stack: &mut Vec<(Entity, Isometry)>,
-    parts: &mut Vec<ShapeOnSweep<'q>>,
+    (parts, part_layers): (&mut Vec<ShapeOnSweep<'q>>, &mut Vec<CollisionLayers>),
 ) {
+    part_layers.clear();
     stack.clear();
     stack.push((body, Isometry::IDENTITY));
     while let Some((node, in_body)) = stack.pop() {
-        let Ok((collider, _, _, children, _, _, sensor)) = obstacles.get(node) else {
+        let Ok((collider, _, _, children, _, layers, sensor)) = obstacles.get(node) else {
             continue;
         };
         for child in children.into_iter().flat_map(|c| c.iter()) {
@@ -393,6 +396,7 @@ fn parts_on_sweep<'q>(
         };
         if !ShapeOnSweep::has_convex_gap(&c.shape) || parts.len() == MAX_REFINED_PARTS {
             parts.clear();
+            part_layers.clear();
             return;
         }
         parts.push(ShapeOnSweep::part(
@@ -401,12 +405,14 @@ fn parts_on_sweep<'q>(
             rotations,
             local_center,
         ));
+        part_layers.push(layers_of(layers));
     }
     if let [only] = parts.as_slice()
         && matches!(only.shape, Shape::Sphere(_))
         && only.local_center == Vec3::ZERO
     {
         parts.clear();
+        part_layers.clear();
     }
 }
 
@@ -416,16 +422,17 @@ const TOUCHING_TOLERANCE: f32 = 1e-4;
 
 /// The earliest impact of `sweep` (`body`, with `layers`) with the static scenery its swept
 /// volume meets, its layers interact with and no joint keeps it from colliding with: the hit,
-/// the obstacle's root, the collider hit, and that collider's restitution. With `parts`, each
-/// sphere impact is refined to the earliest of the parts' own ([`toi_parts_from`]), and one
-/// they all miss is none.
+/// the obstacle's root, the collider hit, and that collider's restitution. With `parts` (and
+/// their layers), each sphere impact is refined to the earliest of the parts' own
+/// ([`toi_parts_from`]), among the parts whose own layers interact with the obstacle's (as the
+/// narrow phase pairs parts), and one they all miss is none.
 fn first_impact(
     sweep: &SphereSweep,
-    (body, layers, jointed, parts): (
+    (body, layers, jointed, (parts, part_layers)): (
         Entity,
         CollisionLayers,
         Option<&JointedPairs>,
-        &[ShapeOnSweep],
+        LayeredParts,
     ),
     obstacles: &Query<Obstacle, Without<Quarantined>>,
     index: &mut BroadPhaseIndex,
@@ -453,20 +460,22 @@ fn first_impact(
             let Some(c) = collider else {
                 continue;
             };
-            if sensor || !layers.interacts_with(&layers_of(node_layers)) {
+            let obstacle_layers = layers_of(node_layers);
+            let meeting = meeting_parts((parts, part_layers), layers, &obstacle_layers);
+            if sensor || meeting.is_none() {
                 continue;
             }
             let Some(mut hit) = toi_sphere_shape(sweep, &c.shape, &global.0, &mut s.query) else {
                 continue;
             };
-            if !parts.is_empty() {
+            if let Some(meeting) = meeting.filter(|m| !m.is_empty()) {
                 // The parts' impact is never earlier than their sphere's: past the best so far,
                 // it cannot win.
                 if best.as_ref().is_some_and(|(b, ..)| b.t <= hit.t) {
                     continue;
                 }
                 let obstacle = (&c.shape, &global.0);
-                match toi_parts_from(sweep, parts, hit, obstacle, &mut s.contacts) {
+                match toi_parts_from(sweep, &meeting, hit, obstacle, &mut s.contacts) {
                     Some(own) => hit = own,
                     None => continue,
                 }
@@ -483,6 +492,36 @@ fn first_impact(
         }
     }
     best
+}
+
+/// A body's convex parts on its sweep and each one's collision layers.
+type LayeredParts<'p, 'q> = (&'p [ShapeOnSweep<'q>], &'p [CollisionLayers]);
+
+/// The parts that meet an obstacle in `obstacle` layers: all of them when each one's layers
+/// interact with it (the common case, borrowed), those that do when some do not, `None` when
+/// none does. Without parts (a body not refined), the body's own `layers` decide, and the
+/// answer is an empty list or `None`.
+fn meeting_parts<'p, 'q>(
+    (parts, part_layers): LayeredParts<'p, 'q>,
+    layers: CollisionLayers,
+    obstacle: &CollisionLayers,
+) -> Option<Cow<'p, [ShapeOnSweep<'q>]>> {
+    if parts.is_empty() {
+        return layers
+            .interacts_with(obstacle)
+            .then_some(Cow::Borrowed(parts));
+    }
+    let meets = |l: &CollisionLayers| l.interacts_with(obstacle);
+    if part_layers.iter().all(meets) {
+        return Some(Cow::Borrowed(parts));
+    }
+    let some: Vec<_> = parts
+        .iter()
+        .zip(part_layers)
+        .filter(|(_, l)| meets(l))
+        .map(|(p, _)| *p)
+        .collect();
+    (!some.is_empty()).then_some(Cow::Owned(some))
 }
 
 /// The substep's impacts join the narrow phase's contacts (once per pair), so the response and
