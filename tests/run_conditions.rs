@@ -2,6 +2,7 @@
 
 mod common;
 
+use bevy_ecs::prelude::*;
 use glam::Vec3;
 use urto::prelude::*;
 
@@ -245,13 +246,28 @@ fn every_one_of_the_17_plugins_can_be_disabled_and_a_busy_scene_steps_without_a_
     }
 }
 
+/// How many of `walls` each of `balls` is paired with in the last step's broad phase.
+fn planes_of(app: &bevy_app::App, walls: &[Entity], balls: &[Entity]) -> Vec<usize> {
+    let pairs = &app
+        .world()
+        .resource::<urto::plugins::BroadPhasePairs>()
+        .pairs;
+    let count = |ball: &Entity| {
+        pairs
+            .iter()
+            .filter(|(a, b)| a == ball && walls.contains(b))
+            .count()
+    };
+    balls.iter().map(count).collect()
+}
+
 #[test]
 fn in_a_box_of_six_planes_a_ball_pairs_only_with_the_planes_its_grown_volume_reaches_0_1_or_2() {
-    // A wall a body does not reach costs it no narrow-phase pair. A 10 m box of half-spaces (each wall's solid outside it) and, without gravity, a ball of
-    // radius 0.5 in the middle, one 1 cm from the +x wall (within its 2 cm margin), one in the
-    // corner of +x and +y.
-    // Pairing every ball with every plane made 18 pairs; a wall pairs with a ball only where
-    // the ball's volume, grown by its speculative margin, reaches it.
+    // A wall a body does not reach costs it no narrow-phase pair. In a 10 m box of half-spaces
+    // (each wall's solid outside it), without gravity: a ball of radius 0.5 in the middle, one
+    // 1 cm from the +x wall (within its 2 cm margin), one in the corner of +x and +y. Pairing
+    // every ball with every plane made 18 pairs; a wall pairs with a ball only where the
+    // ball's volume, grown by its speculative margin, reaches it.
     let mut app = common::app();
     app.insert_resource(Gravity::new(Vec3::ZERO).unwrap());
     let mut walls = Vec::new();
@@ -262,26 +278,31 @@ fn in_a_box_of_six_planes_a_ball_pairs_only_with_the_planes_its_grown_volume_rea
             .id();
         walls.push(wall);
     }
-    let middle = common::ball(&mut app, Vec3::ZERO);
-    let at_wall = common::ball(&mut app, Vec3::new(4.49, 0.0, 0.0));
-    let in_corner = common::ball(&mut app, Vec3::new(4.49, 4.49, 0.0));
+    let balls = [
+        common::ball(&mut app, Vec3::ZERO),
+        common::ball(&mut app, Vec3::new(4.49, 0.0, 0.0)),
+        common::ball(&mut app, Vec3::new(4.49, 4.49, 0.0)),
+    ];
     urto::step(app.world_mut(), 1).unwrap();
-    let pairs = &app
-        .world()
-        .resource::<urto::plugins::BroadPhasePairs>()
-        .pairs;
-    let planes_of = |ball: bevy_ecs::entity::Entity| {
-        pairs
-            .iter()
-            .filter(|(a, b)| *a == ball && walls.contains(b))
-            .count()
-    };
-    assert_eq!(planes_of(middle), 0);
-    assert_eq!(planes_of(at_wall), 1);
-    assert_eq!(planes_of(in_corner), 2);
+    assert_eq!(planes_of(&app, &walls, &balls), [0, 1, 2]);
     // The ones it reaches are still met: the balls touch nothing yet, and nothing moved.
-    for ball in [middle, at_wall, in_corner] {
+    for ball in balls {
         let v = app.world().get::<Velocity>(ball).unwrap().0;
         assert!(v.length() < 1e-6, "{v}");
     }
+    // The floor (the -z wall's solid is below z = -5) given a child without a collider (a
+    // render mesh in a game) is still culled by its plane; given a child with one (a compound),
+    // it is paired with every ball, as any unbounded compound is.
+    let floor = walls[2];
+    app.world_mut()
+        .spawn((Position(Vec3::new(0.0, 0.0, -5.0)), ChildOf(floor)));
+    urto::step(app.world_mut(), 1).unwrap();
+    assert_eq!(planes_of(&app, &walls, &balls), [0, 1, 2]);
+    app.world_mut().spawn((
+        Collider::cuboid(0.5, 0.5, 0.5),
+        Position(Vec3::new(0.0, 0.0, -5.0)),
+        ChildOf(floor),
+    ));
+    urto::step(app.world_mut(), 1).unwrap();
+    assert_eq!(planes_of(&app, &walls, &balls), [1, 2, 3]);
 }

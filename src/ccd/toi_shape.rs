@@ -43,12 +43,6 @@ pub struct ShapeOnSweep<'a> {
 }
 
 impl ShapeOnSweep<'_> {
-    /// Whether refining pays: not for a sphere (the sweep is exact for it), nor for shapes
-    /// without a finite convex gap (half-spaces, meshes).
-    pub fn worth_refining(shape: &Shape) -> bool {
-        !matches!(shape, Shape::Sphere(_)) && Self::has_convex_gap(shape)
-    }
-
     /// Whether the shape has the finite convex gap the advancement reads: every shape but the
     /// half-space and the triangle mesh (a sphere too: as a part off the centre of mass of a
     /// compound, its sweep is no longer exact).

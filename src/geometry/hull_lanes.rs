@@ -50,7 +50,7 @@ impl SupportLanes {
     }
 
     /// The index of the scanned vertex farthest along `dir`, the first on a tie; 0 when there is
-    /// none or every dot product is NaN.
+    /// none or no dot product is above `f32::MIN` (a NaN direction).
     pub(crate) fn farthest(&self, dir: Vec3) -> usize {
         let [dx, dy, dz] = [dir.x, dir.y, dir.z].map(f32x4::splat);
         let mut best = f32x4::splat(f32::MIN);

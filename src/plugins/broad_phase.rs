@@ -9,8 +9,9 @@
 //!   indexed once, queried with each moving body's volume; statics never enter the sort.
 //! - Unbounded scenery (grounds, walls) is paired with every moving body whose volume reaches
 //!   it: a half-space only with the bodies whose grown volume has a corner below its plane (a
-//!   ball in the middle of a box of six planes is paired with the floor alone), anything else
-//!   unbounded with every moving body.
+//!   ball in the middle of a box of six planes is paired with none), anything else unbounded
+//!   (a half-space with colliders below it in the scene graph, a compound) with every moving
+//!   body.
 //! - Sleeping bodies stay indexed where they are but are paired with nothing (neither scenery
 //!   nor other sleepers) until they wake: the plugin hears of each body falling asleep or
 //!   waking from the [`Sleeping`] marker's hooks, so a sleeping pile costs no pass here.
