@@ -5,11 +5,13 @@
 //!
 //! The closed-form tests report only touching or penetrating pairs, so one of the two shapes is
 //! tested grown by the margin and each point's separation is the margin minus its depth against
-//! the grown shape. The shape grown is the one that grows exactly if either does: a ball's or a
-//! capsule's radius, a half-space's boundary moved out. Otherwise a box grows by its half
-//! extents: exact across faces, early near edges and corners (a grown box is not a rounded
-//! one), which only makes a contact speculative sooner, while a pair that reads penetrating
-//! is also measured on the true shapes, never deeper ([`grown_box_contact`]). Two meshes are not grown:
+//! the grown shape. A ball or a capsule, which grow exactly (their radius), is the shape grown
+//! if the pair has one; then a box, by its half extents: exact across faces, early near edges
+//! and corners (a grown box is not a rounded one), which only makes a contact speculative
+//! sooner, while a pair that reads penetrating is also measured on the true shapes, never
+//! deeper ([`grown_box_contact`]); then a half-space, whose boundary moves out (exact). A box
+//! on the ground is read with the box grown: raising the plane instead (exact for a tilted
+//! box) let the accuracy report's 20-box stack sway 10.0 mm in 10 s against 5.6 mm. Two meshes are not grown:
 //! their hierarchies are descended with boxes grown by the margin, and triangle pairs that do
 //! not cross report their exact gap (`trimesh_trimesh.rs`).
 
@@ -103,8 +105,14 @@ pub fn speculative_contact_with_scratch(
             let m = contact_with_scratch(a, pose_a, &gb, pose_b, scratch)?;
             return Some(from_grown(m, margin, None, false));
         }
-        // A half-space grows by moving its boundary out (exact): a mesh or a tilted box above
-        // the ground is found.
+        if let Shape::Cuboid(c) = a {
+            return grown_box_contact((c, pose_a, true), (a, pose_a, b, pose_b), margin, scratch);
+        }
+        if let Shape::Cuboid(c) = b {
+            return grown_box_contact((c, pose_b, false), (a, pose_a, b, pose_b), margin, scratch);
+        }
+        // A half-space grows by moving its boundary out (exact): a mesh above the ground is
+        // found.
         if let Some(raised) = raised_half_space(a, pose_a, margin) {
             let m = contact_with_scratch(a, &raised, b, pose_b, scratch)?;
             return Some(from_grown(m, margin, None, true));
@@ -112,12 +120,6 @@ pub fn speculative_contact_with_scratch(
         if let Some(raised) = raised_half_space(b, pose_b, margin) {
             let m = contact_with_scratch(a, pose_a, b, &raised, scratch)?;
             return Some(from_grown(m, margin, None, false));
-        }
-        if let Shape::Cuboid(c) = a {
-            return grown_box_contact((c, pose_a, true), (a, pose_a, b, pose_b), margin, scratch);
-        }
-        if let Shape::Cuboid(c) = b {
-            return grown_box_contact((c, pose_b, false), (a, pose_a, b, pose_b), margin, scratch);
         }
     }
     contact_with_scratch(a, pose_a, b, pose_b, scratch)
