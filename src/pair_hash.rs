@@ -47,16 +47,22 @@ impl Hasher for PairHasher {
 
     fn write(&mut self, bytes: &[u8]) {
         // Not used by u64 keys; kept correct for any other key type.
-        for chunk in bytes.chunks(8) {
-            let mut word = [0u8; 8];
-            word[..chunk.len()].copy_from_slice(chunk);
-            self.write_u64(u64::from_le_bytes(word));
-        }
+        for_each_word(bytes, |word| self.write_u64(word));
     }
 
     #[inline]
     fn finish(&self) -> u64 {
         self.0
+    }
+}
+
+/// Feeds `bytes` to `fold` as little-endian 64-bit words, the last one zero-padded: how a
+/// word hasher takes keys that are not words.
+pub(crate) fn for_each_word(bytes: &[u8], mut fold: impl FnMut(u64)) {
+    for chunk in bytes.chunks(8) {
+        let mut word = [0u8; 8];
+        word[..chunk.len()].copy_from_slice(chunk);
+        fold(u64::from_le_bytes(word));
     }
 }
 

@@ -43,6 +43,9 @@ pub struct ConvexHull {
     neighbours: Vec<Vec<u32>>,
     /// The first vertices laid out for the support scan.
     lanes: SupportLanes,
+    /// The longest vertex, taken once: the manifold cache asks for it on every lookup of a
+    /// hull pair.
+    bounding_radius: f32,
 }
 
 /// One face of a hull: a convex polygon in the plane `normal · x == offset`.
@@ -171,7 +174,7 @@ impl ConvexHull {
 
     /// Radius of the smallest origin-centred ball holding the hull (its longest vertex).
     pub fn bounding_radius(&self) -> f32 {
-        self.vertices.iter().fold(0.0, |r, v| r.max(v.length()))
+        self.bounding_radius
     }
 }
 
@@ -440,6 +443,7 @@ impl<'a> Builder<'a> {
         let solid = faces.len() > 3; // else a thin tetrahedron whose faces merged
         let hull = ConvexHull {
             lanes: SupportLanes::new(&vertices),
+            bounding_radius: vertices.iter().fold(0.0, |r, v| r.max(v.length())),
             vertices,
             faces,
             face_indices,

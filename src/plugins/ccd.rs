@@ -284,18 +284,15 @@ fn sweep_fast_bodies(
         // The sphere's impacts are refined to the body's own convex parts (not for a body
         // spinning so fast that the slerp between its two orientations may not be the way it
         // turned).
-        parts.clear();
-        part_layers.clear();
-        if turn <= MAX_REFINED_TURN {
-            parts_on_sweep(
-                body,
-                ([rotation, now], local_center),
-                &obstacles,
-                &locals,
-                &mut s.part_stack,
-                (&mut parts, &mut part_layers),
-            );
-        }
+        let rotations = (turn <= MAX_REFINED_TURN).then_some([rotation, now]);
+        parts_on_sweep(
+            body,
+            (rotations, local_center),
+            &obstacles,
+            &locals,
+            &mut s.part_stack,
+            (&mut parts, &mut part_layers),
+        );
         let free = LockedAxes::of(locked).free_translation_axes();
         let (mut at, mut velocity, mut motion) = (from, v.0, to - from);
         let mut impacted = false;
@@ -366,20 +363,26 @@ fn sweep_fast_bodies(
 type NodePose<'a> = (Option<&'a Position>, Option<&'a Rotation>);
 
 /// The convex colliders of `body` (its own and its descendants', sensors left out) placed in
-/// its frame on its sweep, into `parts`; left empty where refining cannot help: a body that is
+/// its frame on its sweep turning by `rotations`, into `parts` (their layers into
+/// `part_layers`); left empty where refining cannot help: a body turning too fast for the slerp
+/// between its two orientations to be the way it turned (`rotations` is `None`), one that is
 /// one ball about its swept centre (its sweep is exact), or one with a part that has no finite
 /// convex gap (a mesh) or more than [`MAX_REFINED_PARTS`] parts. Each part's place in the body
 /// is composed from the nodes' local poses down from the root, not taken from world poses (whose
 /// f32 rounding far from the origin would move a part by millimetres).
 fn parts_on_sweep<'q>(
     body: Entity,
-    (rotations, local_center): ([Quat; 2], Vec3),
+    (rotations, local_center): (Option<[Quat; 2]>, Vec3),
     obstacles: &'q Query<Obstacle, Without<Quarantined>>,
     locals: &Query<NodePose, With<ChildOf>>,
     stack: &mut Vec<(Entity, Isometry)>,
     (parts, part_layers): (&mut Vec<ShapeOnSweep<'q>>, &mut Vec<CollisionLayers>),
 ) {
+    parts.clear();
     part_layers.clear();
+    let Some(rotations) = rotations else {
+        return;
+    };
     stack.clear();
     stack.push((body, Isometry::IDENTITY));
     while let Some((node, in_body)) = stack.pop() {

@@ -44,7 +44,6 @@ use crate::geometry::contacts::{
 };
 use crate::geometry::{ContactManifold, Shape};
 use crate::hierarchy::{BvTree, HierarchyStats, PairScratch, descend_pairs};
-use crate::pair_hash::PairHashBuilder;
 use crate::plugins::broad_phase::BroadPhasePairs;
 use crate::plugins::joints::JointedPairs;
 use crate::plugins::required_resources::RequireResource;
@@ -54,8 +53,8 @@ use crate::schedule::{SubstepSchedule, SubstepSet};
 use crate::settings::SleepSettings;
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
+use bevy_ecs::entity::EntityHashMap;
 use bevy_ecs::prelude::*;
-use std::collections::HashMap;
 use std::time::Instant;
 
 mod visits;
@@ -200,7 +199,7 @@ struct NarrowPhaseScratch {
     mesh_pairs: u64,
     /// What the pair loop asks of each body, read from the world once a step (a body in a
     /// pile is in about eight pairs; the lookups were a tenth of a 1,000-ball pile's step).
-    bodies: HashMap<u64, BodyFacts, PairHashBuilder>,
+    bodies: EntityHashMap<BodyFacts>,
 }
 
 /// A body's part in this step's pairs.
@@ -341,7 +340,7 @@ fn compute_contacts(
     let mut bodies = std::mem::take(&mut scratch.bodies);
     bodies.clear();
     let mut facts = |e: Entity| {
-        *bodies.entry(e.to_bits()).or_insert_with(|| BodyFacts {
+        *bodies.entry(e).or_insert_with(|| BodyFacts {
             margin: margin(e),
             dormant: sleeping && dormant(e),
             compound: matches!(nodes.get(e), Ok((.., Some(_)))),

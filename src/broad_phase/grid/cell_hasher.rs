@@ -41,11 +41,7 @@ impl CellHasher {
 
 impl Hasher for CellHasher {
     fn write(&mut self, bytes: &[u8]) {
-        for chunk in bytes.chunks(8) {
-            let mut word = [0u8; 8];
-            word[..chunk.len()].copy_from_slice(chunk);
-            self.fold(u64::from_le_bytes(word));
-        }
+        crate::pair_hash::for_each_word(bytes, |word| self.fold(word));
     }
 
     #[inline]
