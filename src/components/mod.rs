@@ -279,9 +279,18 @@ impl GlobalPose {
     /// A world pose as the propagation writes it: only for a stage that replaces
     /// [`HierarchyPlugin`](crate::plugins::HierarchyPlugin)'s (game code moves bodies through
     /// [`Position`] and [`Rotation`]; a pose written here by anything else is overwritten at
-    /// the next propagation).
-    pub fn propagated(pose: Isometry) -> Self {
-        Self(pose)
+    /// the next propagation). `None` for a pose with a NaN or an infinity, which no stage may
+    /// hand to the narrow phase (validation quarantines the bodies whose own pose is bad).
+    ///
+    /// ```
+    /// # use urto::prelude::*;
+    /// # use urto::geometry::Isometry;
+    /// assert!(GlobalPose::propagated(Isometry::IDENTITY).is_some());
+    /// let bad = Isometry::from_translation(glam::Vec3::new(f32::NAN, 0.0, 0.0));
+    /// assert!(GlobalPose::propagated(bad).is_none());
+    /// ```
+    pub fn propagated(pose: Isometry) -> Option<Self> {
+        pose.is_finite().then_some(Self(pose))
     }
 }
 
