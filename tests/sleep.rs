@@ -6,7 +6,7 @@ mod common;
 use bevy_app::App;
 use bevy_ecs::message::Messages;
 use bevy_ecs::prelude::*;
-use glam::Vec3;
+use glam::{Quat, Vec3};
 use urto::prelude::*;
 
 fn sleepy_app() -> App {
@@ -322,5 +322,117 @@ fn despawning_the_ground_wakes_the_balls_asleep_on_it_and_they_fall_1m_within_1s
     assert_eq!(count, balls.len());
     for &b in &balls {
         assert!(z(&app, b) < -0.5, "fell: z = {}", z(&app, b));
+    }
+}
+
+/// A game component the physics knows nothing about.
+#[derive(Component)]
+struct Tag;
+
+/// How a test writes to one sleeping body.
+type Write = fn(&mut EntityWorldMut);
+
+/// Every write game code can make to a sleeping body wakes that body and no other, whether the
+/// component was there (a change through `Mut`) or is inserted, in any of the sleeping tables;
+/// a write that leaves a value as it slept (`set_changed` on the pose) and a write to a
+/// component the physics does not read wake nothing. Sleepers are found through the tables'
+/// summary ticks, so this checks that no write goes unseen and that one write does not wake
+/// its table.
+#[test]
+fn each_of_17_writes_wakes_only_the_body_written_among_60_sleepers_in_three_tables() {
+    let mut app = sleepy_app();
+    let balls: Vec<Entity> = (0..60)
+        .map(|i| {
+            let at = Vec3::new((i % 10) as f32 * 3.0, (i / 10) as f32 * 3.0, 0.5);
+            let b = common::ball(&mut app, at);
+            let mut e = app.world_mut().entity_mut(b);
+            match i % 3 {
+                0 => {}
+                1 => {
+                    e.insert(Tag);
+                }
+                _ => {
+                    e.insert((LinearDrag(0.1), Force(Vec3::ZERO), Mass(1.5)));
+                }
+            }
+            b
+        })
+        .collect();
+    urto::step(app.world_mut(), 120).unwrap();
+    assert!(balls.iter().all(|&b| asleep(&app, b)), "all asleep");
+    let unseen: [Write; 2] = [
+        |e| e.get_mut::<Position>().unwrap().set_changed(),
+        |e| {
+            e.insert(Tag);
+        },
+    ];
+    for (i, write) in unseen.iter().enumerate() {
+        write(&mut app.world_mut().entity_mut(balls[3 * i]));
+        urto::step(app.world_mut(), 1).unwrap();
+        assert!(balls.iter().all(|&b| asleep(&app, b)), "unseen write {i}");
+    }
+    let writes: [Write; 17] = [
+        |e| e.get_mut::<Position>().unwrap().0.x += 0.1,
+        |e| e.get_mut::<Rotation>().unwrap().0 = Quat::from_rotation_z(0.3),
+        |e| e.get_mut::<Velocity>().unwrap().0 = Vec3::Z,
+        |e| {
+            e.insert(AngularVelocity::new(0.0, 0.0, 2.0));
+        },
+        |e| match e.get_mut::<Force>() {
+            Some(mut f) => f.0 = Vec3::X,
+            None => {
+                e.insert(Force(Vec3::X));
+            }
+        },
+        |e| {
+            e.insert(Torque(Vec3::Z));
+        },
+        |e| {
+            let mut push = ForceAtPoint::default();
+            push.add(Vec3::X, Vec3::Z);
+            e.insert(push);
+        },
+        |e| {
+            e.insert(Impulse::new(Vec3::X));
+        },
+        |e| {
+            e.insert(GravityScale(0.5));
+        },
+        |e| {
+            e.insert(Mass(2.0));
+        },
+        |e| {
+            e.insert(Density(3.0));
+        },
+        |e| {
+            e.insert(LockedAxes::ROTATION_LOCKED);
+        },
+        |e| {
+            e.insert(Collider::sphere(0.4));
+        },
+        |e| {
+            e.insert(Inertia::custom(Vec3::ONE, Quat::IDENTITY));
+        },
+        |e| match e.get_mut::<LinearDrag>() {
+            Some(mut d) => d.0 = 0.3,
+            None => {
+                e.insert(LinearDrag(0.3));
+            }
+        },
+        |e| {
+            e.insert(AngularDrag(0.2));
+        },
+        |e| {
+            e.remove::<Mass>();
+        },
+    ];
+    for (i, write) in writes.iter().enumerate() {
+        // Rows of all three tables in turn; the `Mass` removal to a ball spawned with one.
+        let written = if i == 16 { balls[50] } else { balls[20 + i] };
+        write(&mut app.world_mut().entity_mut(written));
+        urto::step(app.world_mut(), 1).unwrap();
+        assert!(!asleep(&app, written), "write {i} woke its body");
+        let woken = balls.iter().filter(|&&b| !asleep(&app, b)).count();
+        assert_eq!(woken, i + 1, "write {i} woke only its body");
     }
 }

@@ -12,6 +12,7 @@ use glam::{Quat, Vec3};
 
 /// Angular velocity in world axes (rad/s): the body turns about its centre of mass at this rate.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+#[component(summary_tick)]
 pub struct AngularVelocity(pub Vec3);
 
 impl AngularVelocity {
@@ -24,6 +25,7 @@ impl AngularVelocity {
 /// Torque in world axes (N·m) applied during the next physics step, then cleared, like
 /// [`Force`](super::Force).
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+#[component(summary_tick)]
 pub struct Torque(pub Vec3);
 
 /// Forces applied at world points during the next physics step, then cleared. Each force both
@@ -39,6 +41,7 @@ pub struct Torque(pub Vec3);
 /// assert_eq!(push.torque_about(Vec3::ZERO), Vec3::new(0.0, 10.0, 0.0));
 /// ```
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+#[component(summary_tick)]
 pub struct ForceAtPoint {
     /// The forces and their moment (about the first point, exact far from the origin).
     sum: PointSum,
@@ -69,6 +72,7 @@ impl ForceAtPoint {
 /// Angular drag rate `c` (1/s): without torque the angular velocity decays as `e^{−c t}`
 /// (applied exactly, so any `c >= 0` is stable).
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+#[component(summary_tick)]
 pub struct AngularDrag(pub f32);
 
 /// World axes a body may not turn about or move along (Avian's and rapier's `LockedAxes`):
@@ -81,6 +85,7 @@ pub struct AngularDrag(pub f32);
 /// ignore the locks. On the lecture's pipeline (`SoftStepPlugin` disabled) only the rotation
 /// locks and impulses honour them.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[component(summary_tick)]
 pub struct LockedAxes(u8);
 
 impl LockedAxes {
@@ -182,6 +187,7 @@ impl LockedAxes {
 /// changes. [`Inertia::custom`] overrides it. A body without any collider
 /// has infinite inertia: torques and contacts do not turn it, its angular velocity still does.
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
+#[component(summary_tick)]
 pub struct Inertia {
     /// Principal moments (kg·m²); infinite where the body cannot be turned.
     pub principal: Vec3,

@@ -21,6 +21,7 @@ use glam::Vec3;
 /// assert_eq!(kick.angular_about(Vec3::ZERO), Vec3::new(0.0, 2.0, 0.0));
 /// ```
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+#[component(summary_tick)]
 pub struct Impulse {
     /// Impulses through the centre of mass.
     through_center: Vec3,
@@ -82,6 +83,7 @@ impl Impulse {
 /// the force `(s − 1) m g` on top of gravity, so it works with every integrator and solver. Not
 /// finite quarantines the body.
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
+#[component(summary_tick)]
 pub struct GravityScale(pub f32);
 
 impl Default for GravityScale {

@@ -23,6 +23,7 @@ pub const DEFAULT_DENSITY: f32 = 1.0;
 /// plugin, is never solved with its old mass; its inertia follows at the next step's Prepare.
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
 #[component(on_insert = take_mass_at_once)]
+#[component(summary_tick)]
 pub struct Mass(pub f32);
 
 /// [`Mass`]'s insert hook: a valid mass becomes the body's [`ComputedMass`] now (an invalid
@@ -63,6 +64,7 @@ impl Mass {
 /// when a collider or part changes. A density that is not finite and positive is reported and
 /// the default used instead.
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
+#[component(summary_tick)]
 pub struct Density(pub f32);
 
 /// The mass (kg) the solver uses, derived once per change (never every step): the body's [`Mass`]

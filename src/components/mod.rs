@@ -55,6 +55,7 @@ use glam::{Quat, Vec3};
 /// part of a compound (a wheel of a car, a link of an arm).
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 #[require(Rotation, GlobalPose, BoundingVolume)]
+#[component(summary_tick)]
 pub struct Position(pub Vec3);
 
 impl Position {
@@ -69,6 +70,7 @@ impl Position {
 /// place boxes and planes. Contacts still act through the centre of mass: they do not yet turn
 /// bodies (the rigid-body solver of issue 10, stage 4).
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+#[component(summary_tick)]
 pub struct Rotation(pub Quat);
 
 impl Rotation {
@@ -82,6 +84,7 @@ impl Rotation {
 /// [`AngularVelocity`] and a computed [`Inertia`]: dynamic bodies turn by default.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 #[require(Position, Rotation, ComputedMass, SleepState, AngularVelocity, Inertia)]
+#[component(summary_tick)]
 pub struct Velocity(pub Vec3);
 
 impl Velocity {
@@ -94,10 +97,12 @@ impl Velocity {
 /// Force (N) applied during the next physics step, then cleared: game code adds to it, the step
 /// consumes it. Bodies without it cost the force stage nothing.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+#[component(summary_tick)]
 pub struct Force(pub Vec3);
 
 /// Linear drag coefficient `b` (N·s/m): the force `-b v`.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+#[component(summary_tick)]
 pub struct LinearDrag(pub f32);
 
 /// What the far end of a [`Spring`] holds.
@@ -146,6 +151,7 @@ pub struct RollingResistance(pub f32);
 /// The shape a body collides with, in the body's frame.
 #[derive(Component, Clone, Debug, PartialEq)]
 #[require(Position)]
+#[component(summary_tick)]
 pub struct Collider {
     /// The shape.
     pub shape: Shape,

@@ -35,6 +35,7 @@ pub mod spatial_query;
 mod step_app;
 pub mod transform_sync;
 pub mod validation;
+mod wake_on_writes;
 
 pub use broad_phase::{BroadPhaseFactory, BroadPhaseIndex, BroadPhasePairs, BroadPhasePlugin};
 pub use ccd::{CcdImpacts, CcdPlugin, CcdSettings};

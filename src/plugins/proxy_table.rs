@@ -41,6 +41,9 @@ pub(crate) struct ProxyTable {
     by_entity: EntityHashMap<Proxy>,
     entity_of: Vec<Entity>,
     uses: Vec<IdUse>,
+    /// A bit per id, set for awake moving bodies: the awake ids are found a word of 64 ids at
+    /// a time, so a scene at rest costs no pass over its sleeping bodies' ids.
+    awake: Vec<u64>,
     free: Vec<ProxyId>,
     released: Vec<ProxyId>,
     unbounded: Vec<Entity>,
@@ -66,10 +69,10 @@ impl ProxyTable {
         } else {
             let id = self.allocate(e);
             if moving {
-                self.uses[id as usize] = IdUse::Moving;
+                self.set_use(id, IdUse::Moving);
                 Proxy::Moving(id)
             } else {
-                self.uses[id as usize] = IdUse::Static;
+                self.set_use(id, IdUse::Static);
                 Proxy::Static(id)
             }
         };
@@ -83,7 +86,7 @@ impl ProxyTable {
         match proxy {
             Proxy::Moving(id) | Proxy::Static(id) => {
                 self.entity_of[id as usize] = Entity::PLACEHOLDER;
-                self.uses[id as usize] = IdUse::Free;
+                self.set_use(id, IdUse::Free);
                 self.released.push(id);
             }
             Proxy::Unbounded => {
@@ -107,13 +110,14 @@ impl ProxyTable {
         &self.unbounded
     }
 
-    /// Ids of awake moving bodies, ascending (one pass over a byte per id: no lookups).
+    /// Ids of awake moving bodies, ascending (a pass over a bit per id: no lookups).
     pub fn awake_moving_ids(&self) -> impl Iterator<Item = ProxyId> + '_ {
-        self.uses
-            .iter()
-            .enumerate()
-            .filter(|(_, u)| **u == IdUse::Moving)
-            .map(|(id, _)| id as ProxyId)
+        self.awake.iter().enumerate().flat_map(|(word, &bits)| {
+            let base = (word * 64) as ProxyId;
+            std::iter::successors(Some(bits), |b| Some(b & (b - 1)))
+                .take_while(|&b| b != 0)
+                .map(move |b| base + b.trailing_zeros() as ProxyId)
+        })
     }
 
     /// Whether id `id` holds a sleeping moving body.
@@ -124,7 +128,21 @@ impl ProxyTable {
     /// Records that the moving body `e` fell asleep or woke (nothing for other entities).
     pub fn set_asleep(&mut self, e: Entity, asleep: bool) {
         if let Some(Proxy::Moving(id)) = self.get(e) {
-            self.uses[id as usize] = if asleep { IdUse::Asleep } else { IdUse::Moving };
+            self.set_use(id, if asleep { IdUse::Asleep } else { IdUse::Moving });
+        }
+    }
+
+    /// Records what id `id` holds, keeping its awake bit.
+    fn set_use(&mut self, id: ProxyId, to: IdUse) {
+        self.uses[id as usize] = to;
+        let (word, bit) = (id as usize / 64, 1u64 << (id % 64));
+        if word >= self.awake.len() {
+            self.awake.resize(word + 1, 0);
+        }
+        if to == IdUse::Moving {
+            self.awake[word] |= bit;
+        } else {
+            self.awake[word] &= !bit;
         }
     }
 
@@ -174,5 +192,27 @@ mod tests {
         assert_eq!(t.awake_moving_ids().collect::<Vec<_>>(), vec![0, 2]);
         assert_eq!(t.register(d, false, false), Proxy::Unbounded);
         assert_eq!(t.unbounded(), &[d]);
+    }
+
+    #[test]
+    fn awake_ids_across_many_words_are_those_marked_awake_in_ascending_order() {
+        let mut world = World::new();
+        let mut t = ProxyTable::default();
+        let bodies: Vec<Entity> = (0..300).map(|_| world.spawn_empty().id()).collect();
+        for (i, &e) in bodies.iter().enumerate() {
+            t.register(e, true, i % 7 != 3);
+        }
+        for (i, &e) in bodies.iter().enumerate() {
+            if i % 5 == 0 || (64..128).contains(&i) {
+                t.set_asleep(e, true);
+            }
+        }
+        t.set_asleep(bodies[65], false);
+        t.unregister(bodies[299]);
+        let expected: Vec<ProxyId> = (0..299)
+            .filter(|&i| i % 7 != 3 && (i % 5 != 0 && !(64..128).contains(&i) || i == 65))
+            .map(|i| i as ProxyId)
+            .collect();
+        assert_eq!(t.awake_moving_ids().collect::<Vec<_>>(), expected);
     }
 }

@@ -28,8 +28,9 @@ use crate::plugins::core::PrepareWake;
 use crate::plugins::joints::ActiveJoint;
 use crate::plugins::narrow_phase::Contacts;
 use crate::plugins::required_resources::RequireResource;
+use crate::plugins::wake_on_writes::wake_on_game_changes;
 use crate::schedule::{PhysicsSchedule, PhysicsSet};
-use crate::settings::{Gravity, PhysicsTimestep, SleepSettings};
+use crate::settings::{PhysicsTimestep, SleepSettings};
 use crate::stats::PhysicsStats;
 use bevy_app::prelude::*;
 use bevy_ecs::entity::EntityHashMap;
@@ -122,134 +123,6 @@ impl Waker<'_, '_> {
             state.restart();
         }
     }
-}
-
-type Sleeper<'a> = (
-    Entity,
-    &'a mut SleepState,
-    (&'a Position, &'a Rotation, &'a Velocity),
-    Option<&'a AngularVelocity>,
-    (
-        Option<&'a Force>,
-        Option<&'a Torque>,
-        Option<&'a ForceAtPoint>,
-        Option<&'a Impulse>,
-    ),
-    (
-        (
-            Option<Ref<'a, Mass>>,
-            Option<Ref<'a, Density>>,
-            Option<Ref<'a, GravityScale>>,
-            Option<Ref<'a, LockedAxes>>,
-        ),
-        Option<Ref<'a, Collider>>,
-        Option<Ref<'a, Inertia>>,
-        Option<Ref<'a, LinearDrag>>,
-        Option<Ref<'a, AngularDrag>>,
-        Option<Ref<'a, ChildOf>>,
-        Option<Ref<'a, Children>>,
-    ),
-);
-/// Sleeping bodies game code wrote to since the last step: the only per-body work a sleeping
-/// body costs (change ticks, no values). It covers everything validation checks, so that
-/// validation and the other stages can leave sleeping bodies out: a bad value written to a
-/// sleeper wakes it and is then validated.
-type Touched = (With<Sleeping>, Or<(Moved, Pushed, Reshaped)>);
-type Moved = Or<(
-    Changed<Position>,
-    Changed<Rotation>,
-    Changed<Velocity>,
-    Changed<AngularVelocity>,
-)>;
-type Pushed = Or<(
-    Changed<Force>,
-    Changed<Torque>,
-    Changed<ForceAtPoint>,
-    Changed<Impulse>,
-    Changed<GravityScale>,
-)>;
-type Reshaped = Or<(
-    Changed<Mass>,
-    Changed<Density>,
-    Changed<LockedAxes>,
-    Changed<Collider>,
-    Changed<Inertia>,
-    Changed<LinearDrag>,
-    Changed<AngularDrag>,
-    Changed<ChildOf>,
-    Changed<Children>,
-)>;
-
-/// Wakes sleeping bodies that game code moved, turned, set moving, pushed or reshaped since the
-/// last step, and every body when gravity changed. Values the physics itself writes when a body
-/// falls asleep (pose, velocities, a spent force) wake it only if they differ from what it
-/// slept with; a write to anything else (mass, collider, drag, parent) wakes it.
-#[allow(clippy::type_complexity)]
-fn wake_on_game_changes(
-    mut sleepers: ParamSet<(
-        Query<Sleeper, Touched>,
-        Query<(Entity, &mut SleepState), With<Sleeping>>,
-    )>,
-    gravity: Option<Res<Gravity>>,
-    mut unset: (
-        RemovedComponents<Mass>,
-        RemovedComponents<Density>,
-        RemovedComponents<GravityScale>,
-        RemovedComponents<LockedAxes>,
-    ),
-    mut waker: Waker,
-) {
-    if gravity.is_some_and(|g| g.is_changed()) {
-        for (e, mut sleep) in &mut sleepers.p1() {
-            waker.wake(e, Some(&mut sleep));
-        }
-        return;
-    }
-    // A removed mass, density, gravity scale or lock changes what the body weighs or feels,
-    // or how it may move.
-    let (mass, density, scale, locks) = &mut unset;
-    let removed = mass.read().chain(density.read()).chain(scale.read());
-    for e in removed.chain(locks.read()) {
-        if let Ok((e, mut sleep)) = sleepers.p1().get_mut(e) {
-            waker.wake(e, Some(&mut sleep));
-        }
-    }
-    for (e, mut sleep, (p, r, v), w, pushes, settings) in &mut sleepers.p0() {
-        let (force, torque, at_point, impulse) = pushes;
-        let pushed = force.is_some_and(|f| f.0 != Vec3::ZERO)
-            || torque.is_some_and(|t| t.0 != Vec3::ZERO)
-            || at_point.is_some_and(|f| !f.is_empty())
-            || impulse.is_some_and(|i| !i.is_empty());
-        let spun = w.is_some_and(|w| w.0 != Vec3::ZERO);
-        let moved = p.0 != sleep.at || r.0 != sleep.orientation || v.0 != Vec3::ZERO;
-        let (
-            (mass, density, gravity_scale, locks),
-            collider,
-            inertia,
-            drag,
-            angular_drag,
-            parent,
-            children,
-        ) = settings;
-        let rebuilt = written(mass)
-            || written(density)
-            || written(gravity_scale)
-            || written(locks)
-            || written(collider)
-            || written(inertia)
-            || written(drag)
-            || written(angular_drag)
-            || written(parent)
-            || written(children);
-        if pushed || spun || moved || rebuilt {
-            waker.wake(e, Some(&mut sleep));
-        }
-    }
-}
-
-/// Whether an optional component was written since the system last ran.
-fn written<T: Component>(c: Option<Ref<T>>) -> bool {
-    c.is_some_and(|c| c.is_changed())
 }
 
 /// Takes the [`Sleeping`] marker off `e` when the commands apply (nothing if `e` is gone by
