@@ -93,6 +93,11 @@ pub fn diff_sorted(old: &[Pair], new: &[Pair], added: &mut Vec<Pair>, removed: &
 /// Two sorted lists without common items merged into `out`.
 pub fn merge_sorted(a: &[Pair], b: &[Pair], out: &mut Vec<Pair>) {
     out.clear();
+    out.reserve(a.len() + b.len());
+    if b.len() * 8 < a.len() {
+        merge_few(a, b, out);
+        return;
+    }
     let (mut i, mut j) = (0, 0);
     while i < a.len() && j < b.len() {
         if a[i] < b[j] {
@@ -105,6 +110,21 @@ pub fn merge_sorted(a: &[Pair], b: &[Pair], out: &mut Vec<Pair>) {
     }
     out.extend_from_slice(&a[i..]);
     out.extend_from_slice(&b[j..]);
+}
+
+/// [`merge_sorted`] for a `b` much shorter than `a`: each pair of `b` finds its place in what
+/// is left of `a` by binary search, and the run of `a` before it is copied whole. The regions
+/// merge a few new pairs into many kept ones, where a pair-by-pair merge spent a compare and a
+/// branch on every kept pair.
+fn merge_few(a: &[Pair], b: &[Pair], out: &mut Vec<Pair>) {
+    let mut rest = a;
+    for &p in b {
+        let before = rest.partition_point(|q| *q < p);
+        out.extend_from_slice(&rest[..before]);
+        out.push(p);
+        rest = &rest[before..];
+    }
+    out.extend_from_slice(rest);
 }
 
 #[cfg(test)]
@@ -123,5 +143,43 @@ mod tests {
         );
         assert_eq!(added, [p(0, 2), p(4, 5)]);
         assert_eq!(removed, [p(0, 1), p(2, 5)]);
+    }
+
+    #[test]
+    fn merging_gives_the_sorted_union_whether_one_side_is_short_or_not() {
+        let mut seed = 7u64;
+        let mut next = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 40) as u32 % 500
+        };
+        for (na, nb) in [
+            (0, 0),
+            (40, 0),
+            (0, 40),
+            (200, 3),
+            (200, 30),
+            (50, 50),
+            (3, 200),
+        ] {
+            let mut all: Vec<Pair> = (0..na + nb)
+                .map(|_| Pair::ordered(next(), next() + 500))
+                .collect();
+            all.sort_unstable();
+            all.dedup();
+            let (mut a, mut b) = (Vec::new(), Vec::new());
+            for p in &all {
+                // Spread at random, so that `b`'s pairs fall between `a`'s.
+                if (next() as usize) % (na + nb) < nb {
+                    b.push(*p)
+                } else {
+                    a.push(*p)
+                }
+            }
+            let mut out = Vec::new();
+            merge_sorted(&a, &b, &mut out);
+            assert_eq!(out, all, "{na} + {nb}");
+        }
     }
 }

@@ -8,7 +8,8 @@
 //! become exactly zero and each body gets the [`Sleeping`] marker. The marker moves it to
 //! archetypes that every per-step query leaves out (`Without<Sleeping>`), and the broad phase
 //! stops pairing it with scenery and other sleepers, so a sleeping island costs no pass over its
-//! bodies; only the wake-up check below looks at them, through change ticks. The contacts of a
+//! bodies; only the wake-up check (`wake_on_writes`) looks at them, through the summary ticks of
+//! their tables (one comparison per column of a sleeping table, not per body). The contacts of a
 //! sleeping island are kept (no collision ends by falling asleep). An island touching a moving
 //! kinematic body or a body on a spring never sleeps; one that comes to rest against a sleeping
 //! island joins it.
