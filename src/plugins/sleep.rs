@@ -203,6 +203,8 @@ struct IslandScratch {
     islands: IslandBuilder,
     slots: EntityHashMap<Slot>,
     awake: Vec<Entity>,
+    /// The kinematic bodies and whether each moves.
+    kinematic: Vec<(Entity, bool)>,
     stillness: Vec<Stillness>,
     /// Per awake body: the sleeping island it rests against (0: none).
     joins: Vec<u64>,
@@ -229,6 +231,15 @@ fn fall_asleep(
 ) {
     let s = &mut *scratch;
     count_stillness(&mut bodies, settings.speed, timestep.dt(), s);
+    stats.set_counter("sleep/awake_bodies", s.awake.len() as f64);
+    stats.set_counter("sleep/sleeping_islands", islands.members.len() as f64);
+    if !s.stillness.iter().any(|b| b.still_for >= settings.time) {
+        // An island sleeps once all its bodies have been still for the sleep time; while no
+        // body has, none can, and the islands are not built (a scene in motion pays one pass
+        // over its bodies here, not a lookup per contact and joint).
+        return;
+    }
+    index_slots(s);
     s.islands.reset(s.awake.len());
     s.joins.clear();
     s.joins.resize(s.awake.len(), 0);
@@ -265,25 +276,34 @@ fn fall_asleep(
             }
         }
     }
-    stats.set_counter("sleep/awake_bodies", s.awake.len() as f64);
     stats.set_counter("sleep/sleeping_islands", islands.members.len() as f64);
 }
 
-/// Lists the awake dynamic bodies with their stillness (counting it on) and every body's slot.
+/// Every awake and kinematic body's slot, for the contacts and joints to find.
+fn index_slots(s: &mut IslandScratch) {
+    s.slots.clear();
+    let awake = s.awake.iter().enumerate();
+    s.slots.extend(awake.map(|(i, &e)| (e, Slot::Awake(i))));
+    let kinematic = s.kinematic.iter();
+    s.slots
+        .extend(kinematic.map(|&(e, moving)| (e, Slot::Kinematic { moving })));
+}
+
+/// Lists the awake dynamic bodies with their stillness (counting it on), and the kinematic ones.
 fn count_stillness(
     bodies: &mut Query<Candidate, CandidateFilter>,
     speed: f32,
     dt: f32,
     s: &mut IslandScratch,
 ) {
-    s.slots.clear();
     s.awake.clear();
+    s.kinematic.clear();
     s.stillness.clear();
     for (e, mut sleep, _, v, m, w, volume) in bodies.iter_mut() {
         let spin = w.as_ref().map_or(0.0, |w| w.0.length());
         if m.inverse() == 0.0 {
             let moving = v.0 != Vec3::ZERO || spin != 0.0;
-            s.slots.insert(e, Slot::Kinematic { moving });
+            s.kinematic.push((e, moving));
             continue;
         }
         // A turning body's surface moves at up to |ω| times its reach (Box2D's sleep test).
@@ -294,7 +314,6 @@ fn count_stillness(
         } else {
             sleep.still_for += dt;
         }
-        s.slots.insert(e, Slot::Awake(s.awake.len()));
         s.awake.push(e);
         s.stillness.push(Stillness {
             still_for: sleep.still_for,
