@@ -371,64 +371,56 @@ fn each_of_17_writes_wakes_only_the_body_written_among_60_sleepers_in_three_tabl
         urto::step(app.world_mut(), 1).unwrap();
         assert!(balls.iter().all(|&b| asleep(&app, b)), "unseen write {i}");
     }
-    let writes: [Write; 17] = [
-        |e| e.get_mut::<Position>().unwrap().0.x += 0.1,
-        |e| e.get_mut::<Rotation>().unwrap().0 = Quat::from_rotation_z(0.3),
-        |e| e.get_mut::<Velocity>().unwrap().0 = Vec3::Z,
-        |e| {
+    // (ball, write): balls 20 to 35 and 50, rows of all three tables; a write to a component
+    // the ball has changes it in place (`Force`, `LinearDrag` and `Mass` on balls `i % 3 == 2`),
+    // one it lacks is inserted (the ball moves to a table of its own).
+    let writes: [(usize, Write); 17] = [
+        (20, |e| e.get_mut::<Position>().unwrap().0.x += 0.1),
+        (21, |e| {
+            e.get_mut::<Rotation>().unwrap().0 = Quat::from_rotation_z(0.3)
+        }),
+        (22, |e| e.get_mut::<Velocity>().unwrap().0 = Vec3::Z),
+        (23, |e| {
             e.insert(AngularVelocity::new(0.0, 0.0, 2.0));
-        },
-        |e| match e.get_mut::<Force>() {
-            Some(mut f) => f.0 = Vec3::X,
-            None => {
-                e.insert(Force(Vec3::X));
-            }
-        },
-        |e| {
+        }),
+        (26, |e| e.get_mut::<Force>().unwrap().0 = Vec3::X),
+        (25, |e| {
             e.insert(Torque(Vec3::Z));
-        },
-        |e| {
+        }),
+        (24, |e| {
             let mut push = ForceAtPoint::default();
             push.add(Vec3::X, Vec3::Z);
             e.insert(push);
-        },
-        |e| {
+        }),
+        (27, |e| {
             e.insert(Impulse::new(Vec3::X));
-        },
-        |e| {
+        }),
+        (28, |e| {
             e.insert(GravityScale(0.5));
-        },
-        |e| {
-            e.insert(Mass(2.0));
-        },
-        |e| {
+        }),
+        (29, |e| e.get_mut::<Mass>().unwrap().0 = 2.0),
+        (30, |e| {
             e.insert(Density(3.0));
-        },
-        |e| {
+        }),
+        (31, |e| {
             e.insert(LockedAxes::ROTATION_LOCKED);
-        },
-        |e| {
+        }),
+        (32, |e| {
             e.insert(Collider::sphere(0.4));
-        },
-        |e| {
+        }),
+        (33, |e| {
             e.insert(Inertia::custom(Vec3::ONE, Quat::IDENTITY));
-        },
-        |e| match e.get_mut::<LinearDrag>() {
-            Some(mut d) => d.0 = 0.3,
-            None => {
-                e.insert(LinearDrag(0.3));
-            }
-        },
-        |e| {
+        }),
+        (35, |e| e.get_mut::<LinearDrag>().unwrap().0 = 0.3),
+        (34, |e| {
             e.insert(AngularDrag(0.2));
-        },
-        |e| {
+        }),
+        (50, |e| {
             e.remove::<Mass>();
-        },
+        }),
     ];
-    for (i, write) in writes.iter().enumerate() {
-        // Rows of all three tables in turn; the `Mass` removal to a ball spawned with one.
-        let written = if i == 16 { balls[50] } else { balls[20 + i] };
+    for (i, &(ball, write)) in writes.iter().enumerate() {
+        let written = balls[ball];
         write(&mut app.world_mut().entity_mut(written));
         urto::step(app.world_mut(), 1).unwrap();
         assert!(!asleep(&app, written), "write {i} woke its body");

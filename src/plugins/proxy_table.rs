@@ -114,7 +114,9 @@ impl ProxyTable {
     pub fn awake_moving_ids(&self) -> impl Iterator<Item = ProxyId> + '_ {
         self.awake.iter().enumerate().flat_map(|(word, &bits)| {
             let base = (word * 64) as ProxyId;
-            std::iter::successors(Some(bits), |b| Some(b & (b - 1)))
+            // Each step clears the lowest set bit; `wrapping_sub`: `successors` computes one
+            // step past the last bit (0 - 1 would overflow in a debug build).
+            std::iter::successors(Some(bits), |b| Some(b & b.wrapping_sub(1)))
                 .take_while(|&b| b != 0)
                 .map(move |b| base + b.trailing_zeros() as ProxyId)
         })
@@ -132,7 +134,7 @@ impl ProxyTable {
         }
     }
 
-    /// Records what id `id` holds, keeping its awake bit.
+    /// Records what id `id` holds, and sets or clears its bit in `awake` to match.
     fn set_use(&mut self, id: ProxyId, to: IdUse) {
         self.uses[id as usize] = to;
         let (word, bit) = (id as usize / 64, 1u64 << (id % 64));

@@ -213,8 +213,9 @@ struct IslandScratch {
     keys: Vec<u64>,
 }
 
-/// Counts how long each awake dynamic body has been still, groups the awake bodies into islands
-/// by the step's contacts, and puts to sleep the islands still for [`SleepSettings::time`].
+/// Counts how long each awake dynamic body has been still and, once some body has been still
+/// for [`SleepSettings::time`], groups the awake bodies into islands by the step's contacts
+/// and joints and puts to sleep the islands still for that long.
 #[allow(clippy::too_many_arguments)]
 fn fall_asleep(
     mut bodies: Query<Candidate, CandidateFilter>,

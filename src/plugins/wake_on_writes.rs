@@ -70,6 +70,8 @@ pub(crate) struct WakeScratch {
     /// Per row of the table being read: [`TOUCHED`] and [`REMADE`] bits.
     rows: Vec<u8>,
     woken: Vec<Entity>,
+    /// Whether the sleeping tables could not be read contiguously, and it was said.
+    warned: bool,
 }
 
 /// A row some column of which was written since the last check.
@@ -112,11 +114,18 @@ pub(crate) fn wake_on_game_changes(
     let removed = mass.read().chain(density.read()).chain(scale.read());
     scratch.woken.extend(removed.chain(locks.read()));
     // Every component of the query is stored in tables, so the query is dense and
-    // `contiguous_iter` cannot fail (the wake-up tests would see nothing wake if it did).
-    if let Ok(tables) = sleepers.p0().contiguous_iter() {
-        for table in tables {
-            check_table(table, &mut scratch.rows, &mut scratch.woken);
+    // `contiguous_iter` does not fail; were one made a sparse set, the error says so.
+    match sleepers.p0().contiguous_iter() {
+        Ok(tables) => {
+            for table in tables {
+                check_table(table, &mut scratch.rows, &mut scratch.woken);
+            }
         }
+        Err(e) if !scratch.warned => {
+            scratch.warned = true;
+            log::error!("urto: game writes cannot wake sleeping bodies: {e}");
+        }
+        Err(_) => {}
     }
     for e in scratch.woken.drain(..) {
         if let Ok((e, mut sleep)) = sleepers.p1().get_mut(e) {
@@ -132,20 +141,16 @@ fn check_table(table: SleeperTable<'_, '_>, rows: &mut Vec<u8>, woken: &mut Vec<
     let (p, r, v) = (Column::new(p), Column::new(r), Column::new(v));
     let (w, f, t) = (Column::maybe(w), Column::maybe(f), Column::maybe(t));
     let (fp, imp) = (Column::maybe(fp), Column::maybe(imp));
-    let moved = [p.written(), r.written(), v.written(), written(&w)];
-    let pushed = [written(&f), written(&t), written(&fp), written(&imp)];
+    let motion_ticks = [p.written(), r.written(), v.written(), written(&w)];
+    let push_ticks = [written(&f), written(&t), written(&fp), written(&imp)];
     let remade = remade_ticks(made_of);
-    let any = moved
-        .iter()
-        .chain(&pushed)
-        .chain(&remade)
-        .any(Option::is_some);
-    if !any {
+    let mut columns = motion_ticks.iter().chain(&push_ticks).chain(&remade);
+    if columns.all(Option::is_none) {
         return;
     }
     rows.clear();
     rows.resize(entities.len(), 0);
-    for ticks in moved.into_iter().chain(pushed).flatten() {
+    for ticks in motion_ticks.into_iter().chain(push_ticks).flatten() {
         mark(rows, &ticks, TOUCHED);
     }
     for ticks in remade.iter().flatten() {
