@@ -428,3 +428,68 @@ fn each_of_17_writes_wakes_only_the_body_written_among_60_sleepers_in_three_tabl
         assert_eq!(woken, i + 1, "write {i} woke only its body");
     }
 }
+
+/// Static bodies settle after their first step (they leave the change scans); a game's later
+/// writes to one still reach every stage within a step: a box moved under a falling ball
+/// catches it, a box whose collider grew lifts the ball resting on it, and a box made dynamic
+/// falls; a box moved through its `Transform` catches a ball too. Without the writes the balls
+/// would rest on the ground (centre 0.5 m up) and the box
+/// would hang at 3 m.
+#[test]
+fn a_settled_static_moved_reshaped_or_made_dynamic_acts_on_the_next_step_within_1cm() {
+    let mut app = sleepy_app();
+    let unit_box = || Collider::cuboid(0.5, 0.5, 0.5);
+    let far_box = app
+        .world_mut()
+        .spawn((unit_box(), Position(Vec3::new(20.0, 0.0, 0.5)), Static))
+        .id();
+    let under_box = app
+        .world_mut()
+        .spawn((unit_box(), Position(Vec3::new(5.0, 0.0, 0.5)), Static))
+        .id();
+    let hanging_box = app
+        .world_mut()
+        .spawn((unit_box(), Position(Vec3::new(-5.0, 0.0, 3.0)), Static))
+        .id();
+    let drawn_box = app
+        .world_mut()
+        .spawn((
+            unit_box(),
+            Position(Vec3::new(40.0, 0.0, 0.5)),
+            bevy_transform::components::Transform::from_xyz(40.0, 0.0, 0.5),
+            Static,
+        ))
+        .id();
+    let falling = common::ball(&mut app, Vec3::new(0.0, 0.0, 2.5));
+    let falling_on_drawn = common::ball(&mut app, Vec3::new(-10.0, 0.0, 2.5));
+    let resting = common::ball(&mut app, Vec3::new(5.0, 0.0, 1.5));
+    urto::step(app.world_mut(), 5).unwrap();
+    app.world_mut().get_mut::<Position>(far_box).unwrap().0 = Vec3::new(0.0, 0.0, 0.5);
+    *app.world_mut().get_mut::<Collider>(under_box).unwrap() = Collider::cuboid(1.0, 1.0, 1.0);
+    let mut drawn = app
+        .world_mut()
+        .get_mut::<bevy_transform::components::Transform>(drawn_box);
+    drawn.as_mut().unwrap().translation = Vec3::new(-10.0, 0.0, 0.5);
+    app.world_mut()
+        .entity_mut(hanging_box)
+        .remove::<Static>()
+        .insert((Velocity::default(), Mass(1.0)));
+    urto::step(app.world_mut(), 240).unwrap();
+    let on_moved_box = z(&app, falling);
+    assert!(
+        (on_moved_box - 1.5).abs() < 0.01,
+        "caught at z = {on_moved_box}"
+    );
+    let on_grown_box = z(&app, resting);
+    assert!(
+        (on_grown_box - 2.0).abs() < 0.01,
+        "lifted to z = {on_grown_box}"
+    );
+    let on_drawn_box = z(&app, falling_on_drawn);
+    assert!(
+        (on_drawn_box - 1.5).abs() < 0.01,
+        "caught by the Transform's box at z = {on_drawn_box}"
+    );
+    let fallen = z(&app, hanging_box);
+    assert!((fallen - 0.5).abs() < 0.01, "fell to z = {fallen}");
+}

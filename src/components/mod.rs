@@ -253,6 +253,7 @@ impl Collider {
 /// hierarchy it bounds the node's own collider *and* all its descendants (the scene graph is the
 /// BV hierarchy); empty for a body with no collider at or below it.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+#[component(summary_tick)]
 pub struct BoundingVolume(pub Aabb);
 
 impl BoundingVolume {
@@ -274,6 +275,7 @@ impl BoundingVolume {
 /// [`Position`] and [`Rotation`], which the next propagation turns into this
 /// ([`GlobalPose::propagated`] is for a stage that replaces the propagation).
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+#[component(summary_tick)]
 pub struct GlobalPose(pub(crate) Isometry);
 
 impl GlobalPose {

@@ -36,6 +36,7 @@ use crate::plugins::core::PrepareIndex;
 use crate::plugins::hierarchy::HierarchyInstalled;
 use crate::plugins::proxy_table::{Proxy, ProxyTable};
 use crate::plugins::required_resources::RequireResource;
+use crate::plugins::settle::Unsettled;
 use crate::plugins::soft_step::{Lookahead, LookaheadParams};
 use crate::plugins::validation::quarantine;
 use crate::schedule::{BroadPhaseSystems, PhysicsSchedule, SubstepSchedule};
@@ -236,8 +237,9 @@ type Moved = (
         Changed<AngularVelocity>,
     )>,
     Without<Sleeping>,
+    Unsettled,
 );
-type NoLongerRoot = Or<(Added<Quarantined>, Changed<ChildOf>)>;
+type NoLongerRoot = (Or<(Added<Quarantined>, Changed<ChildOf>)>, Unsettled);
 
 /// Brings the structures in step with the world: registers new roots (in bulk), moves changed
 /// ones, drops removed, despawned, quarantined and re-parented ones, then commits. Only roots of

@@ -7,6 +7,8 @@ use crate::plugins::forces::GatheredForces;
 use crate::plugins::narrow_phase::{Contacts, HierarchyVisits, OverlappingLeaves, SensorOverlaps};
 use crate::plugins::required_resources::{RequireResource, restore_required_resources};
 use crate::plugins::settings_check::check_settings;
+use crate::plugins::settle::{settle_statics, unsettle_written};
+use crate::plugins::transform_sync::ReadGameTransforms;
 use crate::schedule::{
     BroadPhaseSystems, PhysicsSchedule, PhysicsSet, SubstepSchedule, SubstepSet,
 };
@@ -76,6 +78,12 @@ impl Plugin for PhysicsCorePlugin {
                 .in_set(PhysicsSet::Prepare)
                 .before(PrepareWake),
             run_substeps.in_set(PhysicsSet::Substeps),
+            // Before the game's `Transform`s are read: that scan leaves settled bodies out.
+            unsettle_written
+                .in_set(PhysicsSet::Prepare)
+                .before(ReadGameTransforms)
+                .before(PrepareWake),
+            settle_statics.after(PhysicsSet::Debug),
         ));
         physics.configure_sets(
             (PrepareWake, PrepareStart, PrepareIndex)

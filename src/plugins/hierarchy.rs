@@ -19,6 +19,7 @@ use crate::hierarchy::{refit_order, topmost_marked};
 use crate::plugins::broad_phase::IndexBodies;
 use crate::plugins::core::PrepareIndex;
 use crate::plugins::required_resources::RequireResource;
+use crate::plugins::settle::Unsettled;
 use crate::plugins::validation::quarantine;
 use crate::schedule::{BroadPhaseSystems, PhysicsSchedule, PhysicsSet, SubstepSchedule};
 use crate::stats::{PhysicsStats, Stage};
@@ -94,6 +95,7 @@ type LocalChanged = (
     Or<(Changed<Position>, Changed<Rotation>, Changed<ChildOf>)>,
     Without<Quarantined>,
     Without<Sleeping>,
+    Unsettled,
 );
 
 type FlatPose<'a> = (&'a Position, &'a Rotation, &'a mut GlobalPose);
@@ -174,7 +176,7 @@ fn remember_part_poses(
     }
 }
 
-type PartMoved = (InHierarchy, Changed<GlobalPose>);
+type PartMoved = (InHierarchy, Changed<GlobalPose>, Unsettled);
 
 type RefitNode<'a> = (
     Option<&'a Collider>,
@@ -187,6 +189,7 @@ type FlatRefit<'a> = (Entity, &'a Collider, &'a GlobalPose, &'a mut BoundingVolu
 type OwnChanged = (
     Or<(Changed<GlobalPose>, Changed<Collider>, Changed<Children>)>,
     Without<Sleeping>,
+    Unsettled,
 );
 
 /// Refits volumes: a collider outside any hierarchy from its own pose (one linear pass); in a

@@ -14,6 +14,7 @@ use crate::geometry::{Isometry, MassProperties};
 use crate::hierarchy::climb;
 use crate::plugins::core::PrepareIndex;
 use crate::plugins::required_resources::RequireResource;
+use crate::plugins::settle::Unsettled;
 use crate::schedule::PhysicsSchedule;
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
@@ -52,6 +53,7 @@ struct MassBuffers {
 type ChangedRoot = (
     Without<ChildOf>,
     Without<Sleeping>,
+    Unsettled,
     Or<(
         Changed<Collider>,
         Changed<Mass>,
@@ -62,6 +64,7 @@ type ChangedRoot = (
 );
 type ChangedPart = (
     With<ChildOf>,
+    Unsettled,
     Or<(
         Changed<Collider>,
         Changed<ChildOf>,

@@ -17,6 +17,7 @@
 //! Bodies without a `Transform` cost nothing, and a world with none does not run the systems.
 
 use crate::components::{Position, Quarantined, Rotation, Sleeping};
+use crate::plugins::settle::Unsettled;
 use crate::schedule::{PhysicsSchedule, PhysicsSet};
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
@@ -103,7 +104,7 @@ type GameWritten<'a> = (
 
 /// The game-to-physics direction of the module notes.
 fn read_game_transforms(
-    mut bodies: Query<GameWritten, (Changed<Transform>, Without<Quarantined>)>,
+    mut bodies: Query<GameWritten, (Changed<Transform>, Without<Quarantined>, Unsettled)>,
     mut commands: Commands,
 ) {
     for (e, t, mut position, rotation, written) in &mut bodies {
@@ -138,6 +139,7 @@ type Moved = (
     Or<(Changed<Position>, Changed<Rotation>)>,
     Without<Quarantined>,
     Without<Sleeping>,
+    Unsettled,
 );
 
 type Drawn<'a> = (

@@ -10,6 +10,7 @@
 
 use crate::components::*;
 use crate::plugins::core::PrepareStart;
+use crate::plugins::settle::Unsettled;
 use crate::schedule::PhysicsSchedule;
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
@@ -52,6 +53,7 @@ type BodyData<'a> = (
 type ChangedBody = (
     Without<Quarantined>,
     Without<Sleeping>,
+    Unsettled,
     Or<(
         Changed<Position>,
         Changed<Velocity>,
@@ -96,6 +98,7 @@ type AngularData<'a> = (
 type ChangedAngular = (
     Without<Quarantined>,
     Without<Sleeping>,
+    Unsettled,
     Or<(
         Changed<AngularVelocity>,
         Changed<Torque>,
@@ -192,7 +195,7 @@ pub(crate) const MAX_HIERARCHY_DEPTH: u32 = 1 << 16;
 /// climbs stop at settled nodes, so a step costs time linear in the nodes met however deep the
 /// chains (a 10,000-deep chain took seconds when each node climbed to its root).
 fn quarantine_parent_cycles(
-    changed: Query<Entity, (Changed<ChildOf>, Without<Quarantined>)>,
+    changed: Query<Entity, (Changed<ChildOf>, Without<Quarantined>, Unsettled)>,
     parents: Query<&ChildOf>,
     mut settled: Local<EntityHashSet>,
     mut path: Local<EntityHashSet>,

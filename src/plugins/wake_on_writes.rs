@@ -223,7 +223,7 @@ fn written<'w, T>(column: &Option<Column<'w, T>>) -> Option<ContiguousComponentT
 }
 
 /// The written ticks of an optional column whose values the check does not read.
-fn written_ticks<T>(
+pub(crate) fn written_ticks<T>(
     column: Option<ContiguousRef<'_, T>>,
 ) -> Option<ContiguousComponentTicksRef<'_>> {
     Column::maybe(column).and_then(|c| c.ticks)
@@ -235,7 +235,7 @@ fn at<'a, T>(column: &'a Option<Column<'_, T>>, row: usize) -> Option<&'a T> {
 }
 
 /// Sets `bit` on the rows `ticks` says were written since the last check.
-fn mark(rows: &mut [u8], ticks: &ContiguousComponentTicksRef<'_>, bit: u8) {
+pub(crate) fn mark(rows: &mut [u8], ticks: &ContiguousComponentTicksRef<'_>, bit: u8) {
     for (flags, written) in rows.iter_mut().zip(ticks.is_changed_iter()) {
         *flags |= bit * u8::from(written);
     }
