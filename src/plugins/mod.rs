@@ -34,6 +34,7 @@ pub mod sleep;
 pub mod soft_step;
 pub mod spatial_query;
 mod step_app;
+mod table_ticks;
 pub mod transform_sync;
 pub mod validation;
 mod wake_on_writes;

@@ -17,7 +17,7 @@
 //! not settle: a part's change re-fits its root's volume in mid-step, after the check.
 
 use crate::components::*;
-use crate::plugins::wake_on_writes::{mark, written_ticks};
+use crate::plugins::table_ticks::{dense, mark, written_ticks};
 use bevy_ecs::bundle::InsertMode;
 use bevy_ecs::change_detection::ContiguousComponentTicksRef;
 use bevy_ecs::prelude::*;
@@ -93,18 +93,15 @@ pub(crate) fn unsettle_written(
     s.written
         .extend(lost_collider.read().filter(|&e| settled.contains(e)));
     // Every watched component is stored in tables, so the query is dense.
-    match settled.contiguous_iter() {
-        Ok(tables) => {
+    let cannot = "settled static bodies cannot be checked for writes";
+    match dense(settled.contiguous_iter(), &mut s.warned, cannot) {
+        Some(tables) => {
             for table in tables {
                 written_rows(table, &mut s.rows, &mut s.written);
             }
         }
-        Err(e) if !s.warned => {
-            s.warned = true;
-            log::error!("urto: settled static bodies cannot be checked for writes: {e}");
-            s.written.extend(settled.iter().map(|(e, ..)| e));
-        }
-        Err(_) => s.written.extend(settled.iter().map(|(e, ..)| e)),
+        // Unchecked, every settled body is taken as written: the scans see them all.
+        None => s.written.extend(settled.iter().map(|(e, ..)| e)),
     }
     for e in s.written.drain(..) {
         if let Ok(mut entity) = commands.get_entity(e) {

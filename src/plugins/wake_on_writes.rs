@@ -17,6 +17,7 @@
 
 use crate::components::*;
 use crate::plugins::sleep::Waker;
+use crate::plugins::table_ticks::{dense, if_written, mark, written_ticks};
 use crate::settings::Gravity;
 use bevy_ecs::change_detection::{ContiguousComponentTicksRef, ContiguousRef};
 use bevy_ecs::prelude::*;
@@ -115,17 +116,11 @@ pub(crate) fn wake_on_game_changes(
     scratch.woken.extend(removed.chain(locks.read()));
     // Every component of the query is stored in tables, so the query is dense and
     // `contiguous_iter` does not fail; were one made a sparse set, the error says so.
-    match sleepers.p0().contiguous_iter() {
-        Ok(tables) => {
-            for table in tables {
-                check_table(table, &mut scratch.rows, &mut scratch.woken);
-            }
-        }
-        Err(e) if !scratch.warned => {
-            scratch.warned = true;
-            log::error!("urto: game writes cannot wake sleeping bodies: {e}");
-        }
-        Err(_) => {}
+    let readable = sleepers.p0();
+    let cannot = "game writes cannot wake sleeping bodies";
+    let tables = dense(readable.contiguous_iter(), &mut scratch.warned, cannot);
+    for table in tables.into_iter().flatten() {
+        check_table(table, &mut scratch.rows, &mut scratch.woken);
     }
     for e in scratch.woken.drain(..) {
         if let Ok((e, mut sleep)) = sleepers.p1().get_mut(e) {
@@ -200,10 +195,9 @@ struct Column<'w, T> {
 impl<'w, T> Column<'w, T> {
     fn new(column: ContiguousRef<'w, T>) -> Self {
         let (values, ticks) = ContiguousRef::split(column);
-        let written = ticks.summary_tick_is_changed() != Some(false);
         Self {
             values,
-            ticks: written.then_some(ticks),
+            ticks: if_written(ticks),
         }
     }
 
@@ -222,21 +216,7 @@ fn written<'w, T>(column: &Option<Column<'w, T>>) -> Option<ContiguousComponentT
     column.as_ref().and_then(Column::written)
 }
 
-/// The written ticks of an optional column whose values the check does not read.
-pub(crate) fn written_ticks<T>(
-    column: Option<ContiguousRef<'_, T>>,
-) -> Option<ContiguousComponentTicksRef<'_>> {
-    Column::maybe(column).and_then(|c| c.ticks)
-}
-
 /// The value of an optional column at `row`.
 fn at<'a, T>(column: &'a Option<Column<'_, T>>, row: usize) -> Option<&'a T> {
     column.as_ref().map(|c| &c.values[row])
-}
-
-/// Sets `bit` on the rows `ticks` says were written since the last check.
-pub(crate) fn mark(rows: &mut [u8], ticks: &ContiguousComponentTicksRef<'_>, bit: u8) {
-    for (flags, written) in rows.iter_mut().zip(ticks.is_changed_iter()) {
-        *flags |= bit * u8::from(written);
-    }
 }
