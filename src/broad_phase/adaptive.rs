@@ -12,8 +12,9 @@
 //! The rule: after each commit of the incremental SAP in which a box came, went or moved (a
 //! commit re-sending the same boxes says nothing about the motion), a step with more than
 //! [`AdaptiveSweep::SWAPS_PER_SORT_UNIT`]` · n log₂ n` swaps (times `√(n / 10k)` past 10k
-//! bodies, where the rebuild starts missing the cache) is a strike; two strikes in a row
-//! move every body into a sort and sweep. Every [`AdaptiveSweep::PROBE_PERIOD`] such commits
+//! bodies, where the rebuild starts missing the cache) is a strike for each whole budget it
+//! spent; two strikes in a row (one commit at twice the budget, or two just over it) move every
+//! body into a sort and sweep. Every [`AdaptiveSweep::PROBE_PERIOD`] such commits
 //! the bodies go back to the SAP to see whether the motion has calmed (if not, two commits later
 //! they return). A switch costs one bulk insertion; it changes no pair, and the commit that
 //! switches reports the changes the old structure found.
@@ -98,8 +99,8 @@ impl AdaptiveSweep {
     /// (its random accesses miss the cache: 35 ns a unit at 10k bodies, 109 ns at 100k, while a
     /// swap stays near 3.3 ns), so the swap budget grows with it.
     pub const CACHE_SCENE: f64 = 10_000.0;
-    /// Losing commits in a row that trigger the fallback (commits that moved nothing are not
-    /// counted, here and below).
+    /// Strikes in a row that trigger the fallback: a losing commit is one strike per whole swap
+    /// budget it spent (commits that moved nothing are not counted, here and below).
     pub const STRIKES: u32 = 2;
     /// Commits after which sorting from scratch hands the bodies back to the SAP to try again.
     pub const PROBE_PERIOD: u32 = 120;
@@ -141,8 +142,16 @@ impl AdaptiveSweep {
                 let n = sap.len().max(2) as f64;
                 let cache = (n / Self::CACHE_SCENE).max(1.0).sqrt();
                 let budget = Self::SWAPS_PER_SORT_UNIT * cache * n * n.log2();
-                let losing = sap.stats().endpoint_swaps as f64 > budget;
-                self.strikes = if losing { self.strikes + 1 } else { 0 };
+                // A losing commit is as many strikes as whole budgets it spent: a commit that
+                // swapped ten budgets' worth will not do better next time, and waiting for a
+                // second strike cost the 10,000-ball net one commit of 30M swaps (1.2 billion
+                // instructions, a sixth of its first 60 steps).
+                let spent = sap.stats().endpoint_swaps as f64 / budget;
+                self.strikes = if spent > 1.0 {
+                    self.strikes.saturating_add(spent as u32)
+                } else {
+                    0
+                };
                 (self.strikes >= Self::STRIKES).then(|| Engine::FromScratch(Box::default()))
             }
             Engine::FromScratch(_) if large => Some(Engine::Regions(Box::default())),
@@ -406,6 +415,45 @@ mod tests {
         }
         assert!(adaptive.is_sorting_from_scratch());
         assert_eq!(adaptive.fallbacks(), 1);
+    }
+
+    /// A commit that spends two swap budgets falls back at once; one that spends less waits
+    /// for a second strike. The swaps are counted by a bare incremental SAP given the same
+    /// boxes, at jitters from calm to violent.
+    #[test]
+    fn a_row_falls_back_at_its_first_commit_iff_it_swapped_at_least_twice_the_budget() {
+        let n = 2000u32;
+        let at = |i: u32, amplitude: f32| {
+            let wobble = ((i * 7 + 13) % 17) as f32 * amplitude;
+            let c = Vec3::new(i as f32 * 0.9, wobble, 0.05 - wobble);
+            Aabb::from_center_half_extents(c, Vec3::splat(0.5))
+        };
+        let budget = AdaptiveSweep::SWAPS_PER_SORT_UNIT * n as f64 * (n as f64).log2();
+        let mut outcomes = [false, false];
+        for amplitude in [0.0, 1e-4, 3e-4, 1e-3, 4e-3, 0.02] {
+            let bodies: Vec<_> = (0..n).map(|i| (i, at(i, 0.0), BodyKind::Dynamic)).collect();
+            let mut adaptive = AdaptiveSweep::new();
+            let mut bare: IncrementalSap = IncrementalSap::default();
+            adaptive.insert_bulk(&bodies).unwrap();
+            bare.insert_bulk(&bodies).unwrap();
+            adaptive.commit();
+            bare.commit();
+            for i in 0..n {
+                adaptive.update(i, at(i, amplitude)).unwrap();
+                bare.update(i, at(i, amplitude)).unwrap();
+            }
+            adaptive.commit();
+            bare.commit();
+            let spent = bare.stats().endpoint_swaps as f64 / budget;
+            let fell_back = adaptive.is_sorting_from_scratch();
+            assert_eq!(
+                fell_back,
+                spent >= 2.0,
+                "jitter {amplitude}: {spent} budgets"
+            );
+            outcomes[usize::from(fell_back)] = true;
+        }
+        assert_eq!(outcomes, [true, true], "both outcomes tried");
     }
 
     #[test]

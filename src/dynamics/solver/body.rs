@@ -147,6 +147,20 @@ fn isotropic(inverse_moments: Vec3) -> bool {
         <= 1e-6 * inverse_moments.max_element()
 }
 
+/// A body's inverse inertia in world axes with its locked axes zeroed: `L R D Rᵀ L`, `R` the
+/// principal frame in world axes, `D` the inverse principal moments, `L` the free axes on the
+/// diagonal. Written out as column scalings around one product (`(R D) Rᵀ`, then entry `(i, j)`
+/// times `fᵢ fⱼ`): the same numbers as the four matrix products for 0/1 locks, at a third of
+/// the instructions (every awake body's gather computes it once a step).
+fn world_inverse_inertia(b: &BodyInput) -> Mat3 {
+    let r = Mat3::from_quat(b.orientation * b.inertia_frame);
+    let d = b.inverse_principal_inertia;
+    let rd = Mat3::from_cols(r.x_axis * d.x, r.y_axis * d.y, r.z_axis * d.z);
+    let m = rd * r.transpose();
+    let f = b.free_axes;
+    Mat3::from_cols(m.x_axis * f * f.x, m.y_axis * f * f.y, m.z_axis * f * f.z)
+}
+
 impl SolverBodies {
     /// Empties the arrays (keeping their memory).
     pub fn clear(&mut self) {
@@ -169,11 +183,12 @@ impl SolverBodies {
     /// Adds a body; returns its slot.
     pub fn push(&mut self, b: BodyInput) -> u32 {
         let slot = self.states.len() as u32;
-        let r = Mat3::from_quat(b.orientation * b.inertia_frame);
-        let lock = Mat3::from_diagonal(b.free_axes);
-        let inverse_inertia =
-            lock * r * Mat3::from_diagonal(b.inverse_principal_inertia) * r.transpose() * lock;
         let dynamic = b.inverse_mass > 0.0;
+        let inverse_inertia = if dynamic {
+            world_inverse_inertia(&b)
+        } else {
+            Mat3::ZERO
+        };
         let linear_mask = if dynamic {
             b.free_translation
         } else {
@@ -186,7 +201,7 @@ impl SolverBodies {
         });
         self.params.push(BodyParams {
             inverse_mass: Vec3::splat(b.inverse_mass) * b.free_translation,
-            inverse_inertia: if dynamic { inverse_inertia } else { Mat3::ZERO },
+            inverse_inertia,
             linear_acceleration: if dynamic {
                 b.linear_acceleration * b.free_translation
             } else {
@@ -221,5 +236,34 @@ impl SolverBodies {
     /// Body `i`'s orientation now.
     pub fn orientation(&self, i: usize) -> Quat {
         (self.states[i].delta_rotation * self.orientations[i]).normalize()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_rng::TestRng;
+
+    /// The written-out product gives the four matrix products' numbers exactly, on random
+    /// frames, moments and locks.
+    #[test]
+    fn world_inverse_inertia_equals_the_four_products_exactly_on_2000_random_bodies() {
+        let mut rng = TestRng::new(7);
+        for _ in 0..2000 {
+            let bit = |rng: &mut TestRng| if rng.below(3) == 0 { 0.0 } else { 1.0 };
+            let b = BodyInput {
+                orientation: rng.rotation(),
+                inertia_frame: rng.rotation(),
+                inverse_principal_inertia: rng.vec3(0.01, 50.0),
+                free_axes: Vec3::new(bit(&mut rng), bit(&mut rng), bit(&mut rng)),
+                inverse_mass: 1.0,
+                ..Default::default()
+            };
+            let r = Mat3::from_quat(b.orientation * b.inertia_frame);
+            let lock = Mat3::from_diagonal(b.free_axes);
+            let four =
+                lock * r * Mat3::from_diagonal(b.inverse_principal_inertia) * r.transpose() * lock;
+            assert_eq!(world_inverse_inertia(&b), four);
+        }
     }
 }

@@ -2,6 +2,7 @@
 //! order (collider pairs, never archetype order), the moving parts of kinematic compounds as
 //! extra immovable solver bodies, and the solver's impulses reported back on the contacts.
 
+use super::BodySlots;
 use crate::components::*;
 use crate::dynamics::solver::{BodyInput, ContactInput, ContactPointInput, Solver, SolverBodies};
 use crate::plugins::narrow_phase::Contacts;
@@ -34,7 +35,7 @@ pub(super) struct KeyedContacts {
 /// the index of the pair it came from (`sources`).
 pub(super) fn gather_contacts(
     contacts: &Contacts,
-    entities: &[Entity],
+    slots: &BodySlots,
     materials: &Query<Material>,
     settings: &ContactSettings,
     keyed: &mut KeyedContacts,
@@ -43,7 +44,8 @@ pub(super) fn gather_contacts(
 ) {
     keyed.found.clear();
     keyed.materials.clear();
-    keyed.materials.resize(entities.len(), None);
+    keyed.materials.resize(slots.len(), None);
+    let entities = slots.entities();
     let mut material = |slot: usize| {
         *keyed.materials[slot].get_or_insert_with(|| {
             let (r, f, rolling) = materials.get(entities[slot]).unwrap_or((None, None, None));
@@ -55,10 +57,7 @@ pub(super) fn gather_contacts(
         })
     };
     for (source, pair) in contacts.pairs.iter().enumerate() {
-        let (Ok(a), Ok(b)) = (
-            entities.binary_search(&pair.a),
-            entities.binary_search(&pair.b),
-        ) else {
+        let (Some(a), Some(b)) = (slots.slot(pair.a), slots.slot(pair.b)) else {
             continue;
         };
         let ((ea, fa, ra), (eb, fb, rb)) = (material(a), material(b));

@@ -1,7 +1,7 @@
 //! The joints' side of the solver's gather: which bodies the joints bring into the step, which
 //! sleepers they wake, and each [`Joint`] as a core [`JointInput`] between solver slots.
 
-use super::{Mover, MoverFilter};
+use super::{BodySlots, Mover, MoverFilter};
 use crate::components::*;
 use crate::dynamics::solver::{JointFrame, JointInput};
 use crate::plugins::joints::ActiveJoint;
@@ -22,25 +22,28 @@ impl JointParams<'_, '_> {
         !self.joints.is_empty()
     }
 
-    /// Adds the joints' bodies that sorted `entities` lacks (a quarantined body is left out:
-    /// its joints are skipped), then sorts them in. Most jointed bodies are already there (the
-    /// awake movers): a net of 10,000 balls sorted its 50,000 entries every step when each
-    /// joint pushed both of its bodies.
-    pub(crate) fn add_bodies(&self, entities: &mut Vec<Entity>) {
-        let known = entities.len();
+    /// Adds the joints' bodies that the indexed `slots` lack (a quarantined body is left out:
+    /// its joints are skipped), then sorts them in and indexes again. Most jointed bodies are
+    /// already there (the awake movers): a net of 10,000 balls sorted its 50,000 entries every
+    /// step when each joint pushed both of its bodies.
+    pub(crate) fn add_bodies(&self, slots: &mut BodySlots) {
+        let known = slots.len();
         for (_, joint) in &self.joints {
             for e in [Some(joint.body_a), joint.body_b_entity()]
                 .into_iter()
                 .flatten()
             {
-                if entities[..known].binary_search(&e).is_err() && !self.quarantined.contains(e) {
-                    entities.push(e);
+                // A body pushed here may answer as present: it is, and is not pushed twice.
+                if slots.slot(e).is_none() && !self.quarantined.contains(e) {
+                    slots.entities_mut().push(e);
                 }
             }
         }
-        if entities.len() > known {
+        if slots.len() > known {
+            let entities = slots.entities_mut();
             entities.sort_unstable();
             entities.dedup();
+            slots.index();
         }
     }
 
@@ -70,19 +73,19 @@ impl JointParams<'_, '_> {
         }
     }
 
-    /// The joints between solver slots: `entities` are sorted, `local_centers[slot]` is each
+    /// The joints between solver slots: `slots` are indexed, `local_centers[slot]` is each
     /// slot's centre of mass in its body frame (anchors are given from the origin, the solver
     /// takes them from the centre of mass), `world` the world's slot. A joint whose body has
     /// no slot (quarantined, gone) is skipped.
     pub(crate) fn gather(
         &self,
-        entities: &[Entity],
+        slots: &BodySlots,
         local_centers: &[Vec3],
         world: Option<u32>,
         out: &mut Vec<JointInput>,
     ) {
         out.clear();
-        let slot = |e: Entity| entities.binary_search(&e).ok().map(|s| s as u32);
+        let slot = |e: Entity| slots.slot(e).map(|s| s as u32);
         for (e, joint) in &self.joints {
             let Some(a) = slot(joint.body_a) else {
                 continue;
