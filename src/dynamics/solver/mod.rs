@@ -25,8 +25,10 @@
 //!       a dynamic body's speed at most [`SoftStepSettings::max_linear_speed`] and every
 //!       body's turn at most [`SoftStepSettings::max_rotation_per_substep`]; the joints' rows
 //!       are taken again where the bodies now are;
-//!    5. **relax** — passes without bias, friction and rolling resistance included (two by default, see
-//!       [`SoftStepSettings::relax_iterations`]);
+//!    5. **relax** — passes without bias, friction and rolling resistance included (two over
+//!       the contacts and one over the joints by default, see
+//!       [`SoftStepSettings::relax_iterations`] and
+//!       [`SoftStepSettings::joint_relax_iterations`]);
 //! 3. **restitution** — bounces from the approach speeds at the step's start, then the speed
 //!    and spin bounds once more on what the step hands out;
 //! 4. **store impulses** — for the next step's warm start.
@@ -113,6 +115,13 @@ pub struct SoftStepSettings {
     /// one more pass over the contacts per substep (a second *biased* pass instead gave 0.52 and
     /// 0.84 cm, three relax passes 0.10 and 1.18 cm).
     pub relax_iterations: u32,
+    /// Relax passes per substep over the joints (Box2D v3 makes one): the first this many of
+    /// the relax passes include the joints, and if this is the larger, the last passes relax
+    /// the joints alone. A second pass, which steadies stacks, buys joints nothing: measured on
+    /// the joint grid (`peers/benches/joint_grid.rs`, 60 steps), the worst joint gap of a
+    /// 20 × 20 net is 14.6 mm with one pass and 19.6 mm with two, of a 100 × 100 net 369.5 and
+    /// 374.0 mm, for a third more joint work.
+    pub joint_relax_iterations: u32,
     /// Contact stiffness between two movable bodies (Hz). Box2D and rapier take 30 Hz; here a
     /// stack of 20 unit boxes at 30 Hz sags 11 cm under its own weight (a soft contact yields
     /// `load / (m_eff ω²)`) and slowly topples, at 60 Hz it sags 3 cm and stands (measured in
@@ -150,6 +159,7 @@ impl Default for SoftStepSettings {
         Self {
             substeps: 4,
             relax_iterations: 2,
+            joint_relax_iterations: 1,
             contact_hertz: 60.0,
             static_contact_hertz: 120.0,
             damping_ratio: 10.0,
@@ -166,18 +176,20 @@ impl Default for SoftStepSettings {
 
 impl SoftStepSettings {
     /// The settings if every number is usable: `1..=MAX_SUBSTEPS` substeps,
-    /// `1..=MAX_RELAX_ITERATIONS` relax passes, stiffnesses,
+    /// `1..=MAX_RELAX_ITERATIONS` relax passes (contacts and joints), stiffnesses,
     /// damping ratio, restitution threshold and warm-start distance finite and `>= 0`, push-out
     /// speed, rotation bound and speed bound finite and `> 0`.
     pub fn validated(self) -> Result<Self, SettingsError> {
         if !(1..=MAX_SUBSTEPS).contains(&self.substeps) {
             return Err(SettingsError::BadSubsteps(self.substeps));
         }
-        if !(1..=MAX_RELAX_ITERATIONS).contains(&self.relax_iterations) {
-            return Err(SettingsError::BadCoefficient(
-                "relax_iterations",
-                self.relax_iterations as f32,
-            ));
+        for (name, passes) in [
+            ("relax_iterations", self.relax_iterations),
+            ("joint_relax_iterations", self.joint_relax_iterations),
+        ] {
+            if !(1..=MAX_RELAX_ITERATIONS).contains(&passes) {
+                return Err(SettingsError::BadCoefficient(name, passes as f32));
+            }
         }
         let at_least_zero = [
             ("contact_hertz", self.contact_hertz),
@@ -305,9 +317,13 @@ impl Solver {
             self.solve_contacts(bodies, inv_h, true, flip);
             integrate_positions(bodies, h, s.max_rotation_per_substep, s.max_linear_speed);
             self.joints.refresh(&bodies.states);
-            for _ in 0..s.relax_iterations {
-                self.solve_joints(bodies, joint_soft, h, false);
-                self.solve_contacts(bodies, inv_h, false, flip);
+            for pass in 0..s.relax_iterations.max(s.joint_relax_iterations) {
+                if pass < s.joint_relax_iterations {
+                    self.solve_joints(bodies, joint_soft, h, false);
+                }
+                if pass < s.relax_iterations {
+                    self.solve_contacts(bodies, inv_h, false, flip);
+                }
             }
         }
         self.joints.store();
