@@ -253,22 +253,26 @@ impl AxisEndpoints {
         self.values[body[2 * axis + 1] as usize] = max;
     }
 
-    /// The slides' `InsertionSort_X` over the whole array (after many bodies were written).
-    pub fn insertion_sort(
+    /// The slides' `InsertionSort_X` over the whole array (after many bodies were written),
+    /// giving up once it has made more than `max_swaps` swaps: the array is then part sorted
+    /// (every swap made was reported to `listener`).
+    pub fn insertion_sort_within(
         &mut self,
         axis: usize,
+        max_swaps: u64,
         slots: &mut [EndpointSlots],
         listener: &mut impl SwapListener,
     ) -> SortCount {
         match axis {
-            0 => self.insertion_sort_on::<0>(slots, listener),
-            1 => self.insertion_sort_on::<1>(slots, listener),
-            _ => self.insertion_sort_on::<2>(slots, listener),
+            0 => self.insertion_sort_on::<0>(max_swaps, slots, listener),
+            1 => self.insertion_sort_on::<1>(max_swaps, slots, listener),
+            _ => self.insertion_sort_on::<2>(max_swaps, slots, listener),
         }
     }
 
     fn insertion_sort_on<const AXIS: usize>(
         &mut self,
+        max_swaps: u64,
         slots: &mut [EndpointSlots],
         listener: &mut impl SwapListener,
     ) -> SortCount {
@@ -277,6 +281,9 @@ impl AxisEndpoints {
             let (value, owner) = (self.values[at], self.owners[at]);
             if precedes(value, owner, self.values[at - 1], self.owners[at - 1]) {
                 count += self.sift_down::<AXIS>(at, slots, listener);
+                if count.swaps > max_swaps {
+                    break;
+                }
             }
         }
         count

@@ -144,6 +144,10 @@ pub struct IncrementalSap<T: PairTracking = AxisTests> {
     /// Moved bodies / stored bodies at or above which one whole-array insertion sort per axis
     /// replaces per-body moves; `None`: chosen by scene size.
     full_sort_fraction: Option<f32>,
+    /// Swaps after which a commit gives up (see [`IncrementalSap::set_max_swaps`]).
+    max_swaps: u64,
+    /// The last commit gave up.
+    abandoned: bool,
     scratch: Scratch,
 }
 
@@ -161,6 +165,8 @@ impl<T: PairTracking> Default for IncrementalSap<T> {
             tracker: T::default(),
             stats: StepStats::default(),
             full_sort_fraction: None,
+            max_swaps: u64::MAX,
+            abandoned: false,
             scratch: Scratch::default(),
         }
     }
@@ -206,6 +212,21 @@ impl<T: PairTracking> IncrementalSap<T> {
             } else {
                 Self::LARGE_SCENE_FULL_SORT_FRACTION
             })
+    }
+
+    /// Makes each commit give up once its insertion sorts have made more than `max_swaps`
+    /// swaps, for an owner that then rebuilds from the boxes ([`super::AdaptiveSweep`]: a
+    /// losing sort is abandoned at a bounded cost instead of finished). After such a commit
+    /// ([`Self::abandoned`]) the structure is inconsistent: only [`BroadPhase::aabb`] of the
+    /// live bodies, the pairs listed and their changes so far (every swap made was tracked;
+    /// this commit's insertions were not applied) may be read, and it must be dropped.
+    pub(crate) fn set_max_swaps(&mut self, max_swaps: u64) {
+        self.max_swaps = max_swaps;
+    }
+
+    /// Whether the last commit gave up past [`Self::set_max_swaps`]'s budget.
+    pub(crate) fn abandoned(&self) -> bool {
+        self.abandoned
     }
 
     /// The pair-tracking state (for its own statistics).
@@ -339,8 +360,10 @@ impl<T: PairTracking> BroadPhase for IncrementalSap<T> {
             ..StepStats::default()
         };
         self.apply_removals();
-        self.apply_updates();
-        self.apply_inserts();
+        self.abandoned = !self.apply_updates();
+        if !self.abandoned {
+            self.apply_inserts();
+        }
         self.pairs.finish_step();
         clear_buffer(&mut self.to_insert);
         clear_buffer(&mut self.to_update);

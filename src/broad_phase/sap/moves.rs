@@ -27,8 +27,10 @@ impl<T: PairTracking> SwapListener for SwapToTracking<'_, T> {
 }
 
 impl<T: PairTracking> IncrementalSap<T> {
-    /// Moves the endpoints of the bodies updated since the last commit into place.
-    pub(super) fn apply_updates(&mut self) {
+    /// Moves the endpoints of the bodies updated since the last commit into place; returns
+    /// false if it gave up past the swap budget (`IncrementalSap::within_swaps`), the axes
+    /// then part sorted.
+    pub(super) fn apply_updates(&mut self) -> bool {
         let mut moved = std::mem::take(&mut self.scratch.ids);
         moved.clear();
         for &id in &self.to_update {
@@ -50,13 +52,18 @@ impl<T: PairTracking> IncrementalSap<T> {
         } = self;
         let mut listener = SwapToTracking { tracker, pairs };
         let mut count = SortCount::default();
+        let budget = self.max_swaps;
         if whole_arrays && !moved.is_empty() {
             for (axis, endpoints) in axes.iter_mut().enumerate() {
                 for &id in &moved {
                     let aabb = &bodies[id as usize].aabb;
                     endpoints.write_body(axis, id, (aabb.min[axis], aabb.max[axis]), slots);
                 }
-                count += endpoints.insertion_sort(axis, slots, &mut listener);
+                let left = budget.saturating_sub(count.swaps);
+                count += endpoints.insertion_sort_within(axis, left, slots, &mut listener);
+                if count.swaps > budget {
+                    break;
+                }
             }
         } else {
             // Body by body, all axes at once: one read of the body's record.
@@ -66,10 +73,14 @@ impl<T: PairTracking> IncrementalSap<T> {
                     let bounds = (aabb.min[axis], aabb.max[axis]);
                     count += endpoints.move_body(axis, id, bounds, slots, &mut listener);
                 }
+                if count.swaps > budget {
+                    break;
+                }
             }
         }
         self.stats.endpoint_swaps += count.swaps;
         self.stats.pair_tests += count.flips;
         self.scratch.ids = moved;
+        count.swaps <= budget
     }
 }
