@@ -46,6 +46,12 @@ impl Plugin for JointPlugin {
 #[derive(Resource, Debug, Default)]
 pub struct JointedPairs {
     pairs: Vec<(Entity, Entity)>,
+    /// The pairs in the joints' iteration order, as last collected: while the joints are the
+    /// same, so is this list, and the sort is skipped (a 10,000-ball net's 19,800 joints cost
+    /// 4.8 million instructions a step to sort).
+    collected: Vec<(Entity, Entity)>,
+    /// This step's collection, compared with the last.
+    scratch: Vec<(Entity, Entity)>,
 }
 
 impl JointedPairs {
@@ -92,13 +98,20 @@ fn quarantine_invalid_joints(
 
 /// Rebuilds [`JointedPairs`] from the joints that do not let their bodies collide.
 fn collect_jointed_pairs(joints: Query<&Joint, ActiveJoint>, mut pairs: ResMut<JointedPairs>) {
-    pairs.pairs.clear();
+    let pairs = &mut *pairs;
+    pairs.scratch.clear();
     for joint in &joints {
         if let (false, Some(b)) = (joint.collide_connected, joint.body_b_entity()) {
             let a = joint.body_a;
-            pairs.pairs.push((a.min(b), a.max(b)));
+            pairs.scratch.push((a.min(b), a.max(b)));
         }
     }
+    if pairs.scratch == pairs.collected {
+        return;
+    }
+    std::mem::swap(&mut pairs.scratch, &mut pairs.collected);
+    pairs.pairs.clear();
+    pairs.pairs.extend_from_slice(&pairs.collected);
     pairs.pairs.sort_unstable();
     pairs.pairs.dedup();
 }
