@@ -15,9 +15,13 @@
 //! bodies, where the rebuild starts missing the cache) is a strike for each whole budget it
 //! spent; two strikes in a row (one commit at twice the budget, or two just over it) move every
 //! body into a sort and sweep. Every [`AdaptiveSweep::PROBE_PERIOD`] such commits
-//! the bodies go back to the SAP to see whether the motion has calmed (if not, two commits later
-//! they return). A switch costs one bulk insertion; it changes no pair, and the commit that
-//! switches reports the changes the old structure found.
+//! the bodies go back to the SAP to see whether the motion has calmed (if not, one or two
+//! commits later they return). A switch costs one bulk insertion; it changes no pair, and the
+//! commit that switches reports the changes the old structure found. The SAP also gives up a
+//! commit once it has spent the budgets that would switch anyway (its insertion sorts stop
+//! there, and the sort from scratch takes over at once, the commit's changes diffed from the
+//! pairs before it): a losing commit costs at most two budgets, not the 23 a 10,000-ball net's
+//! second commit spent.
 //!
 //! From [`AdaptiveSweep::REGION_SCENE`] bodies the whole-scene lists are dense whatever the
 //! motion (100k boxes all moving: 4.3× slower than parry's tree, `peers/benches/broad_phase.rs`),
@@ -65,14 +69,14 @@ pub struct AdaptiveSweep {
     engine: Engine,
     /// Per id: its kind while present (a switch moves every present body).
     kinds: Vec<Option<BodyKind>>,
-    /// Consecutive losing commits of the incremental SAP.
+    /// Strikes of the incremental SAP's losing commits in a row (one per whole budget spent).
     strikes: u32,
     /// Commits since the last switch.
     since_switch: u32,
     /// Switches to sorting from scratch so far.
     fallbacks: u64,
-    /// The changes of a commit that switched (the old structure's), reported until the next
-    /// commit.
+    /// The changes of a commit that switched (the old structure's, or after a commit the SAP
+    /// gave up, the diff from the pairs before it), reported until the next commit.
     switched: Option<(Vec<Pair>, Vec<Pair>)>,
     /// Buffers for a switch.
     moving: Vec<(ProxyId, Aabb, BodyKind)>,
@@ -138,7 +142,8 @@ impl AdaptiveSweep {
         Self::SWAPS_PER_SORT_UNIT * cache * n * n.log2()
     }
 
-    /// After an incremental commit that gave up past [`Self::STRIKES`] budgets: every body moves
+    /// After an incremental commit that gave up past the budgets left before the rule switches
+    /// (`STRIKES` less the strikes so far): every body moves
     /// into a sort from scratch, and the commit reports the changes from the pairs before it
     /// (the pairs the SAP lists less its net additions so far, plus its net removals so far).
     fn fall_back_from_abandoned(&mut self) {
@@ -252,10 +257,15 @@ impl BroadPhase for AdaptiveSweep {
         self.switched = None;
         // Insertion sort gives up where the rule would switch anyway (a 10,000-ball net's
         // second commit made 30M swaps, 23 budgets, before it could count as a strike).
+        // A scene large enough for the regions switches there instead, whatever the swaps.
         if let Engine::Incremental(sap) = &mut self.engine {
-            let strikes_left = Self::STRIKES.saturating_sub(self.strikes).max(1);
-            let cap = f64::from(strikes_left) * Self::swap_budget(sap.len());
-            sap.set_max_swaps(cap as u64);
+            let cap = if sap.len() >= Self::REGION_SCENE {
+                u64::MAX
+            } else {
+                let strikes_left = Self::STRIKES.saturating_sub(self.strikes).max(1);
+                (f64::from(strikes_left) * Self::swap_budget(sap.len())) as u64
+            };
+            sap.set_max_swaps(cap);
         }
         self.engine.get_mut().commit();
         if matches!(&self.engine, Engine::Incremental(sap) if sap.abandoned()) {

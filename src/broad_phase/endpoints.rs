@@ -240,7 +240,7 @@ impl AxisEndpoints {
     }
 
     /// Overwrites the values of a body's endpoints in place, leaving the order to a later
-    /// [`AxisEndpoints::insertion_sort`].
+    /// [`AxisEndpoints::insertion_sort_within`].
     pub fn write_body(
         &mut self,
         axis: usize,

@@ -28,7 +28,7 @@ impl<T: PairTracking> SwapListener for SwapToTracking<'_, T> {
 
 impl<T: PairTracking> IncrementalSap<T> {
     /// Moves the endpoints of the bodies updated since the last commit into place; returns
-    /// false if it gave up past the swap budget (`IncrementalSap::within_swaps`), the axes
+    /// false if it gave up past the swap budget (`IncrementalSap::set_max_swaps`), the axes
     /// then part sorted.
     pub(super) fn apply_updates(&mut self) -> bool {
         let mut moved = std::mem::take(&mut self.scratch.ids);

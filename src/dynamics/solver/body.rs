@@ -150,7 +150,8 @@ fn isotropic(inverse_moments: Vec3) -> bool {
 /// A body's inverse inertia in world axes with its locked axes zeroed: `L R D Rᵀ L`, `R` the
 /// principal frame in world axes, `D` the inverse principal moments, `L` the free axes on the
 /// diagonal. Written out as column scalings around one product (`(R D) Rᵀ`, then entry `(i, j)`
-/// times `fᵢ fⱼ`): the same numbers as the four matrix products for 0/1 locks, at a third of
+/// times `fᵢ fⱼ`): the same numbers as the four matrix products for 0/1 locks (a zeroed entry
+/// may differ in the sign of its zero), at a third of
 /// the instructions (every awake body's gather computes it once a step).
 fn world_inverse_inertia(b: &BodyInput) -> Mat3 {
     let r = Mat3::from_quat(b.orientation * b.inertia_frame);

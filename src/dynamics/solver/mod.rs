@@ -110,14 +110,15 @@ pub const MAX_RELAX_ITERATIONS: u32 = 64;
 pub struct SoftStepSettings {
     /// Substeps per step (each integrates, solves once and relaxes).
     pub substeps: u32,
-    /// Relax passes per substep (Box2D v3 makes one). Two halve a tall stack's sway: measured in
+    /// Relax passes per substep over the contacts (Box2D v3 makes one). Two halve a tall stack's sway: measured in
     /// `scenarios.rs` over 10 s, 10 boxes drift 1.07 → 0.31 cm and 20 boxes 2.06 → 0.59 cm, for
     /// one more pass over the contacts per substep (a second *biased* pass instead gave 0.52 and
     /// 0.84 cm, three relax passes 0.10 and 1.18 cm).
     pub relax_iterations: u32,
     /// Relax passes per substep over the joints (Box2D v3 makes one): the first this many of
     /// the relax passes include the joints, and if this is the larger, the last passes relax
-    /// the joints alone. A second pass, which steadies stacks, buys joints nothing: measured on
+    /// the joints alone (after the contacts, so that those passes let the joints win a
+    /// conflict). A second pass, which steadies stacks, buys joints nothing: measured on
     /// the joint grid (`peers/benches/joint_grid.rs`, 60 steps), the worst joint gap of a
     /// 20 × 20 net is 14.6 mm with one pass and 19.6 mm with two, of a 100 × 100 net 369.5 and
     /// 374.0 mm, for a third more joint work.

@@ -231,13 +231,15 @@ fn solve_soft_step(
     s.local_centers.clear();
     let lone = movers.p0();
     for (&e, found) in s.slots.entities().iter().zip(&s.inputs) {
-        let (input, local_center) = match (found, lone.get(e)) {
-            (Some(found), _) => *found,
-            (None, Ok(m)) if !held(m.10, e, &s.waking) => {
-                let local_center = m.6.local_center_of_mass;
-                (body_input(m, &gathered, gyroscopic), local_center)
-            }
-            _ => (immovable_input(poses.get(e).ok().map(|p| p.0)), Vec3::ZERO),
+        let (input, local_center) = match found {
+            Some(found) => *found,
+            None => match lone.get(e) {
+                Ok(m) if !held(m.10, e, &s.waking) => {
+                    let local_center = m.6.local_center_of_mass;
+                    (body_input(m, &gathered, gyroscopic), local_center)
+                }
+                _ => (immovable_input(poses.get(e).ok().map(|p| p.0)), Vec3::ZERO),
+            },
         };
         s.bodies.push(input);
         s.local_centers.push(local_center);

@@ -7,9 +7,14 @@
 //! comparisons per joint, a twentieth of a 10,000-ball net's step (`valgrind --tool=callgrind`).
 //! Here a table indexed by the entity's index holds its slot, and the slot's entity confirms it
 //! (a stale entry from another step, or a recycled index, never matches), so nothing is cleared
-//! between steps.
+//! between steps. The table covers indices below [`TABLE_LIMIT`] (16 MB at most): an entity
+//! past it (a joint naming `Entity::PLACEHOLDER` before validation quarantines it) is found by
+//! binary search instead of growing the table to gigabytes.
 
 use bevy_ecs::entity::Entity;
+
+/// Entity indices the table covers (4 bytes each).
+const TABLE_LIMIT: usize = 1 << 22;
 
 /// The bodies of this step in slot order (sorted by entity) and a slot per entity index.
 #[derive(Debug, Default)]
@@ -37,19 +42,26 @@ impl BodySlots {
             .entities
             .iter()
             .map(|e| e.index_u32() as usize + 1)
+            .filter(|&top| top <= TABLE_LIMIT)
             .max()
             .unwrap_or(0);
         if self.by_index.len() < top {
             self.by_index.resize(top, u32::MAX);
         }
         for (slot, e) in self.entities.iter().enumerate() {
-            self.by_index[e.index_u32() as usize] = slot as u32;
+            if let Some(entry) = self.by_index.get_mut(e.index_u32() as usize) {
+                *entry = slot as u32;
+            }
         }
     }
 
     /// `e`'s slot this step, if it has one.
     pub(super) fn slot(&self, e: Entity) -> Option<usize> {
-        let slot = *self.by_index.get(e.index_u32() as usize)? as usize;
+        let index = e.index_u32() as usize;
+        if index >= TABLE_LIMIT {
+            return self.entities.binary_search(&e).ok();
+        }
+        let slot = *self.by_index.get(index)? as usize;
         (self.entities.get(slot) == Some(&e)).then_some(slot)
     }
 
@@ -93,6 +105,14 @@ mod tests {
         assert_ne!(recycled, old);
         assert_eq!(slots.slot(recycled), None);
         assert_eq!(slots.slot(old), Some(0));
-        assert_eq!(slots.len(), second.len());
+        // An index past the table (the placeholder's) is searched, and grows nothing.
+        slots.entities_mut().push(Entity::PLACEHOLDER);
+        slots.entities_mut().sort_unstable();
+        slots.index();
+        let at = slots.entities().binary_search(&Entity::PLACEHOLDER).ok();
+        assert!(at.is_some());
+        assert_eq!(slots.slot(Entity::PLACEHOLDER), at);
+        assert!(slots.by_index.len() <= TABLE_LIMIT);
+        assert_eq!(slots.len(), second.len() + 1);
     }
 }
