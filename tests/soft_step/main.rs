@@ -325,6 +325,36 @@ fn a_zero_negative_nan_or_infinite_speed_bound_is_refused_naming_it() {
 }
 
 #[test]
+fn zero_or_more_than_64_relax_passes_over_contacts_or_joints_are_refused_naming_them() {
+    for bad in [0, 65, u32::MAX] {
+        for (name, settings) in [
+            (
+                "joint_relax_iterations",
+                SoftStepSettings {
+                    joint_relax_iterations: bad,
+                    ..Default::default()
+                },
+            ),
+            (
+                "relax_iterations",
+                SoftStepSettings {
+                    relax_iterations: bad,
+                    ..Default::default()
+                },
+            ),
+        ] {
+            let err = settings.validated().expect_err("unusable relax passes");
+            assert!(format!("{err}").contains(name), "{err}");
+        }
+    }
+    let fine = SoftStepSettings {
+        joint_relax_iterations: 64,
+        ..Default::default()
+    };
+    assert!(fine.validated().is_ok());
+}
+
+#[test]
 fn with_the_soft_step_unusable_settings_fall_back_to_the_defaults_and_a_box_still_rests_within_1_cm()
  {
     let bad = SoftStepSettings {
