@@ -178,8 +178,7 @@ fn a_hanging_20_link_chain_stretches_under_1_percent_of_its_length_at_rest() {
 
 /// More joint relax passes than contact ones: the last passes relax the joints alone.
 #[test]
-fn with_three_joint_relax_passes_and_one_contact_pass_a_hanging_chain_stretches_under_1_percent()
-{
+fn with_three_joint_relax_passes_and_one_contact_pass_a_hanging_chain_stretches_under_1_percent() {
     let (mut scene, links, rest) = chain(20, Vec3::NEG_Z, |_| 1.0);
     scene.solver.settings.relax_iterations = 1;
     scene.solver.settings.joint_relax_iterations = 3;
