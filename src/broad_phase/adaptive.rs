@@ -155,14 +155,7 @@ impl AdaptiveSweep {
         before.retain(|p| added_so_far.binary_search(p).is_err());
         before.extend_from_slice(sap.removed());
         before.sort_unstable();
-        self.switch_to(Engine::FromScratch(Box::default()));
-        if let Some((added, removed)) = &mut self.switched {
-            let mut now = self.engine.get().pairs().to_vec();
-            now.sort_unstable();
-            added.clear();
-            removed.clear();
-            diff_sorted(&before, &now, added, removed);
-        }
+        self.switch_to(Engine::FromScratch(Box::default()), Some(&before));
     }
 
     /// The switch the last commit's work calls for, if any.
@@ -193,8 +186,10 @@ impl AdaptiveSweep {
         }
     }
 
-    /// Moves every body into `next`, keeping this commit's changes to report.
-    fn switch_to(&mut self, mut next: Engine) {
+    /// Moves every body into `next`, keeping this commit's changes to report: the old
+    /// structure's, or with `before` (sorted) the difference from those pairs to the new
+    /// structure's.
+    fn switch_to(&mut self, mut next: Engine, before: Option<&[Pair]>) {
         let old = self.engine.get();
         self.moving.clear();
         for (id, kind) in self.kinds.iter().enumerate() {
@@ -202,11 +197,15 @@ impl AdaptiveSweep {
                 self.moving.push((id as ProxyId, aabb, *kind));
             }
         }
-        let changes = (old.added().to_vec(), old.removed().to_vec());
+        let old_changes = (old.added().to_vec(), old.removed().to_vec());
         let new = next.get_mut();
         // The boxes were accepted once: a bulk insertion of them cannot fail.
         if new.insert_bulk(&self.moving).is_ok() {
             new.commit();
+            let changes = match before {
+                Some(before) => changes_since(before, new.pairs()),
+                None => old_changes,
+            };
             if matches!(next, Engine::FromScratch(_)) {
                 self.fallbacks += 1;
             }
@@ -281,7 +280,7 @@ impl BroadPhase for AdaptiveSweep {
             return;
         }
         if let Some(next) = self.next_engine() {
-            self.switch_to(next);
+            self.switch_to(next, None);
         }
     }
 
@@ -326,15 +325,22 @@ impl BroadPhase for AdaptiveSweep {
     }
 }
 
+/// The pairs added and removed from sorted `before` to `now` (in any order).
+fn changes_since(before: &[Pair], now: &[Pair]) -> (Vec<Pair>, Vec<Pair>) {
+    let mut now = now.to_vec();
+    now.sort_unstable();
+    let (mut added, mut removed) = (Vec::new(), Vec::new());
+    diff_sorted(before, &now, &mut added, &mut removed);
+    (added, removed)
+}
+
 /// The pairs of `a` and `b` as sorted sets are equal (a test helper: the structures list
 /// pairs in different orders).
 #[cfg(test)]
 fn same_pairs(a: &[Pair], b: &[Pair]) -> bool {
-    let (mut a, mut b) = (a.to_vec(), b.to_vec());
+    let mut a = a.to_vec();
     a.sort_unstable();
-    b.sort_unstable();
-    let (mut added, mut removed) = (Vec::new(), Vec::new());
-    diff_sorted(&a, &b, &mut added, &mut removed);
+    let (added, removed) = changes_since(&a, b);
     added.is_empty() && removed.is_empty()
 }
 

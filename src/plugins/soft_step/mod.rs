@@ -104,10 +104,9 @@ pub struct SoftStepSolver {
     pub solver: Solver,
     /// The step's bodies by slot, and each entity's slot.
     slots: BodySlots,
-    /// Each slot's input as the awake movers' pass found it (`None`: not an awake mover).
+    /// Each slot's input as the awake movers' pass found it (`None`: not an awake mover; the
+    /// scatter's awake pass writes back exactly the slots that are `Some`).
     inputs: Vec<Option<(BodyInput, Vec3)>>,
-    /// Whether each slot's body was written back by the awake movers' pass.
-    scattered: Vec<bool>,
     bodies: SolverBodies,
     contacts: Vec<ContactInput>,
     springs: Vec<CoreSpring>,
@@ -223,8 +222,7 @@ fn solve_soft_step(
     s.inputs.resize(s.slots.len(), None);
     for m in movers.p1().iter() {
         if let Some(slot) = s.slots.slot(m.0) {
-            let local_center = m.6.local_center_of_mass;
-            s.inputs[slot] = Some((body_input(m, &gathered, gyroscopic), local_center));
+            s.inputs[slot] = Some(body_input(m, &gathered, gyroscopic));
         }
     }
     s.bodies.clear();
@@ -234,10 +232,7 @@ fn solve_soft_step(
         let (input, local_center) = match found {
             Some(found) => *found,
             None => match lone.get(e) {
-                Ok(m) if !held(m.10, e, &s.waking) => {
-                    let local_center = m.6.local_center_of_mass;
-                    (body_input(m, &gathered, gyroscopic), local_center)
-                }
+                Ok(m) if !held(m.10, e, &s.waking) => body_input(m, &gathered, gyroscopic),
                 _ => (immovable_input(poses.get(e).ok().map(|p| p.0)), Vec3::ZERO),
             },
         };
@@ -292,17 +287,14 @@ fn solve_soft_step(
     }
     stats.set_counter("soft_step/springs_clamped", clamped as f64);
     stats.set_counter("soft_step/bounded_joints", s.solver.bounded_joints() as f64);
-    s.scattered.clear();
-    s.scattered.resize(s.slots.len(), false);
     for m in movers.p1().iter_mut() {
         if let Some(slot) = s.slots.slot(m.0) {
             scatter(m, &s.bodies, slot);
-            s.scattered[slot] = true;
         }
     }
     let mut lone = movers.p0();
     for (slot, &e) in s.slots.entities().iter().enumerate() {
-        if !s.scattered[slot]
+        if s.inputs[slot].is_none()
             && let Ok(m) = lone.get_mut(e)
             && !held(m.10, e, &s.waking)
         {
@@ -387,18 +379,19 @@ fn immovable_input(pose: Option<&GlobalPose>) -> BodyInput {
     }
 }
 
-/// A moving body at the step's start: its centre of mass, inertia, gravity and damping.
+/// A moving body at the step's start: its centre of mass, inertia, gravity and damping, and its
+/// centre of mass in its body frame (joint anchors are given from the origin).
 fn body_input(
     m: ROQueryItem<'_, '_, Mover<'_>>,
     gathered: &GatheredForces,
     gyroscopic: bool,
-) -> BodyInput {
+) -> (BodyInput, Vec3) {
     let (_, p, r, v, w, mass, inertia, locked, angular_drag, drag, ..) = m;
     let inverse_mass = mass.inverse();
     let dynamic = inverse_mass > 0.0;
     // Without the component nothing is locked (`LockedAxes::default()`).
     let locks = LockedAxes::of(locked);
-    BodyInput {
+    let input = BodyInput {
         center: p.0 + r.0 * inertia.local_center_of_mass,
         orientation: r.0,
         linear_velocity: v.0,
@@ -417,7 +410,8 @@ fn body_input(
         free_axes: locks.free_rotation_axes(),
         free_translation: locks.free_translation_axes(),
         gyroscopic,
-    }
+    };
+    (input, inertia.local_center_of_mass)
 }
 
 /// The step's forces and torques, each to its body's slot (bodies are sorted by entity).
