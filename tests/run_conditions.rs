@@ -265,7 +265,7 @@ fn planes_of(app: &bevy_app::App, walls: &[Entity], balls: &[Entity]) -> Vec<usi
 fn in_a_box_of_six_planes_a_ball_pairs_only_with_the_planes_its_grown_volume_reaches_0_1_or_2() {
     // A wall a body does not reach costs it no narrow-phase pair. In a 10 m box of half-spaces
     // (each wall's solid outside it), without gravity: a ball of radius 0.5 in the middle, one
-    // 1 cm from the +x wall (within its 2 cm margin), one in the corner of +x and +y. Pairing
+    // half its margin from the +x wall, one in the corner of +x and +y. Pairing
     // every ball with every plane made 18 pairs; a wall pairs with a ball only where the
     // ball's volume, grown by its speculative margin, reaches it.
     let mut app = common::app();
@@ -278,10 +278,12 @@ fn in_a_box_of_six_planes_a_ball_pairs_only_with_the_planes_its_grown_volume_rea
             .id();
         walls.push(wall);
     }
+    // At rest without gravity a ball's margin is the fixed distance.
+    let near = 4.5 - 0.5 * urto::plugins::SpeculativeMargin::default().distance;
     let balls = [
         common::ball(&mut app, Vec3::ZERO),
-        common::ball(&mut app, Vec3::new(4.49, 0.0, 0.0)),
-        common::ball(&mut app, Vec3::new(4.49, 4.49, 0.0)),
+        common::ball(&mut app, Vec3::new(near, 0.0, 0.0)),
+        common::ball(&mut app, Vec3::new(near, near, 0.0)),
     ];
     urto::step(app.world_mut(), 1).unwrap();
     assert_eq!(planes_of(&app, &walls, &balls), [0, 1, 2]);

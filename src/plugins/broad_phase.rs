@@ -219,6 +219,7 @@ type Indexed<'a> = (
     Has<Static>,
     Option<&'a Velocity>,
     Option<&'a AngularVelocity>,
+    Option<&'a GravityScale>,
 );
 type IndexedRow<'a> = (
     Entity,
@@ -226,6 +227,7 @@ type IndexedRow<'a> = (
     bool,
     Option<&'a Velocity>,
     Option<&'a AngularVelocity>,
+    Option<&'a GravityScale>,
 );
 type Root = (Without<ChildOf>, Without<Quarantined>);
 /// A moving body's margin follows its velocity, so a new velocity re-indexes it.
@@ -322,7 +324,7 @@ impl BroadPhaseIndex {
 
     /// Registers a new root or moves a known one (re-registering it if its kind changed); a
     /// root with nothing to collide (an empty volume) is dropped.
-    fn upsert(&mut self, (e, bv, is_static, v, w): IndexedRow, lookahead: &Lookahead) {
+    fn upsert(&mut self, (e, bv, is_static, v, w, g): IndexedRow, lookahead: &Lookahead) {
         if !bv.0.is_valid() {
             self.forget(e);
             return;
@@ -330,7 +332,7 @@ impl BroadPhaseIndex {
         let bounded = bv.0.is_finite();
         let moving = v.is_some() && !is_static;
         let aabb = if moving {
-            bv.0.expanded(lookahead.of(v, w, bv))
+            bv.0.expanded(lookahead.of(v, w, bv, g))
         } else {
             bv.0
         };

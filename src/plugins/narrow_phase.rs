@@ -6,8 +6,8 @@
 //! hierarchy's work is published as `hierarchy/bv_tests`, `hierarchy/nodes_visited` and
 //! `hierarchy/collider_pairs`.
 //!
-//! With the rigid-body solver each pair is tested looking ahead by the sum of its two bodies'
-//! speculative margins ([`speculative_contact_with_scratch`]: grown spheres and boxes, raised
+//! With the rigid-body solver each pair is tested looking ahead by its speculative margin (the
+//! two bodies' fixed distances and how far they can close in a step, `Lookahead::pair` in `soft_step/lookahead.rs`) ([`speculative_contact_with_scratch`]: grown spheres and boxes, raised
 //! half-spaces, the gaps between two meshes' triangles), so manifolds may hold points still apart
 //! (negative depth). A pair is always computed with its lower collider first, so which shape is
 //! grown and which face is the reference never follow the broad phase's (archetype) order.
@@ -48,7 +48,7 @@ use crate::plugins::broad_phase::BroadPhasePairs;
 use crate::plugins::joints::JointedPairs;
 use crate::plugins::required_resources::RequireResource;
 use crate::plugins::sleep::dormant;
-use crate::plugins::soft_step::LookaheadParams;
+use crate::plugins::soft_step::{BodyMotion, LookaheadParams};
 use crate::schedule::{SubstepSchedule, SubstepSet};
 use crate::settings::SleepSettings;
 use crate::stats::{PhysicsStats, Stage};
@@ -205,8 +205,8 @@ struct NarrowPhaseScratch {
 /// A body's part in this step's pairs.
 #[derive(Clone, Copy, Debug)]
 struct BodyFacts {
-    /// Its speculative margin (m).
-    margin: f32,
+    /// Its part in its pairs' speculative margins.
+    margin: BodyMotion,
     /// At rest and allowed to stay so (with sleeping on).
     dormant: bool,
     /// It has parts (the scene graph is descended).
@@ -279,12 +279,14 @@ impl BvTree for EcsTree<'_, '_, '_, '_> {
 /// Whether a body is static or asleep (see [`crate::plugins::sleep`]).
 pub(crate) type Dormancy = (Has<Static>, Has<Sleeping>);
 
-/// What a root body's speculative margin depends on.
+/// What a root body's part in its pairs' speculative margins depends on.
 type Motion<'a> = (
     Has<Static>,
     Option<&'a Velocity>,
     Option<&'a AngularVelocity>,
     &'a BoundingVolume,
+    Option<&'a GravityScale>,
+    Option<&'a ComputedMass>,
 );
 
 #[allow(clippy::too_many_arguments)]
@@ -319,9 +321,12 @@ fn compute_contacts(
     debug.pairs.clear();
     visits.clear();
     let lookahead = lookahead.get();
+    // Gravity pulls a body unless it is kinematic (infinite mass).
     let margin = |e: Entity| match motion.get(e) {
-        Ok((false, v, w, bv)) => lookahead.of(v, w, bv),
-        _ => 0.0,
+        Ok((false, v, w, bv, g, m)) => {
+            lookahead.motion(v, w, bv, g, m.is_none_or(|m| m.inverse() > 0.0))
+        }
+        _ => BodyMotion::default(),
     };
     let start = Instant::now();
     contacts.pairs.clear();
@@ -354,7 +359,7 @@ fn compute_contacts(
         if jointed.is_some_and(|j| j.contains(a, b)) {
             continue; // a joint keeps them from colliding
         }
-        let margin = fa.margin + fb.margin;
+        let margin = lookahead.pair(&fa.margin, &fb.margin);
         if !fa.compound && !fb.compound {
             if !interacts(a, b) {
                 continue;

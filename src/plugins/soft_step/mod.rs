@@ -38,7 +38,7 @@ pub use lookahead::SpeculativeMargin;
 
 use contact_inputs::{KeyedContacts, Material, add_part_motion, gather_contacts, report_impulses};
 use joint_inputs::JointParams;
-pub(crate) use lookahead::{Lookahead, LookaheadParams};
+pub(crate) use lookahead::{BodyMotion, Lookahead, LookaheadParams};
 use slots::BodySlots;
 
 use crate::components::*;
