@@ -211,7 +211,9 @@ impl Default for ContactSettings {
 pub struct SleepSettings {
     /// Whether bodies may fall asleep.
     pub enabled: bool,
-    /// Speed below which a body counts as still (m/s).
+    /// Average speed below which a body counts as still (m/s): it must stay within
+    /// `speed × time` of where its still time began, its surface as it turns too (Jolt's sleep
+    /// test; see [`crate::dynamics::stillness`]).
     pub speed: f32,
     /// How long a body must stay still before it sleeps (s).
     pub time: f32,

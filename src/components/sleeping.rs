@@ -30,11 +30,13 @@ pub struct Sleeping;
 /// A body's progress towards sleep and, asleep, what it slept with.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 pub struct SleepState {
-    /// Seconds the body has been slower than the sleep speed (awake bodies).
+    /// Seconds the body has been still (awake bodies): within the sleep speed times the sleep
+    /// time of where this still time began ([`SleepSettings`](crate::settings::SleepSettings)).
     pub still_for: f32,
-    /// Where it fell asleep: moving it elsewhere wakes it.
+    /// Awake, where its still time began; asleep, where it fell asleep: moving it elsewhere
+    /// wakes it.
     pub at: Vec3,
-    /// Its orientation then: turning it wakes it.
+    /// Its orientation then: turning it wakes it (asleep).
     pub orientation: Quat,
     /// The island it fell asleep with (0: none): waking one body of it wakes all of them
     /// ([`crate::dynamics::islands`]).

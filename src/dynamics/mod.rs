@@ -8,6 +8,7 @@ pub mod islands;
 pub mod response;
 pub mod rotation;
 pub mod solver;
+pub mod stillness;
 
 pub use forces::{ForceModel, Spring, SpringEnd};
 pub use integrators::{AccelerationField, Integrator, IntegratorScratch, integrate};

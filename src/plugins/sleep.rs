@@ -3,8 +3,9 @@
 //!
 //! Bodies sleep by islands ([`crate::dynamics::islands`]): at the end of each step the awake
 //! dynamic bodies are grouped by the step's contacts, and an island whose every body has been
-//! slower than [`SleepSettings::speed`] for [`SleepSettings::time`] (its centre, and its surface
-//! turning at `|ω|` times its reach) falls asleep as a whole: velocities and angular velocities
+//! still for [`SleepSettings::time`] falls asleep as a whole (still: within `speed × time` of
+//! where its still time began, its centre and its surface as it turned, so slower than
+//! [`SleepSettings::speed`] on average; Jolt's sleep test, see [`crate::dynamics::stillness`]): velocities and angular velocities
 //! become exactly zero and each body gets the [`Sleeping`] marker. The marker moves it to
 //! archetypes that every per-step query leaves out (`Without<Sleeping>`), and the broad phase
 //! stops pairing it with scenery and other sleepers, so a sleeping island costs no pass over its
@@ -25,6 +26,7 @@
 
 use crate::components::*;
 use crate::dynamics::islands::{IslandBuilder, Stillness, islands_to_sleep};
+use crate::dynamics::stillness::StillTest;
 use crate::plugins::core::PrepareWake;
 use crate::plugins::joints::ActiveJoint;
 use crate::plugins::narrow_phase::Contacts;
@@ -231,7 +233,7 @@ fn fall_asleep(
     mut commands: Commands,
 ) {
     let s = &mut *scratch;
-    count_stillness(&mut bodies, settings.speed, timestep.dt(), s);
+    count_stillness(&mut bodies, &settings, timestep.dt(), s);
     stats.set_counter("sleep/awake_bodies", s.awake.len() as f64);
     stats.set_counter("sleep/sleeping_islands", islands.members.len() as f64);
     if !s.stillness.iter().any(|b| b.still_for >= settings.time) {
@@ -290,30 +292,38 @@ fn index_slots(s: &mut IslandScratch) {
         .extend(kinematic.map(|&(e, moving)| (e, Slot::Kinematic { moving })));
 }
 
-/// Lists the awake dynamic bodies with their stillness (counting it on), and the kinematic ones.
+/// Lists the awake dynamic bodies with their stillness (counting it on, [`StillTest`]: within
+/// `speed × time` of where the body's still time began, never faster than four times the
+/// speed), and the kinematic ones.
 fn count_stillness(
     bodies: &mut Query<Candidate, CandidateFilter>,
-    speed: f32,
+    settings: &SleepSettings,
     dt: f32,
     s: &mut IslandScratch,
 ) {
     s.awake.clear();
     s.kinematic.clear();
     s.stillness.clear();
-    for (e, mut sleep, _, v, m, w, volume) in bodies.iter_mut() {
+    let test = StillTest::new(settings.speed, settings.time);
+    for (e, mut sleep, (p, r), v, m, w, volume) in bodies.iter_mut() {
         let spin = w.as_ref().map_or(0.0, |w| w.0.length());
         if m.inverse() == 0.0 {
             let moving = v.0 != Vec3::ZERO || spin != 0.0;
             s.kinematic.push((e, moving));
             continue;
         }
-        // A turning body's surface moves at up to |ω| times its reach (Box2D's sleep test).
-        if v.0.length().max(spin * volume.reach()) >= speed {
-            if sleep.still_for != 0.0 {
-                sleep.still_for = 0.0;
-            }
-        } else {
-            sleep.still_for += dt;
+        if sleep.still_for == 0.0 {
+            // A new window starts here (`at` and `orientation` are where it began; asleep, where
+            // the body fell asleep).
+            (sleep.at, sleep.orientation) = (p.0, r.0);
+        }
+        let (start, reach) = ((sleep.at, sleep.orientation), volume.reach());
+        // A turning body's surface moves at up to |ω| times its reach.
+        let speed = v.0.length().max(spin * reach);
+        let still_for =
+            test.still_for_after(sleep.still_for, (start, (p.0, r.0)), speed, reach, dt);
+        if still_for != sleep.still_for {
+            sleep.still_for = still_for;
         }
         s.awake.push(e);
         s.stillness.push(Stillness {

@@ -1,0 +1,155 @@
+//! When a body counts as still, for sleeping: it has stayed within `speed × time` of where its
+//! still time began (its centre, and its surface as it turned: the angle times its reach), so
+//! its *average* speed over the window is below the sleep speed. This is Jolt's sleep test
+//! (`Body::UpdateSleepStateInternal`: three points of the body must stay within a sphere of
+//! `mPointVelocitySleepThreshold × mTimeBeforeSleep`), and close to rapier's (the pose's drift
+//! over each step, at twice the speed threshold); Box2D v3 compares the instantaneous speed.
+//!
+//! Why the displacement and not the speed: a pile held by stiff soft contacts keeps a small
+//! oscillation that decays slowly. urto's 210-box pyramid breathed by about ±7 mm at 3 Hz, its
+//! boxes passing 0.1 m/s, for more than two seconds while going nowhere; by the speed it slept
+//! at step 158–170, by the displacement it sleeps as soon as it has settled. A body drifting
+//! steadily at speed `u` still sleeps only when `u` is below the sleep speed, as before. What
+//! changes is a body accelerating from rest (a ball set on a gentle slope): it is still while
+//! it has covered less than `speed × time` in the window, so it now sleeps below about twice
+//! the acceleration it did (0.2 m/s² against 0.1 with the defaults: a ball on a ramp under
+//! about 1.7°, against 0.8°), where rapier's and Jolt's rules put it too.
+//!
+//! A body faster than four times the sleep speed (0.2 m/s with the defaults, the speed of a
+//! 2 mm hop) is never still, whatever its window: a ball's last small bounces, which stay
+//! within the window, must not freeze it in the air (Jolt's pure displacement test would).
+
+use glam::{Quat, Vec3};
+
+/// A body's pose: its centre and orientation.
+pub type Pose = (Vec3, Quat);
+
+/// The still test of a sleep speed and time (see the module doc).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StillTest {
+    /// The farthest a still body may have gone from where its window began (m).
+    pub limit: f32,
+    /// The fastest a still body's centre or surface may move now (m/s).
+    pub fastest: f32,
+}
+
+impl StillTest {
+    /// The test of a body still below `speed` on average over `time`.
+    pub fn new(speed: f32, time: f32) -> Self {
+        Self {
+            limit: speed * time,
+            fastest: 4.0 * speed,
+        }
+    }
+
+    /// How long a body has been still after one more step of `dt` (0: not still, its window
+    /// starts again), given where its window began and its pose now (`start`, `now`), how fast
+    /// its centre or surface moves now (`speed`: the larger of `|v|` and `|ω|` × reach) and
+    /// its `reach` (how far its surface is from its centre). A NaN anywhere is not still.
+    pub fn still_for_after(
+        &self,
+        still_for: f32,
+        (start, now): (Pose, Pose),
+        speed: f32,
+        reach: f32,
+        dt: f32,
+    ) -> f32 {
+        let moved = start.0.distance(now.0);
+        let turned = start.1.angle_between(now.1) * reach;
+        let near = moved.max(turned) <= self.limit && !moved.is_nan() && !turned.is_nan();
+        if near && speed < self.fastest {
+            still_for + dt
+        } else {
+            0.0
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const DT: f32 = 1.0 / 60.0;
+
+    /// The defaults: 0.05 m/s for 0.5 s.
+    fn test() -> StillTest {
+        StillTest::new(0.05, 0.5)
+    }
+
+    /// Steps a body along `path` (seconds → pose), its speed by finite differences, restarting
+    /// its window as the sleep plugin does; returns the longest still time reached within
+    /// `seconds`.
+    fn longest_still(path: impl Fn(f32) -> Pose, reach: f32, seconds: f32) -> f32 {
+        let (mut still, mut start, mut best) = (0.0f32, path(0.0), 0.0f32);
+        for i in 1..=(seconds / DT) as u32 {
+            let (before, now) = (path((i - 1) as f32 * DT), path(i as f32 * DT));
+            let turn = now.1.angle_between(before.1) * reach;
+            let speed = now.0.distance(before.0).max(turn) / DT;
+            if still == 0.0 {
+                start = now;
+            }
+            still = test().still_for_after(still, (start, now), speed, reach, DT);
+            best = best.max(still);
+        }
+        best
+    }
+
+    #[test]
+    fn a_body_breathing_7_mm_at_3_hz_is_still_though_it_passes_0_13_m_per_s() {
+        let path = |t: f32| {
+            let y = 0.007 * (std::f32::consts::TAU * 3.0 * t).sin();
+            (Vec3::new(0.0, y, 1.0), Quat::IDENTITY)
+        };
+        assert!(longest_still(path, 0.9, 2.0) > 1.9);
+    }
+
+    #[test]
+    fn a_steady_drift_is_still_below_the_sleep_speed_and_never_above_it_by_10_percent() {
+        let drift = |u: f32| move |t: f32| (Vec3::new(u * t, 0.0, 0.0), Quat::IDENTITY);
+        assert!(longest_still(drift(0.045), 0.5, 3.0) >= 0.5);
+        assert!(longest_still(drift(0.055), 0.5, 3.0) < 0.5);
+    }
+
+    #[test]
+    fn a_body_turning_its_surface_faster_than_the_sleep_speed_is_never_still_for_the_sleep_time() {
+        // 0.2 rad/s at a 1 m reach: its surface moves at 0.2 m/s, its centre not at all.
+        let spin = |t: f32| (Vec3::ZERO, Quat::from_rotation_z(0.2 * t));
+        assert!(longest_still(spin, 1.0, 3.0) < 0.5);
+        // Rocking by ±0.01 rad at the same reach: still.
+        let rock = |t: f32| (Vec3::ZERO, Quat::from_rotation_z(0.01 * (10.0 * t).sin()));
+        assert!(longest_still(rock, 1.0, 2.0) > 1.9);
+    }
+
+    #[test]
+    fn accelerating_from_rest_at_0_25_m_per_s2_is_never_still_and_at_0_15_is() {
+        let ramp = |a: f32| move |t: f32| (Vec3::new(0.5 * a * t * t, 0.0, 0.0), Quat::IDENTITY);
+        assert!(longest_still(ramp(0.25), 0.5, 3.0) < 0.5);
+        assert!(longest_still(ramp(0.15), 0.5, 0.6) >= 0.5);
+    }
+
+    #[test]
+    fn a_ball_hopping_1_cm_is_never_still_and_one_hopping_under_1_mm_is() {
+        // Bounces of height h under gravity, over and over: the window holds them, the speed
+        // (√(2 g h): 0.44 m/s at 1 cm) does not.
+        let hops = |h: f32| {
+            move |t: f32| {
+                let period = 2.0 * (2.0 * h / 9.81).sqrt();
+                let s = t % period - 0.5 * period;
+                let z = h - 0.5 * 9.81 * s * s;
+                (Vec3::new(0.0, 0.0, z), Quat::IDENTITY)
+            }
+        };
+        assert!(longest_still(hops(0.01), 0.5, 3.0) < 0.5);
+        assert!(longest_still(hops(0.0008), 0.5, 1.0) >= 0.5);
+    }
+
+    #[test]
+    fn a_nan_pose_or_speed_is_never_still() {
+        let nan = (Vec3::NAN, Quat::IDENTITY);
+        let here = (Vec3::ZERO, Quat::IDENTITY);
+        let t = test();
+        assert_eq!(t.still_for_after(1.0, (here, nan), 0.0, 1.0, DT), 0.0);
+        assert_eq!(t.still_for_after(1.0, (here, here), 0.0, f32::NAN, DT), 0.0);
+        assert_eq!(t.still_for_after(1.0, (here, here), f32::NAN, 1.0, DT), 0.0);
+    }
+}
