@@ -312,16 +312,16 @@ fn count_stillness(
             s.kinematic.push((e, moving));
             continue;
         }
-        if sleep.still_for == 0.0 {
-            // A new window starts here (`at` and `orientation` are where it began; asleep, where
-            // the body fell asleep).
-            (sleep.at, sleep.orientation) = (p.0, r.0);
-        }
         let (start, reach) = ((sleep.at, sleep.orientation), volume.reach());
         // A turning body's surface moves at up to |ω| times its reach.
         let speed = v.0.length().max(spin * reach);
-        let still_for =
-            test.still_for_after(sleep.still_for, (start, (p.0, r.0)), speed, reach, dt);
+        let (still_for, restart) =
+            test.step(sleep.still_for, (start, (p.0, r.0)), speed, reach, dt);
+        if restart {
+            // Its window starts again here (`at` and `orientation` are where it began; asleep,
+            // where the body fell asleep).
+            (sleep.at, sleep.orientation) = (p.0, r.0);
+        }
         if still_for != sleep.still_for {
             sleep.still_for = still_for;
         }
