@@ -200,8 +200,9 @@ impl Default for ContactSettings {
     }
 }
 
-/// Sleeping (on by default): islands of bodies that stay slower than `speed` for `time` seconds
-/// stop being simulated until something wakes them (see
+/// Sleeping (on by default): islands of bodies that stay still for `time` seconds (each within
+/// `speed × time` of where its current window began, never faster than `4 × speed`) stop
+/// being simulated until something wakes them (see
 /// [`Sleeping`](crate::components::Sleeping) and [`crate::dynamics::islands`]): a sleeping
 /// body is left out of every per-step pass (`benches/effects.rs`, group `sleeping`, measures
 /// what a sleeping scene still costs). Turn it off (`enabled: false`) to watch a scene settle
@@ -211,11 +212,13 @@ impl Default for ContactSettings {
 pub struct SleepSettings {
     /// Whether bodies may fall asleep.
     pub enabled: bool,
-    /// Average speed below which a body counts as still (m/s): it must stay within
-    /// `speed × time` of where its still time began, its surface as it turns too (Jolt's sleep
-    /// test; see [`crate::dynamics::stillness`]).
+    /// The sleep speed (m/s): a still body stays within `speed × time` of where its current
+    /// window began (a net displacement: its average velocity below `speed`), its surface as it
+    /// turns too, and moves slower than `4 × speed` at every step (Jolt's sleep test with a cap;
+    /// see [`crate::dynamics::stillness`]). Also the approach speed at which a contact wakes a
+    /// sleeper.
     pub speed: f32,
-    /// How long a body must stay still before it sleeps (s).
+    /// How long a body must stay still before it sleeps (s; more than 0).
     pub time: f32,
 }
 

@@ -503,8 +503,10 @@ fn translated_scenes_match_the_origin(app: impl Fn() -> App, spacings: f32) {
     }
 }
 
-/// The rigid-body solver far from the origin: within 8 spacings (measured: 3.0 at 10³ m, 6.5
-/// at 10⁴, 6.1 at 10⁵; 7 cm there). Each step rounds the positions to the offset's spacing,
+/// The rigid-body solver far from the origin: within 8 spacings (measured: 2.9 at 10³ m, 2.6
+/// at 10⁴, 1.1 at 10⁵ since the margins by pair, 3.0, 6.5 and 6.1 before; while the margin
+/// took gravity's fall at `g dt²` for any substep count, a bounce at 10⁴ m came a step apart,
+/// 29 spacings: the bound is of rounding, not of chaos). Each step rounds the positions to the offset's spacing,
 /// and the soft contact turns a separation off by that much into a push (1/h times larger as
 /// a velocity) before the restitution pass sets the bounce, so the ball's flights differ by a
 /// few spacings more than the lecture's response lets them; the error does not grow with time

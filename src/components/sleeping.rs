@@ -13,8 +13,8 @@ use glam::{Quat, Vec3};
 use std::collections::HashMap;
 
 /// Marks a sleeping body (with [`SleepSettings`](crate::settings::SleepSettings) on, the
-/// default): a dynamic body whose whole island has been slower than the settings' speed for
-/// their time falls asleep with it. It is then neither integrated nor tested against other
+/// default): a dynamic body whose whole island has been still for the settings' time (see
+/// [`crate::dynamics::stillness`]) falls asleep with it. It is then neither integrated nor tested against other
 /// sleeping or static bodies, and costs no work per step. It wakes, with its island, when
 /// something awake hits it, when a body it rests on goes, when the game moves or turns it, sets
 /// its velocity or angular velocity, pushes it with a [`Force`](crate::components::Force),
@@ -31,10 +31,10 @@ pub struct Sleeping;
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 pub struct SleepState {
     /// Seconds the body has been still (awake bodies): within the sleep speed times the sleep
-    /// time of where this still time began ([`SleepSettings`](crate::settings::SleepSettings)).
+    /// time of where each window began ([`SleepSettings`](crate::settings::SleepSettings)).
     pub still_for: f32,
-    /// Awake, where its still time began; asleep, where it fell asleep: moving it elsewhere
-    /// wakes it.
+    /// Awake, where its current still window began; asleep, where it fell asleep: moving it
+    /// elsewhere wakes it.
     pub at: Vec3,
     /// Its orientation then: turning it wakes it (asleep).
     pub orientation: Quat,

@@ -73,7 +73,7 @@ impl IslandBuilder {
 /// What decides whether one body lets its island sleep.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Stillness {
-    /// Seconds it has been slower than the sleep speed.
+    /// Seconds it has been still ([`crate::dynamics::stillness`]).
     pub still_for: f32,
     /// It touches a body that never sleeps, or cannot sleep itself.
     pub restless: bool,

@@ -16,8 +16,9 @@
 //!   nor other sleepers) until they wake: the plugin hears of each body falling asleep or
 //!   waking from the [`Sleeping`] marker's hooks, so a sleeping pile costs no pass here.
 //! - With the rigid-body solver, a moving body's volume in the sweep is grown by its speculative
-//!   margin ([`SpeculativeMargin`](crate::plugins::SpeculativeMargin)), and a new velocity
-//!   re-indexes it, so pairs are found while the bodies can still close in one step.
+//!   margin ([`SpeculativeMargin`](crate::plugins::SpeculativeMargin)), and a new velocity or
+//!   [`GravityScale`] (written or removed) re-indexes it, so pairs are found while the bodies
+//!   can still close in one step.
 //!
 //! The moving-body algorithm is replaceable: any [`BroadPhase`] works, e.g.
 //! `BroadPhasePlugin { moving: || Box::new(RegionSweep::new()), ..default() }` (the segmented
@@ -237,6 +238,7 @@ type Moved = (
         Changed<BoundingVolume>,
         Changed<Velocity>,
         Changed<AngularVelocity>,
+        Changed<GravityScale>,
     )>,
     Without<Sleeping>,
     Unsettled,
@@ -256,6 +258,7 @@ fn sync_broad_phase(
     mut despawned: RemovedComponents<BoundingVolume>,
     mut released: RemovedComponents<Quarantined>,
     mut orphaned: RemovedComponents<ChildOf>,
+    mut unscaled: RemovedComponents<GravityScale>,
     mut transitions: ResMut<SleepTransitions>,
     lookahead: LookaheadParams,
     mut stats: ResMut<PhysicsStats>,
@@ -279,7 +282,12 @@ fn sync_broad_phase(
     for e in despawned.read().chain(gone.iter()) {
         index.forget(e);
     }
-    let back: Vec<Entity> = released.read().chain(orphaned.read()).collect();
+    // Back in the index, or with a margin that changed without a new velocity.
+    let back: Vec<Entity> = released
+        .read()
+        .chain(orphaned.read())
+        .chain(unscaled.read())
+        .collect();
     if std::mem::take(&mut index.fresh) {
         for row in roots.iter() {
             index.upsert(row, &lookahead);

@@ -173,8 +173,9 @@ fn gather_point_forces(
 }
 
 /// Bodies with their own share of gravity: the force `(s − 1) m g` on top of the world's
-/// gravity, through the user-force path every integrator and solver reads (so the lookahead,
-/// the integrators and both solvers need no per-body gravity). Kinematic bodies ignore it.
+/// gravity, through the user-force path every integrator and solver reads (so the integrators
+/// and both solvers need no per-body gravity; the speculative lookahead reads the scale
+/// itself). Kinematic bodies ignore it.
 fn scale_gravity(
     bodies: Query<(Entity, &GravityScale, &ComputedMass), Active>,
     gravity: Res<Gravity>,

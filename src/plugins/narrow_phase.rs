@@ -48,7 +48,7 @@ use crate::plugins::broad_phase::BroadPhasePairs;
 use crate::plugins::joints::JointedPairs;
 use crate::plugins::required_resources::RequireResource;
 use crate::plugins::sleep::dormant;
-use crate::plugins::soft_step::{BodyMotion, LookaheadParams};
+use crate::plugins::soft_step::{BodyMotion, LookaheadParams, Moves};
 use crate::schedule::{SubstepSchedule, SubstepSet};
 use crate::settings::SleepSettings;
 use crate::stats::{PhysicsStats, Stage};
@@ -286,8 +286,25 @@ type Motion<'a> = (
     Option<&'a AngularVelocity>,
     &'a BoundingVolume,
     Option<&'a GravityScale>,
-    Option<&'a ComputedMass>,
+    (
+        Option<&'a ComputedMass>,
+        Option<&'a LockedAxes>,
+        Has<Sleeping>,
+    ),
 );
+
+/// How the solver moves a body: a dynamic one along its free axes (gravity not pulling it while
+/// it sleeps), a kinematic one by its velocity, one without a mass not at all.
+fn moves(mass: Option<&ComputedMass>, locked: Option<&LockedAxes>, asleep: bool) -> Moves {
+    match mass {
+        Some(m) if m.inverse() > 0.0 => Moves::Dynamic {
+            free: LockedAxes::of(locked).free_translation_axes(),
+            asleep,
+        },
+        Some(_) => Moves::Kinematic,
+        None => Moves::Not,
+    }
+}
 
 #[allow(clippy::too_many_arguments)]
 fn compute_contacts(
@@ -321,10 +338,9 @@ fn compute_contacts(
     debug.pairs.clear();
     visits.clear();
     let lookahead = lookahead.get();
-    // Gravity pulls a body unless it is kinematic (infinite mass).
     let margin = |e: Entity| match motion.get(e) {
-        Ok((false, v, w, bv, g, m)) => {
-            lookahead.motion(v, w, bv, g, m.is_none_or(|m| m.inverse() > 0.0))
+        Ok((false, v, w, bv, g, (m, locked, asleep))) => {
+            lookahead.motion(v, w, bv, g, moves(m, locked, asleep))
         }
         _ => BodyMotion::default(),
     };

@@ -41,7 +41,10 @@ impl SettingsRule for ContactSettings {
 
 impl SettingsRule for SleepSettings {
     fn problem(&self) -> Option<String> {
-        below("speed", self.speed, 0.0).or_else(|| below("time", self.time, 0.0))
+        below("speed", self.speed, 0.0)
+            .or_else(|| below("time", self.time, 0.0))
+            // A zero time would put every body to sleep at its first step, in mid-air too.
+            .or_else(|| (self.time == 0.0).then(|| "time must be > 0, got 0".to_string()))
     }
 }
 

@@ -4,8 +4,9 @@
 //! Bodies sleep by islands ([`crate::dynamics::islands`]): at the end of each step the awake
 //! dynamic bodies are grouped by the step's contacts, and an island whose every body has been
 //! still for [`SleepSettings::time`] falls asleep as a whole (still: within `speed × time` of
-//! where its still time began, its centre and its surface as it turned, so slower than
-//! [`SleepSettings::speed`] on average; Jolt's sleep test, see [`crate::dynamics::stillness`]): velocities and angular velocities
+//! where its current window began, its centre and its surface as it turned, a net
+//! displacement below [`SleepSettings::speed`] on average, and never faster than four times
+//! it; Jolt's sleep test, see [`crate::dynamics::stillness`]): velocities and angular velocities
 //! become exactly zero and each body gets the [`Sleeping`] marker. The marker moves it to
 //! archetypes that every per-step query leaves out (`Without<Sleeping>`), and the broad phase
 //! stops pairing it with scenery and other sleepers, so a sleeping island costs no pass over its
@@ -293,7 +294,7 @@ fn index_slots(s: &mut IslandScratch) {
 }
 
 /// Lists the awake dynamic bodies with their stillness (counting it on, [`StillTest`]: within
-/// `speed × time` of where the body's still time began, never faster than four times the
+/// `speed × time` of where the body's current window began, never faster than four times the
 /// speed), and the kinematic ones.
 fn count_stillness(
     bodies: &mut Query<Candidate, CandidateFilter>,

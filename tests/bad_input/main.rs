@@ -235,6 +235,23 @@ fn u32_max_solver_iterations_end_after_at_most_256_sweeps() {
     assert_eq!(urto::dynamics::response::MAX_ITERATIONS, 256);
 }
 
+/// A sleep time of 0 would let every body count as still at once and sleep in mid-air: refused
+/// with the defaults back, and a dropped ball falls 2 m within 1 s.
+#[test]
+fn a_zero_sleep_time_is_refused_and_a_dropped_ball_falls_2m_within_1s() {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    let ball = common::ball(&mut app, Vec3::new(0.0, 0.0, 10.0));
+    urto::step(app.world_mut(), 1).unwrap();
+    app.world_mut().resource_mut::<SleepSettings>().time = 0.0;
+    urto::step(app.world_mut(), 60).unwrap();
+    assert_eq!(
+        *app.world().resource::<SleepSettings>(),
+        SleepSettings::default()
+    );
+    assert!(app.world().get::<Position>(ball).unwrap().0.z < 8.0);
+}
+
 /// Two entities that are each other's `ChildOf` (a loop with no root) are both quarantined, and
 /// the step ends; a ball beside them falls as it would alone.
 #[test]

@@ -12,17 +12,23 @@
 //! exactly the bodies faster than that). The broad phase grows each moving body's volume by its
 //! margin.
 //!
-//! The narrow phase tests a pair with a tighter margin ([`Lookahead::pair`]): the two fixed
-//! distances plus how far the two can close, which is their *relative* motion (Avian's
-//! speculative margin follows the relative velocity too). Two boxes resting side by side, or
-//! one on the other, fall together under gravity and close by nothing, where the sum of their
-//! own bounds read 2.7 mm at 60 Hz; the pair's closing is still capped by the sum of the two
-//! bodies' margins, so the broad phase's grown volumes always find it. Forces other than gravity
-//! are not in the bound (a body pushed hard is caught by the contacts of the next step, or by
-//! CCD).
+//! The narrow phase tests a pair with a tighter margin ([`Lookahead::pair`]): the fixed
+//! distances of its moving bodies plus how far the two can close, which is their *relative*
+//! motion (Avian's speculative margin follows the relative velocity too): each body's velocity
+//! as the solver moves it (along its free axes), and gravity's pull on the bodies it pulls
+//! (awake dynamic ones, along their free axes; not kinematic, sleeping or translation-locked
+//! ones). Two boxes resting side by side, or one on the other, fall together under gravity and
+//! close by nothing, where the sum of their own bounds read 5.4 mm at 60 Hz; the pair's closing
+//! is still capped by the sum of the two bodies' margins, so the broad phase's grown volumes
+//! (re-indexed when a velocity or a [`GravityScale`] changes) always find it. Gravity moves a
+//! body by `g dt² (n + 1) / 2n` over the solver's `n` symplectic Euler substeps (`g dt²` for
+//! one, `0.625 g dt²` for the default four), which the bound takes instead of the exact fall's
+//! `g dt² / 2`. Forces other than gravity are not in the bound (a body pushed hard
+//! is caught by the contacts of the next step, or by CCD).
 //!
-//! The fixed distance is 2.5 mm per moving body, 5 mm between two (Avian's 5 mm contact
-//! tolerance; rapier predicts 2 mm; Box2D and Jolt look 2 cm ahead). It only has to keep resting
+//! The fixed distance is 2.5 mm per moving body: 5 mm between two moving bodies, 2.5 mm
+//! between a moving one and a static one (Avian's 5 mm contact tolerance; rapier predicts
+//! 2 mm; Box2D and Jolt look 2 cm ahead). It only has to keep resting
 //! contacts found while the solver holds them a hair apart: the motion bound covers the rest.
 //! At 2 cm per body the 1 cm gaps between the boxes of a row became 190 contacts more in a
 //! 210-box pyramid (590 against 400), a quarter of its awake step.
@@ -61,16 +67,22 @@ pub(crate) struct LookaheadParams<'w> {
     margin: Option<Res<'w, SpeculativeMargin>>,
     timestep: Option<Res<'w, PhysicsTimestep>>,
     gravity: Option<Res<'w, Gravity>>,
+    solver: Option<Res<'w, super::SoftStepSolver>>,
 }
 
 impl LookaheadParams<'_> {
     /// This step's lookahead.
     pub fn get(&self) -> Lookahead {
+        let substeps = self
+            .solver
+            .as_ref()
+            .map_or(1, |s| s.solver.settings.substeps);
         Lookahead::new(
             self.margin.as_deref(),
             self.timestep.as_deref(),
             self.gravity.as_deref(),
         )
+        .with_substeps(substeps)
     }
 }
 
@@ -80,15 +92,41 @@ pub(crate) struct Lookahead {
     margin: Option<SpeculativeMargin>,
     dt: f32,
     gravity: Vec3,
+    /// How much farther than `g dt² / 2` the solver's substeps let a body fall: `(n + 1) / n`.
+    euler: f32,
+}
+
+/// How the solver moves a body, for its part in its pairs' margins.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Moves {
+    /// A dynamic body, by its velocity and gravity along its free translation axes (none
+    /// pulled while it sleeps: the solver holds a sleeper still unless a contact wakes it).
+    Dynamic { free: Vec3, asleep: bool },
+    /// A kinematic body, by its velocity alone.
+    Kinematic,
+    /// Not at all (a body the solver does not take, such as one without a mass).
+    Not,
+}
+
+impl Moves {
+    /// The axes its velocity moves it along, and those gravity pulls it along (1 or 0 each).
+    fn masks(self) -> (Vec3, Vec3) {
+        match self {
+            Moves::Dynamic { free, asleep } => (free, if asleep { Vec3::ZERO } else { free }),
+            Moves::Kinematic => (Vec3::ONE, Vec3::ZERO),
+            Moves::Not => (Vec3::ZERO, Vec3::ZERO),
+        }
+    }
 }
 
 /// A moving body's part in the margins of its pairs ([`Lookahead::pair`]); all zero for a
 /// static body.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct BodyMotion {
-    /// Its velocity (m/s).
+    /// Its velocity as the solver moves it (m/s; along its free axes).
     velocity: Vec3,
-    /// Gravity's pull on it (m/s²; none on a kinematic body).
+    /// Gravity's pull on it (m/s²; none on a kinematic or sleeping body, none along its locked
+    /// axes).
     pull: Vec3,
     /// How fast its surface can move by turning: spin × reach (m/s).
     turning: f32,
@@ -110,6 +148,17 @@ impl Lookahead {
             margin: margin.copied(),
             dt: timestep.map_or(0.0, |t| t.substep_dt()),
             gravity: gravity.map_or(Vec3::ZERO, |g| g.acceleration()),
+            euler: 2.0,
+        }
+    }
+
+    /// The lookahead of a solver integrating in `substeps` symplectic Euler substeps (one
+    /// without this call, the farthest fall; 0 counts as one).
+    pub fn with_substeps(self, substeps: u32) -> Self {
+        let n = substeps.max(1) as f32;
+        Self {
+            euler: (n + 1.0) / n,
+            ..self
         }
     }
 
@@ -123,19 +172,20 @@ impl Lookahead {
         volume: &BoundingVolume,
         scale: Option<&GravityScale>,
     ) -> f32 {
-        self.motion(v, w, volume, scale, true).own
+        // Its own bound does not depend on how the solver moves it.
+        self.motion(v, w, volume, scale, Moves::Not).own
     }
 
-    /// What a body brings to its pairs' margins; `pulled` says whether gravity moves it (a
-    /// kinematic body is not). Its own bound counts gravity's pull whatever `pulled` says, so
-    /// that it is the same as the broad phase's.
+    /// What a body brings to its pairs' margins, moved by the solver as `moves` says. Its own
+    /// bound counts its whole velocity and gravity's pull whatever `moves` says, so that it is
+    /// the same as the broad phase's.
     pub fn motion(
         &self,
         v: Option<&Velocity>,
         w: Option<&AngularVelocity>,
         volume: &BoundingVolume,
         scale: Option<&GravityScale>,
-        pulled: bool,
+        moves: Moves,
     ) -> BodyMotion {
         let (Some(m), Some(v)) = (self.margin, v) else {
             return BodyMotion::default();
@@ -143,15 +193,14 @@ impl Lookahead {
         let scale = scale.map_or(1.0, |s| s.0);
         let (spin, reach) = (w.map_or(0.0, |w| w.0.length()), volume.reach());
         let fall = scale.abs() * self.gravity.length();
-        let own = motion_bound(v.0.length(), spin, reach, fall, self.dt).min(m.reach_ratio * reach);
+        // The substeps' symplectic Euler falls `(n + 1) / n` times the `a/2` of `motion_bound`.
+        let own = motion_bound(v.0.length(), spin, reach, fall * self.euler, self.dt)
+            .min(m.reach_ratio * reach);
+        let (moved, pulled) = moves.masks();
         let finite = |x: f32| if x.is_finite() { x.max(0.0) } else { 0.0 };
         BodyMotion {
-            velocity: v.0,
-            pull: if pulled {
-                self.gravity * scale
-            } else {
-                Vec3::ZERO
-            },
+            velocity: v.0 * moved,
+            pull: self.gravity * scale * pulled,
             turning: finite(spin * reach),
             distance: finite(m.distance),
             own: finite(finite(m.distance) + finite(own)),
@@ -166,7 +215,11 @@ impl Lookahead {
         // archetype order, which must not reach the result.
         let speed = (a.velocity - b.velocity).length() + (a.turning + b.turning);
         let pull = (a.pull - b.pull).length();
-        let closing = motion_bound(speed, 0.0, 0.0, pull, self.dt);
+        let closing = if speed.is_finite() && pull.is_finite() {
+            motion_bound(speed, 0.0, 0.0, pull * self.euler, self.dt)
+        } else {
+            f32::INFINITY // overflowed: as far as the broad phase grew them
+        };
         let d = (a.distance + b.distance + closing).min(a.own + b.own);
         if d.is_finite() { d.max(0.0) } else { 0.0 }
     }
@@ -184,6 +237,11 @@ mod tests {
         Lookahead::new(Some(&margin), Some(&step), Some(&Gravity::EARTH_Z_UP))
     }
 
+    const DYNAMIC: Moves = Moves::Dynamic {
+        free: Vec3::ONE,
+        asleep: false,
+    };
+
     fn unit_box() -> BoundingVolume {
         BoundingVolume(Aabb::from_center_half_extents(Vec3::ZERO, Vec3::splat(0.5)))
     }
@@ -192,7 +250,7 @@ mod tests {
     fn two_bodies_resting_together_look_only_their_two_distances_ahead_within_1e_9() {
         // Side by side or stacked, at rest: gravity pulls both alike, so they close by nothing.
         let (l, bv) = (lookahead(), unit_box());
-        let rest = l.motion(Some(&Velocity::default()), None, &bv, None, true);
+        let rest = l.motion(Some(&Velocity::default()), None, &bv, None, DYNAMIC);
         let d = SpeculativeMargin::default().distance;
         assert!((l.pair(&rest, &rest) - 2.0 * d).abs() < 1e-9);
         // The sum of their own bounds, the old rule, counted gravity twice.
@@ -200,28 +258,64 @@ mod tests {
     }
 
     #[test]
-    fn a_body_falling_on_a_kinematic_platform_or_the_ground_counts_gravity_within_1e_6() {
+    fn a_body_falling_on_an_unpulled_body_or_the_ground_counts_gravity_within_1e_6() {
         let (l, bv) = (lookahead(), unit_box());
         let v = Velocity(Vec3::new(0.0, 0.0, -2.0));
-        let falling = l.motion(Some(&v), None, &bv, None, true);
-        let platform = l.motion(Some(&Velocity::default()), None, &bv, None, false);
+        let falling = l.motion(Some(&v), None, &bv, None, DYNAMIC);
         let dt = PhysicsTimestep::default().substep_dt();
         let d = SpeculativeMargin::default().distance;
-        let closing = 2.0 * dt + 0.5 * 9.8 * dt * dt;
-        assert!((l.pair(&falling, &platform) - (2.0 * d + closing)).abs() < 1e-6);
+        let closing = 2.0 * dt + 9.8 * dt * dt; // one substep: the farthest fall
+        // A kinematic platform, a sleeping body and a paddle locked along gravity's axis are
+        // not pulled (a game-written upward speed on the locked axis moves it neither).
+        let rest = Some(&Velocity::default());
+        let up = Velocity(Vec3::new(0.0, 0.0, 3.0));
+        let sleeper = Moves::Dynamic {
+            free: Vec3::ONE,
+            asleep: true,
+        };
+        let locked = Moves::Dynamic {
+            free: Vec3::new(1.0, 1.0, 0.0),
+            asleep: false,
+        };
+        for other in [
+            l.motion(rest, None, &bv, None, Moves::Kinematic),
+            l.motion(rest, None, &bv, None, sleeper),
+            l.motion(Some(&up), None, &bv, None, locked),
+        ] {
+            assert!((l.pair(&falling, &other) - (2.0 * d + closing)).abs() < 1e-6);
+        }
         // The ground (static) has no distance of its own.
         let ground = BodyMotion::default();
         assert!((l.pair(&falling, &ground) - (d + closing)).abs() < 1e-6);
     }
 
+    /// How far two point bodies close in one step of `n` symplectic Euler substeps (the
+    /// solver's integration), each moved as `moves` says: the change of their separation.
+    fn closed_by(l: &Lookahead, bodies: [(Vec3, f32, Moves); 2], n: u32) -> f32 {
+        let h = l.dt / n as f32;
+        let ends = bodies.map(|(v, scale, moves)| {
+            let (moved, pulled) = moves.masks();
+            let (mut x, mut v) = (Vec3::ZERO, v * moved);
+            for _ in 0..n {
+                v += l.gravity * scale * pulled * h;
+                x += v * h;
+            }
+            x
+        });
+        (ends[0] - ends[1]).length()
+    }
+
     #[test]
-    fn a_pairs_margin_is_symmetric_to_the_bit_and_never_exceeds_what_the_broad_phase_grew() {
-        // The broad phase finds a pair when the gap is under the sum of the two grown margins;
-        // the narrow phase's pair margin must stay within it, whatever the velocities, spins,
-        // gravity scales and sizes (kinematic or not), and must not depend on the pair's order.
-        let l = lookahead();
+    fn a_pairs_margin_covers_how_far_the_solver_closes_them_is_symmetric_to_the_bit_and_finite() {
+        // Random velocities, gravity scales and kinds (dynamic free or locked, asleep,
+        // kinematic): the separation two bodies integrated like the solver's substeps change by
+        // in a step is within the pair's margin less its fixed distances, unless the margin is
+        // capped at what the broad phase grew them by (beyond a body's reach is CCD's business);
+        // the margin does not depend on the pair's order.
         let mut rng = TestRng::new(5);
-        for _ in 0..10_000 {
+        for i in 0..10_000 {
+            let n = [1, 2, 4, 8][i % 4];
+            let l = lookahead().with_substeps(n);
             let body = |rng: &mut TestRng| {
                 let v = Velocity(rng.vec3(-30.0, 30.0) * rng.range(0.0, 1.0).powi(3));
                 let w = AngularVelocity(rng.vec3(-20.0, 20.0) * rng.range(0.0, 1.0).powi(3));
@@ -230,15 +324,31 @@ mod tests {
                     rng.vec3(0.01, 3.0),
                 ));
                 let g = GravityScale(rng.range(-2.0, 3.0));
-                let pulled = rng.range(0.0, 1.0) < 0.8;
+                let lock = |rng: &mut TestRng| if rng.unit() < 0.2 { 0.0 } else { 1.0 };
+                let free = Vec3::new(lock(rng), lock(rng), lock(rng));
+                let moves = match rng.below(4) {
+                    0 => Moves::Kinematic,
+                    1 => Moves::Dynamic { free, asleep: true },
+                    _ => Moves::Dynamic {
+                        free,
+                        asleep: false,
+                    },
+                };
                 let grown = l.of(Some(&v), Some(&w), &bv, Some(&g));
-                (l.motion(Some(&v), Some(&w), &bv, Some(&g), pulled), grown)
+                let motion = l.motion(Some(&v), Some(&w), &bv, Some(&g), moves);
+                (motion, grown, (v.0, g.0, moves))
             };
-            let ((a, grown_a), (b, grown_b)) = (body(&mut rng), body(&mut rng));
+            let ((a, grown_a, pa), (b, grown_b, pb)) = (body(&mut rng), body(&mut rng));
             let m = l.pair(&a, &b);
             assert_eq!(m.to_bits(), l.pair(&b, &a).to_bits());
-            assert!(m <= grown_a + grown_b, "{m} > {grown_a} + {grown_b}");
-            assert!(m >= 0.0 && m.is_finite());
+            assert!(m >= 0.0 && m.is_finite() && m <= grown_a + grown_b);
+            let capped = m == grown_a + grown_b;
+            let closed = closed_by(&l, [pa, pb], n);
+            let room = m - a.distance - b.distance;
+            assert!(
+                capped || closed <= room * (1.0 + 1e-5) + 1e-7,
+                "{n} substeps: {closed} > {room}"
+            );
         }
     }
 }

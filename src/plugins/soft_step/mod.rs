@@ -5,7 +5,8 @@
 //! lever arms, friction, restitution, springs; see [`crate::dynamics::solver`]): the Integrate
 //! stage and the legacy response stand aside (their systems run only without this plugin's
 //! resource), the broad and narrow phases find the contacts once per step at the step's start,
-//! looking ahead by each body's speculative margin ([`SpeculativeMargin`]), and one system in
+//! looking ahead by each pair's speculative margin ([`SpeculativeMargin`]: the bodies' fixed
+//! distances and how far the two can close in the step), and one system in
 //! the Response set gathers the bodies, calls [`Solver::step`] and writes positions, rotations
 //! and velocities back. Continuous collision sweeps the solver's motion afterwards; collision
 //! messages, sleeping, hierarchies and validation work as before.
@@ -38,7 +39,7 @@ pub use lookahead::SpeculativeMargin;
 
 use contact_inputs::{KeyedContacts, Material, add_part_motion, gather_contacts, report_impulses};
 use joint_inputs::JointParams;
-pub(crate) use lookahead::{BodyMotion, Lookahead, LookaheadParams};
+pub(crate) use lookahead::{BodyMotion, Lookahead, LookaheadParams, Moves};
 use slots::BodySlots;
 
 use crate::components::*;
