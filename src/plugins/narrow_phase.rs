@@ -6,10 +6,12 @@
 //! hierarchy's work is published as `hierarchy/bv_tests`, `hierarchy/nodes_visited` and
 //! `hierarchy/collider_pairs`.
 //!
-//! With the rigid-body solver each pair is tested looking ahead by its speculative margin (the
-//! two bodies' fixed distances and how far they can close in a step, `Lookahead::pair` in `soft_step/lookahead.rs`) ([`speculative_contact_with_scratch`]: grown spheres and boxes, raised
-//! half-spaces, the gaps between two meshes' triangles), so manifolds may hold points still apart
-//! (negative depth). A pair is always computed with its lower collider first, so which shape is
+//! With the rigid-body solver each pair is tested looking ahead by its speculative margin: the
+//! fixed distances of its moving bodies and how far the two can close in a step
+//! (`Lookahead::pair`, `soft_step/lookahead.rs`). The test grows spheres and boxes, raises
+//! half-spaces and measures the gaps between two meshes' triangles
+//! ([`speculative_contact_with_scratch`]), so manifolds may hold points still apart (negative
+//! depth). A pair is always computed with its lower collider first, so which shape is
 //! grown and which face is the reference never follow the broad phase's (archetype) order.
 //!
 //! A costly pair (a mesh against anything; two shapes that are neither spheres, half-spaces

@@ -180,7 +180,8 @@ const MAX_GROWN_BOX_ERROR: f32 = 1e-5;
 /// How far a body can move in `dt`, for its speculative margin: its centre at `speed` plus
 /// the exact fall `a dt²/2`, and its surface turning at `angular_speed` times its `reach` (the
 /// radius about its centre that holds it). A body integrated in symplectic Euler substeps falls
-/// up to twice as far in `dt`: the solver's lookahead passes `2a`. Non-finite inputs count as no motion (validation
+/// up to twice as far in `dt` (`(n + 1) / n` times as far over `n` substeps): the solver's
+/// lookahead passes `a (n + 1) / n`. Non-finite inputs count as no motion (validation
 /// quarantines such bodies).
 pub fn motion_bound(speed: f32, angular_speed: f32, reach: f32, acceleration: f32, dt: f32) -> f32 {
     let d = (speed + angular_speed * reach) * dt + 0.5 * acceleration * dt * dt;
