@@ -45,7 +45,8 @@ struct Args {
     /// Waves they come in (one every half second).
     #[arg(long, default_value_t = 10)]
     waves: u32,
-    /// Physics steps (60 per simulated second): the pile falls asleep at about 11 s.
+    /// Physics steps (60 per simulated second): the pile falls asleep at about 11–18 s (one
+    /// straggler may roll on for a while).
     #[arg(long, default_value_t = 720)]
     steps: u32,
     /// Substeps per step (with 1, overlaps between bodies triple and now and then a body falls
