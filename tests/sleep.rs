@@ -493,3 +493,64 @@ fn a_settled_static_moved_reshaped_or_made_dynamic_acts_on_the_next_step_within_
     let fallen = z(&app, hanging_box);
     assert!((fallen - 0.5).abs() < 0.01, "fell to z = {fallen}");
 }
+
+/// Sleeping by displacement (`src/dynamics/stillness.rs`): a 20-row pyramid of 210 boxes, whose
+/// stiff contacts keep it breathing by a few millimetres at 3 Hz (boxes passing 0.1 m/s), falls
+/// asleep within 1 s of being built, every box within 1 cm of where it stood (by the speed rule
+/// it slept after 2.6 s).
+#[test]
+fn a_breathing_210_box_pyramid_sleeps_within_1_s_every_box_within_1_cm() {
+    let mut app = sleepy_app();
+    let mut boxes = Vec::new();
+    for row in 0..20 {
+        let count = 20 - row;
+        for k in 0..count {
+            let y = (k as f32 - (count - 1) as f32 * 0.5) * 1.01;
+            let at = Vec3::new(0.0, y, 0.5 + row as f32);
+            let body = (
+                Collider::cuboid(0.5, 0.5, 0.5),
+                Position(at),
+                Velocity::default(),
+            );
+            boxes.push((app.world_mut().spawn(body).id(), at));
+        }
+    }
+    urto::step(app.world_mut(), 60).unwrap();
+    for &(b, at) in &boxes {
+        assert!(asleep(&app, b), "a box still awake after 1 s");
+        let moved = position(&app, b).distance(at);
+        assert!(moved < 0.01, "a box moved {moved} m");
+    }
+}
+
+/// A turning point is not a resting place: a 1 m pendulum swinging by 10° (0.55 m/s at the
+/// bottom) slows to a stop at each end, but any half-second window there holds more than the
+/// 2.5 cm a still body may move, so it is never frozen and still swings by more than 8° after
+/// 5 s (below about 5° it could freeze at an end: see the README's limits).
+#[test]
+fn a_pendulum_swinging_10_degrees_never_sleeps_in_5_s_and_keeps_8_degrees() {
+    let mut app = sleepy_app();
+    let pivot = Vec3::new(0.0, 0.0, 5.0);
+    let start = 10f32.to_radians();
+    let at = pivot + Vec3::new(start.sin(), 0.0, -start.cos());
+    let bob = app
+        .world_mut()
+        .spawn((Collider::sphere(0.05), Position(at), Velocity::default()))
+        .id();
+    app.world_mut()
+        .spawn(Joint::spherical(bob, JointEnd::World).with_anchors(pivot - at, pivot));
+    let mut widest = 0.0f32;
+    for step in 0..300 {
+        urto::step(app.world_mut(), 1).unwrap();
+        assert!(!asleep(&app, bob), "frozen at step {step}");
+        if step >= 240 {
+            let x = position(&app, bob).x;
+            widest = widest.max(x.clamp(-1.0, 1.0).asin().abs()); // a 1 m rope
+        }
+    }
+    assert!(
+        widest > 8f32.to_radians(),
+        "{} degrees",
+        widest.to_degrees()
+    );
+}
