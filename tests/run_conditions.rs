@@ -308,3 +308,46 @@ fn in_a_box_of_six_planes_a_ball_pairs_only_with_the_planes_its_grown_volume_rea
     urto::step(app.world_mut(), 1).unwrap();
     assert_eq!(planes_of(&app, &walls, &balls), [1, 2, 3]);
 }
+
+/// Two boxes floating still 4 mm apart (no gravity, never moving, so nothing re-indexes them
+/// for their own sake): with a 1 mm speculative distance per body they are no broad-phase pair;
+/// when the game raises it to 2.5 mm (5 mm for the two) they are one at the next step, and
+/// again none after it is lowered back.
+#[test]
+fn a_changed_speculative_margin_regrows_resting_bodies_within_one_step_4_mm_apart() {
+    use urto::plugins::SpeculativeMargin;
+    let mut app = common::app();
+    app.insert_resource(Gravity::new(Vec3::ZERO).unwrap());
+    let margin = |d: f32| SpeculativeMargin {
+        distance: d,
+        ..Default::default()
+    };
+    app.insert_resource(margin(0.001));
+    let still = |app: &mut bevy_app::App, x: f32| {
+        let body = (
+            Collider::cuboid(0.5, 0.5, 0.5),
+            Position::new(x, 0.0, 5.0),
+            Velocity::default(),
+        );
+        app.world_mut().spawn(body).id()
+    };
+    let (a, b) = (still(&mut app, 0.0), still(&mut app, 1.004));
+    let paired = |app: &bevy_app::App| {
+        let pairs = &app
+            .world()
+            .resource::<urto::plugins::BroadPhasePairs>()
+            .pairs;
+        pairs.iter().any(|&p| p == (a, b) || p == (b, a))
+    };
+    urto::step(app.world_mut(), 3).unwrap();
+    assert!(!paired(&app));
+    app.insert_resource(margin(0.0025));
+    urto::step(app.world_mut(), 1).unwrap();
+    assert!(
+        paired(&app),
+        "the raised margin did not regrow the resting boxes"
+    );
+    app.insert_resource(margin(0.001));
+    urto::step(app.world_mut(), 1).unwrap();
+    assert!(!paired(&app));
+}

@@ -148,6 +148,10 @@ pub struct BroadPhaseIndex {
     /// Made since the last sync (first step, or made again after game code removed it): every
     /// root is indexed, not only the changed ones.
     fresh: bool,
+    /// The lookahead the indexed volumes were grown with: when the margin settings, the step,
+    /// gravity or the solver's substeps change, every root is indexed again (a resting body's
+    /// velocity does not change, so nothing else would re-grow it).
+    grown_with: Option<Lookahead>,
 }
 
 impl BroadPhaseIndex {
@@ -165,6 +169,7 @@ impl BroadPhaseIndex {
             hits: Vec::new(),
             planes: Vec::new(),
             fresh: true,
+            grown_with: None,
         }
     }
 
@@ -276,6 +281,9 @@ fn sync_broad_phase(
     let start = Instant::now();
     let lookahead = lookahead.get();
     let index = &mut *index;
+    if index.grown_with.replace(lookahead) != Some(lookahead) {
+        index.fresh = true;
+    }
     for (e, asleep) in transitions.0.drain(..) {
         index.proxies.set_asleep(e, asleep);
     }

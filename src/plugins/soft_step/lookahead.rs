@@ -27,9 +27,9 @@
 //!
 //! What the bound leaves to the fixed distance: forces other than gravity (a body pushed hard
 //! is caught by the contacts of the next step, or by CCD); a sleeper that a contact wakes
-//! within the solve, counted unpulled (at most the fall above, 1.7 mm at 60 Hz); and a resting
-//! body's growth in the broad phase, refreshed when its velocity or gravity scale changes, not
-//! when the world's gravity, the step or the substep count does.
+//! within the solve, counted unpulled (at most the fall above, 1.7 mm at 60 Hz). A resting
+//! body's growth in the broad phase is refreshed when its velocity or gravity scale changes,
+//! and every body's when the margin settings, the step, gravity or the substep count do.
 //!
 //! The fixed distance is 2.5 mm per moving body: 5 mm between two moving bodies, 2.5 mm
 //! between a moving one and a static one (Avian's 5 mm contact tolerance; rapier predicts
@@ -95,7 +95,7 @@ impl LookaheadParams<'_> {
 }
 
 /// A system's view of the margin for this step: the settings, the step and gravity.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Lookahead {
     margin: Option<SpeculativeMargin>,
     dt: f32,
