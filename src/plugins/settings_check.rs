@@ -20,6 +20,11 @@ fn below(name: &str, x: f32, min: f32) -> Option<String> {
     (!(x.is_finite() && x >= min)).then(|| format!("{name} must be finite and >= {min}, got {x}"))
 }
 
+/// `Some(description)` when `x` is not finite or not above `min`.
+fn not_above(name: &str, x: f32, min: f32) -> Option<String> {
+    (!(x.is_finite() && x > min)).then(|| format!("{name} must be finite and > {min}, got {x}"))
+}
+
 impl SettingsRule for ContactSettings {
     fn problem(&self) -> Option<String> {
         let s = &self.solver;
@@ -41,10 +46,8 @@ impl SettingsRule for ContactSettings {
 
 impl SettingsRule for SleepSettings {
     fn problem(&self) -> Option<String> {
-        below("speed", self.speed, 0.0)
-            .or_else(|| below("time", self.time, 0.0))
-            // A zero time would put every body to sleep at its first step, in mid-air too.
-            .or_else(|| (self.time == 0.0).then(|| "time must be > 0, got 0".to_string()))
+        // A zero time would put every body to sleep at its first step, in mid-air too.
+        below("speed", self.speed, 0.0).or_else(|| not_above("time", self.time, 0.0))
     }
 }
 

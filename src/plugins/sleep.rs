@@ -318,17 +318,19 @@ fn count_stillness(
         let speed = v.0.length().max(spin * reach);
         let (still_for, restart) =
             test.step(sleep.still_for, (start, (p.0, r.0)), speed, reach, dt);
+        let mut next = SleepState {
+            still_for,
+            ..*sleep
+        };
         if restart {
             // Its window starts again here (`at` and `orientation` are where it began; asleep,
             // where the body fell asleep).
-            (sleep.at, sleep.orientation) = (p.0, r.0);
+            (next.at, next.orientation) = (p.0, r.0);
         }
-        if still_for != sleep.still_for {
-            sleep.still_for = still_for;
-        }
+        sleep.set_if_neq(next);
         s.awake.push(e);
         s.stillness.push(Stillness {
-            still_for: sleep.still_for,
+            still_for,
             restless: false,
         });
     }

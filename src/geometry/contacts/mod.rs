@@ -90,7 +90,9 @@ pub use cuboid_cuboid::contact_cuboid_cuboid;
 pub use cuboid_halfspace::contact_cuboid_halfspace;
 pub use manifold_cache::{MAX_SHIFT, ManifoldCache};
 pub use mesh_scratch::{ContactScratch, NO_TRIANGLE};
-pub use speculative::{motion_bound, speculative_contact, speculative_contact_with_scratch};
+pub use speculative::{
+    motion_bound, raw_motion_bound, speculative_contact, speculative_contact_with_scratch,
+};
 pub use sphere_cuboid::contact_sphere_cuboid;
 pub use sphere_halfspace::contact_sphere_halfspace;
 pub use sphere_sphere::contact_sphere_sphere;

@@ -184,8 +184,14 @@ const MAX_GROWN_BOX_ERROR: f32 = 1e-5;
 /// lookahead passes `a (n + 1) / n`. Non-finite inputs count as no motion (validation
 /// quarantines such bodies).
 pub fn motion_bound(speed: f32, angular_speed: f32, reach: f32, acceleration: f32, dt: f32) -> f32 {
-    let d = (speed + angular_speed * reach) * dt + 0.5 * acceleration * dt * dt;
+    let d = raw_motion_bound(speed + angular_speed * reach, acceleration, dt);
     if d.is_finite() { d.max(0.0) } else { 0.0 }
+}
+
+/// [`motion_bound`] of a point at `speed` as computed, infinite or NaN when the inputs are (a
+/// caller that must not read an overflow as no motion decides what it means).
+pub fn raw_motion_bound(speed: f32, acceleration: f32, dt: f32) -> f32 {
+    speed * dt + 0.5 * acceleration * dt * dt
 }
 
 /// The pose of a half-space moved `margin` out along its outward normal (`None` for any other

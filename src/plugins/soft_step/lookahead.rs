@@ -39,7 +39,7 @@
 //! 210-box pyramid (590 against 400), a quarter of its awake step.
 
 use crate::components::{AngularVelocity, BoundingVolume, GravityScale, Velocity};
-use crate::geometry::contacts::motion_bound;
+use crate::geometry::contacts::{motion_bound, raw_motion_bound};
 use crate::settings::{Gravity, PhysicsTimestep};
 use bevy_ecs::prelude::*;
 use bevy_ecs::system::SystemParam;
@@ -223,8 +223,7 @@ impl Lookahead {
         // archetype order, which must not reach the result.
         let speed = (a.velocity - b.velocity).length() + (a.turning + b.turning);
         let pull = (a.pull - b.pull).length();
-        let dt = self.dt;
-        let closing = speed * dt + 0.5 * pull * self.euler * dt * dt;
+        let closing = raw_motion_bound(speed, pull * self.euler, self.dt);
         // Overflowed (or NaN): as far as the broad phase grew them.
         let closing = if closing.is_finite() {
             closing.max(0.0)
