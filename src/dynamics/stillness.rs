@@ -47,7 +47,10 @@ pub struct StillTest {
 }
 
 impl StillTest {
-    /// The test of a body still below `speed` on average over `time`.
+    /// The test of a body still below `speed` on average over `time`. A NaN or negative speed
+    /// or time, or a zero speed, makes a test that finds no body still (a zero time, one that
+    /// finds only a body exactly at rest still); the ECS refuses them before they get here
+    /// (`SleepSettings`).
     pub fn new(speed: f32, time: f32) -> Self {
         Self {
             limit: speed * time,
@@ -194,6 +197,26 @@ mod tests {
         let q = Quat::from_rotation_z(0.25);
         assert!((turn_angle(Quat::IDENTITY, q) - 0.25).abs() < 1e-6);
         assert!((turn_angle(q, -q)).abs() < 1e-6); // the same orientation
+    }
+
+    #[test]
+    fn a_test_of_a_nan_negative_or_zero_speed_or_time_finds_a_body_at_rest_never_still() {
+        let rest = (Vec3::ZERO, Quat::IDENTITY);
+        for (speed, time) in [
+            (f32::NAN, 0.5),
+            (0.05, f32::NAN),
+            (-0.05, 0.5),
+            (0.05, -0.5),
+            (0.0, 0.5),
+            (f32::NEG_INFINITY, 0.5),
+        ] {
+            let t = StillTest::new(speed, time);
+            let mut still = 0.0;
+            for _ in 0..120 {
+                (still, _) = t.step(still, (rest, rest), 0.0, 1.0, DT);
+            }
+            assert_eq!(still, 0.0, "{speed} m/s, {time} s");
+        }
     }
 
     #[test]
