@@ -8,6 +8,7 @@ use crate::plugins::narrow_phase::{Contacts, HierarchyVisits, OverlappingLeaves,
 use crate::plugins::required_resources::{RequireResource, restore_required_resources};
 use crate::plugins::settings_check::check_settings;
 use crate::plugins::settle::{settle_statics, unsettle_written};
+use crate::plugins::soft_step::SpeculativeMargin;
 use crate::plugins::transform_sync::ReadGameTransforms;
 use crate::schedule::{
     BroadPhaseSystems, PhysicsSchedule, PhysicsSet, SubstepSchedule, SubstepSet,
@@ -73,6 +74,7 @@ impl Plugin for PhysicsCorePlugin {
                 check_settings::<ContactSettings>,
                 check_settings::<SleepSettings>,
                 check_settings::<CcdSettings>,
+                check_settings::<SpeculativeMargin>,
             )
                 .chain()
                 .in_set(PhysicsSet::Prepare)

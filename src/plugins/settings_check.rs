@@ -5,6 +5,7 @@
 //! are; the rule for each is written once here.
 
 use crate::plugins::ccd::CcdSettings;
+use crate::plugins::soft_step::SpeculativeMargin;
 use crate::settings::{ContactSettings, SleepSettings};
 use bevy_ecs::component::Mutable;
 use bevy_ecs::prelude::*;
@@ -48,6 +49,13 @@ impl SettingsRule for SleepSettings {
     fn problem(&self) -> Option<String> {
         // A zero time would put every body to sleep at its first step, in mid-air too.
         below("speed", self.speed, 0.0).or_else(|| not_above("time", self.time, 0.0))
+    }
+}
+
+impl SettingsRule for SpeculativeMargin {
+    fn problem(&self) -> Option<String> {
+        below("distance", self.distance, 0.0)
+            .or_else(|| below("reach_ratio", self.reach_ratio, 0.0))
     }
 }
 

@@ -235,6 +235,39 @@ fn u32_max_solver_iterations_end_after_at_most_256_sweeps() {
     assert_eq!(urto::dynamics::response::MAX_ITERATIONS, 256);
 }
 
+/// A NaN or negative speculative distance (each would silently read as no lookahead) and a
+/// negative reach ratio are refused with the defaults back, and a dropped ball falls 2 m
+/// within 1 s.
+#[test]
+fn unusable_speculative_margins_are_refused_with_the_defaults_and_a_dropped_ball_falls_2m_within_1s()
+ {
+    use urto::plugins::SpeculativeMargin;
+    for bad in [
+        SpeculativeMargin {
+            distance: f32::NAN,
+            ..Default::default()
+        },
+        SpeculativeMargin {
+            distance: -0.01,
+            ..Default::default()
+        },
+        SpeculativeMargin {
+            reach_ratio: -1.0,
+            ..Default::default()
+        },
+    ] {
+        let (mut app, ball) = dropped_ball();
+        app.insert_resource(bad);
+        urto::step(app.world_mut(), 60).unwrap();
+        assert_eq!(
+            *app.world().resource::<SpeculativeMargin>(),
+            SpeculativeMargin::default()
+        );
+        let z = app.world().get::<Position>(ball).unwrap().0.z;
+        assert!(z < 8.0, "z = {z}");
+    }
+}
+
 /// A ball dropped from 10 m above a bare world, after its first step (for the settings tests:
 /// it must fall 2 m within 1 s whatever a refused setting would have done).
 fn dropped_ball() -> (bevy_app::App, bevy_ecs::entity::Entity) {

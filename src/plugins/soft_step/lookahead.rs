@@ -47,6 +47,8 @@ use glam::Vec3;
 
 /// The speculative margin's two numbers; inserted by
 /// [`SoftStepPlugin`](super::SoftStepPlugin) (without it, contacts are found touching only).
+/// Checked when a game changes it: a NaN, infinite or negative value is refused with a warning
+/// and the defaults back.
 #[derive(Resource, Clone, Copy, Debug, PartialEq)]
 pub struct SpeculativeMargin {
     /// Looked ahead always by each moving body (m; a pair of them looks twice as far): contacts
