@@ -235,7 +235,10 @@ fn touching_now(contacts: &Contacts, fresh: &mut Vec<Touch>) {
             .filter(|(c, _)| c.normal_impulse > 0.0 || c.manifold.touching(TOUCHING_TOLERANCE))
             .map(|(c, i)| ((c.a.min(c.b), c.a.max(c.b)), i)),
     );
-    fresh.sort_unstable();
+    // By pair, then by index (the list is in index order and the radix sort stable).
+    radsort::sort_by_key(fresh, |((a, b), _)| {
+        (u128::from(a.to_bits()) << 64) | u128::from(b.to_bits())
+    });
     // The strongest push, then (ties, as without the rigid-body solver) the fastest approach.
     let strength = |i: u32| {
         let c = &contacts.pairs[i as usize];

@@ -158,6 +158,7 @@ pub struct RowPart {
 impl RowPart {
     /// The row along `dir` at anchors `ra`, `rb`; `linear` is its translational part
     /// `d·W_a d + d·W_b d` (the same for every point of a contact, so computed once).
+    #[inline]
     fn new(
         pa: &BodyParams,
         pb: &BodyParams,
@@ -218,6 +219,42 @@ impl ContactConstraint {
         params: &[BodyParams],
         softness: Softness,
     ) -> Self {
+        let mut c = Self {
+            a: 0,
+            b: 0,
+            normal: Vec3::ZERO,
+            tangents: [Vec3::ZERO; 2],
+            friction: 0.0,
+            restitution: 0.0,
+            softness,
+            points: [ConstraintPoint::default(); MAX_MANIFOLD_POINTS],
+            count: 0,
+            key: 0,
+            flip: false,
+            inverse_mass: [Vec3::ZERO; 2],
+            translation_locked: false,
+            dynamic: [false; 2],
+            rolling: RollingRows::default(),
+            closing_acceleration: 0.0,
+        };
+        c.refill(input, centers, states, params, softness);
+        c
+    }
+
+    /// [`Self::prepare`] in place, over last step's constraint in the same place of the list:
+    /// a constraint is about a kilobyte (four points of three rows), and building each one to
+    /// move it into the list copied it twice and cleared its unused points, a tenth of a
+    /// pile's preparation. The points past [`Self::points`] keep stale values; nothing reads
+    /// them.
+    #[inline]
+    pub fn refill(
+        &mut self,
+        input: &ContactInput,
+        centers: &[Vec3],
+        states: &[BodyState],
+        params: &[BodyParams],
+        softness: Softness,
+    ) {
         let (ia, ib) = (input.a as usize, input.b as usize);
         let (pa, pb) = (&params[ia], &params[ib]);
         let n = input.normal;
@@ -231,8 +268,8 @@ impl ContactConstraint {
         let uniform = same_on_every_axis(w);
         let along = |d: Vec3| (d, if uniform { w.x } else { w.dot(d * d) });
         let (normal, sides) = (along(n), tangents.map(along));
-        let mut points = [ConstraintPoint::default(); MAX_MANIFOLD_POINTS];
-        for (cp, p) in points.iter_mut().zip(&input.points[..input.count as usize]) {
+        let count = (input.count as usize).min(MAX_MANIFOLD_POINTS);
+        for (cp, p) in self.points.iter_mut().zip(&input.points[..count]) {
             let ra = p.point - centers[ia];
             let rb = p.point - centers[ib];
             let relative = point_velocity(&states[ib], rb) - point_velocity(&states[ia], ra);
@@ -246,29 +283,26 @@ impl ContactConstraint {
                 ..Default::default()
             };
         }
-        Self {
-            a: input.a,
-            b: input.b,
-            normal: n,
+        self.a = input.a;
+        self.b = input.b;
+        self.normal = n;
+        self.tangents = tangents;
+        self.friction = input.friction.max(0.0);
+        self.restitution = sane_restitution(input.restitution);
+        self.softness = softness;
+        self.count = count as u8;
+        self.key = input.key;
+        self.flip = false;
+        self.inverse_mass = [pa.inverse_mass, pb.inverse_mass];
+        self.translation_locked =
+            !same_on_every_axis(pa.inverse_mass) || !same_on_every_axis(pb.inverse_mass);
+        self.dynamic = [pa.dynamic, pb.dynamic];
+        self.closing_acceleration = (pb.linear_acceleration - pa.linear_acceleration).dot(n);
+        self.rolling = RollingRows::new(
+            input.rolling_resistance,
             tangents,
-            friction: input.friction.max(0.0),
-            restitution: sane_restitution(input.restitution),
-            softness,
-            points,
-            count: input.count,
-            key: input.key,
-            flip: false,
-            inverse_mass: [pa.inverse_mass, pb.inverse_mass],
-            translation_locked: !same_on_every_axis(pa.inverse_mass)
-                || !same_on_every_axis(pb.inverse_mass),
-            dynamic: [pa.dynamic, pb.dynamic],
-            closing_acceleration: (pb.linear_acceleration - pa.linear_acceleration).dot(n),
-            rolling: RollingRows::new(
-                input.rolling_resistance,
-                tangents,
-                [pa.inverse_inertia, pb.inverse_inertia],
-            ),
-        }
+            [pa.inverse_inertia, pb.inverse_inertia],
+        );
     }
 
     /// The used points.
@@ -453,5 +487,80 @@ impl Pair {
             s.linear_velocity = self.vb;
             s.angular_velocity = self.wb;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dynamics::solver::{BodyInput, SolverBodies};
+    use glam::Quat;
+
+    /// A contact between bodies `a` and `b` with `count` points, its numbers drawn from `k`.
+    fn input(a: u32, b: u32, count: u8, k: f32) -> ContactInput {
+        let mut points = [ContactPointInput::default(); MAX_MANIFOLD_POINTS];
+        for (j, p) in points.iter_mut().enumerate() {
+            *p = ContactPointInput {
+                point: Vec3::new(k + 0.5, 0.2 * j as f32, -0.1 * k),
+                separation: 0.01 * (j as f32 - k),
+            };
+        }
+        ContactInput {
+            a,
+            b,
+            normal: Vec3::new(0.1 * k, 0.3, 1.0).normalize(),
+            friction: 0.2 * k,
+            restitution: 0.1 * k,
+            rolling_resistance: 0.05 * (k - 1.0),
+            points,
+            count,
+            key: k as u128,
+        }
+    }
+
+    #[test]
+    fn a_constraint_refilled_over_a_fuller_one_equals_a_fresh_one_on_every_read_value() {
+        let mut bodies = SolverBodies::default();
+        for i in 0..4 {
+            let f = i as f32;
+            bodies.push(BodyInput {
+                center: Vec3::new(f, 0.2 * f, 0.1),
+                orientation: Quat::from_rotation_x(0.3 * f),
+                linear_velocity: Vec3::new(0.4, -f, 0.2),
+                angular_velocity: Vec3::new(-0.3, 0.5 * f, 1.0),
+                inverse_mass: 1.0 / (1.0 + f),
+                inverse_principal_inertia: Vec3::new(1.0 + f, 2.0, 3.0),
+                ..Default::default()
+            });
+        }
+        let (soft, stiff) = (
+            Softness::new(30.0, 10.0, 1.0 / 240.0),
+            Softness::new(60.0, 10.0, 1.0 / 240.0),
+        );
+        let prepare = |c: &ContactInput, s| {
+            ContactConstraint::prepare(c, &bodies.centers, &bodies.states, &bodies.params, s)
+        };
+        // Last step's constraint: four points with impulses, flipped, rolling.
+        let mut reused = prepare(&input(0, 1, 4, 2.0), soft);
+        for p in &mut reused.points {
+            p.normal_impulse = 0.3;
+            p.tangent_impulse = [0.1, -0.2];
+            p.max_normal_impulse = 0.4;
+        }
+        reused.flip = true;
+        let next = input(2, 3, 1, 1.0);
+        reused.refill(
+            &next,
+            &bodies.centers,
+            &bodies.states,
+            &bodies.params,
+            stiff,
+        );
+        let fresh = prepare(&next, stiff);
+        assert_eq!(reused.points(), fresh.points());
+        // Everything but the unused points, which nothing reads.
+        let mut unused_cleared = reused;
+        unused_cleared.points[1..].copy_from_slice(&fresh.points[1..]);
+        assert_eq!(unused_cleared, fresh);
     }
 }

@@ -483,18 +483,28 @@ impl Solver {
         let s = self.settings;
         let soft = Softness::new(s.contact_hertz, s.damping_ratio, h);
         let static_soft = Softness::new(s.static_contact_hertz, s.damping_ratio, h);
-        self.constraints.clear();
-        self.constraints.extend(contacts.iter().map(|c| {
-            // A dynamic body locked on every axis is as immovable as a static one, and its
-            // contacts as stiff.
+        // A dynamic body locked on every axis is as immovable as a static one, and its
+        // contacts as stiff.
+        let softness = |c: &ContactInput| {
             let immovable = |i: u32| bodies.params[i as usize].is_immovable();
-            let softness = if immovable(c.a) || immovable(c.b) {
+            if immovable(c.a) || immovable(c.b) {
                 static_soft
             } else {
                 soft
-            };
-            ContactConstraint::prepare(c, &bodies.centers, &bodies.states, &bodies.params, softness)
-        }));
+            }
+        };
+        let (centers, states, params) = (&bodies.centers, &bodies.states, &bodies.params);
+        // Last step's constraints are refilled in place; only new places are built.
+        let reused = self.constraints.len().min(contacts.len());
+        self.constraints.truncate(reused);
+        for (c, input) in self.constraints.iter_mut().zip(contacts) {
+            c.refill(input, centers, states, params, softness(input));
+        }
+        self.constraints.extend(
+            contacts[reused..]
+                .iter()
+                .map(|c| ContactConstraint::prepare(c, centers, states, params, softness(c))),
+        );
         let orientations = &bodies.orientations;
         self.cache.seed(
             &mut self.constraints,

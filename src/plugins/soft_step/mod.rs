@@ -362,7 +362,10 @@ fn collect_entities(
         out.push(pair.a);
         out.push(pair.b);
     }
-    out.sort_unstable();
+    // Entity order by a radix sort on its bits (index, then generation; the generation's bytes,
+    // the same for all, are skipped): a comparison sort of the 7,000 entries of a 1,000-ball
+    // pile cost three times as much.
+    radsort::sort_by_key(out, |e| e.to_bits());
     out.dedup();
     awake
 }
