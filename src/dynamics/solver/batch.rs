@@ -244,11 +244,13 @@ impl ContactBatch {
         };
         let (inv_h, most_push) = (Lanes::splat(inv_h), Lanes::splat(-max_push_out));
         let n = self.normal;
+        // The normal in each body's rotation since the step's start, once for all points (see
+        // `ContactConstraint::solve`).
+        let (moved, na, nb) = (moved.dot(n), dqa.inverse_rotate(n), dqb.inverse_rotate(n));
         for k in 0..self.count {
             let i = if flip { self.count - 1 - k } else { k };
             let p = &mut self.points[i];
-            let s = p.base_separation
-                + (moved + dqb.rotate(p.anchor_b) - dqa.rotate(p.anchor_a)).dot(n);
+            let s = p.base_separation + moved + p.anchor_b.dot(nb) - p.anchor_a.dot(na);
             let apart = s.simd_gt(zero);
             let push_out = if use_bias {
                 (bias_rate * s).max(most_push)

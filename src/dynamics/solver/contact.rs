@@ -343,9 +343,14 @@ impl ContactConstraint {
     ) {
         let mut pair = Pair::load(self, states);
         let (sa, sb) = (&states[self.a as usize], &states[self.b as usize]);
-        let moved = sb.delta_position - sa.delta_position;
-        let (dqa, dqb) = (sa.delta_rotation, sb.delta_rotation);
         let (n, soft) = (self.normal, self.softness);
+        // The current separation of a point is `s₀' + (Δp_b − Δp_a + Δq_b r_b − Δq_a r_a)·n`;
+        // with `(Δq r)·n = r·(Δq⁻¹ n)` the normal is turned back into each body's rotation
+        // since the step's start once per contact instead of turning every anchor (a box on a
+        // box has four points: two rotations a pass instead of eight).
+        let moved = (sb.delta_position - sa.delta_position).dot(n);
+        let na = sa.delta_rotation.inverse() * n;
+        let nb = sb.delta_rotation.inverse() * n;
         let closing = self.closing_acceleration;
         let count = self.count as usize;
         for k in 0..count {
@@ -356,7 +361,7 @@ impl ContactConstraint {
             let inverse_mass = self.inverse_mass;
             let cp = &mut self.points[i];
             let (ra, rb) = (cp.anchor_a, cp.anchor_b);
-            let s = cp.base_separation + (moved + dqb * rb - dqa * ra).dot(n);
+            let s = cp.base_separation + moved + rb.dot(nb) - ra.dot(na);
             let (bias, mass_scale, impulse_scale) = if s > 0.0 {
                 (s * inv_h, 1.0, 0.0)
             } else if use_bias {

@@ -153,6 +153,15 @@ impl Quatx4 {
         let t = self.v.cross(r) * two;
         r + t * self.w + self.v.cross(t)
     }
+
+    /// Rotates each lane's vector by the inverse rotation (the conjugate `(−u, w)`).
+    pub fn inverse_rotate(self, r: Vec3x4) -> Vec3x4 {
+        Self {
+            v: -self.v,
+            w: self.w,
+        }
+        .rotate(r)
+    }
 }
 
 /// The items at `indices` one per lane (`None` past them), and the first: `None` for no
