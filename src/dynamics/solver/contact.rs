@@ -115,7 +115,8 @@ pub struct ContactConstraint {
     pub restitution: f32,
     /// Softness of the push-out (stiffer against immovable bodies).
     pub softness: Softness,
-    /// The points.
+    /// The points: the first `count` are used; the others may hold a former constraint's
+    /// values ([`Self::refill`]) and are never read.
     pub points: [ConstraintPoint; MAX_MANIFOLD_POINTS],
     /// How many are used.
     pub count: u8,

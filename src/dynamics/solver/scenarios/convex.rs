@@ -40,7 +40,7 @@ fn a_standing_cylinder_rests_on_ground_and_box_within_0_2_mm_and_on_a_mesh_withi
     let floor = MeshCollider::new(TriMesh::grid_floor(6.0, 12).unwrap()).unwrap();
     on_mesh.add(Shape::TriMesh(floor), Vec3::ZERO, Quat::IDENTITY, 0.0);
     // On a mesh the cap's octagon is clipped triangle by triangle and the pieces merged
-    // (`mesh_manifold.rs`): the merged points are not symmetric about the axis (0.34 mm measured).
+    // (`mesh_manifold.rs`): the merged points are not symmetric about the axis.
     // The drift is rounding at work, not a bias: two orderings of the same arithmetic (each
     // anchor turned by its body's rotation, or the normal turned back once per contact) gave
     // 0.027 and 0.018 mm on the ground, 0.067 and 0.160 mm on the box, 0.48 and 0.21 mm on
