@@ -327,9 +327,9 @@ impl BroadPhase for AdaptiveSweep {
         }
         // Only commits in which a box came, went or moved count for the rule: a game's
         // schedule may commit again with nothing moved (the ECS commits at the step's start
-        // and in its substep, re-sending unchanged boxes), and such a commit, swapping
-        // nothing, once cleared every strike, so a net of 10,000 balls making 30M swaps a step
-        // never fell back.
+        // and in its substep; until the eighteenth stop the substep re-sent unchanged boxes),
+        // and such a commit, swapping nothing, once cleared every strike, so a net of 10,000
+        // balls making 30M swaps a step never fell back.
         if !self.engine.get().stats().changed {
             return;
         }

@@ -462,7 +462,7 @@ impl BroadPhase for RegionSweep {
     fn update(&mut self, id: ProxyId, aabb: Aabb) -> Result<(), BroadPhaseError> {
         self.slot(id).ok_or(BroadPhaseError::UnknownId(id))?;
         check_aabb(id, &aabb)?;
-        // The same box again is no change (the ECS re-sends every box in a second commit).
+        // The same box again is no change (a game may re-send unchanged boxes).
         if self.slots[id as usize].aabb != aabb {
             self.slots[id as usize].aabb = aabb;
             self.queue(id);

@@ -152,8 +152,8 @@ impl BroadPhase for SortAndSweep {
 
     fn commit(&mut self) {
         if !self.bodies.take_changed() {
-            // The same boxes find the same pairs: a game re-sending unchanged boxes (the ECS
-            // commits twice a step) pays nothing.
+            // The same boxes find the same pairs: a game re-sending unchanged boxes, or
+            // committing with none moved (the ECS commits twice a step), pays nothing.
             self.history.keep();
             self.stats = StepStats::default();
             return;

@@ -43,7 +43,7 @@ use crate::plugins::validation::quarantine;
 use crate::schedule::{BroadPhaseSystems, PhysicsSchedule, SubstepSchedule};
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
-use bevy_ecs::change_detection::Tick;
+use bevy_ecs::change_detection::{CheckChangeTicks, Tick};
 use bevy_ecs::prelude::*;
 use bevy_ecs::system::SystemChangeTick;
 use glam::Vec3;
@@ -222,7 +222,8 @@ impl Plugin for BroadPhasePlugin {
                     .run_if(any_with_component::<Collider>)
                     .in_set(IndexBodies)
                     .in_set(PrepareIndex),
-            );
+            )
+            .add_observer(clamp_synced_tick);
     }
 }
 
@@ -303,18 +304,31 @@ fn sync_broad_phase(
     if index.grown_with.replace(lookahead) != Some(lookahead) {
         index.fresh = true;
     }
+    // Back in the index, or with a margin that changed without a new velocity. A body that
+    // woke is indexed again: a write to it while it slept (skipped then) is older than the
+    // last sync. A body whose volume was removed is forgotten, and indexed again if it has one
+    // now: both syncs read the removal, and the second must not leave out a volume put back.
+    let mut back: Vec<Entity> = Vec::new();
     for (e, asleep) in transitions.0.drain(..) {
         index.proxies.set_asleep(e, asleep);
+        if !asleep {
+            back.push(e);
+        }
     }
-    for e in despawned.read().chain(gone.iter()) {
+    let removed = back.len();
+    back.extend(despawned.read());
+    for &e in &back[removed..] {
         index.forget(e);
     }
-    // Back in the index, or with a margin that changed without a new velocity.
-    let back: Vec<Entity> = released
-        .read()
-        .chain(orphaned.read())
-        .chain(unscaled.read())
-        .collect();
+    for e in gone.iter() {
+        index.forget(e);
+    }
+    back.extend(
+        released
+            .read()
+            .chain(orphaned.read())
+            .chain(unscaled.read()),
+    );
     if std::mem::take(&mut index.fresh) {
         for row in roots.iter() {
             index.upsert(row, &lookahead);
@@ -324,7 +338,7 @@ fn sync_broad_phase(
         index.upsert(row, &lookahead);
     }
     // Changed since this system last ran, and since the other one did too (the later of the
-    // two runs; a stored tick too old to compare counts as this system's own run).
+    // two runs; `clamp_synced_tick` keeps the stored one comparable, as Bevy keeps a system's).
     let (own, now) = (ticks.last_run(), ticks.this_run());
     let since = index
         .synced_at
@@ -359,6 +373,16 @@ fn sync_broad_phase(
     stats.set_counter("broad_phase/moving_bodies", index.moving.len() as f64);
     stats.set_counter("broad_phase/static_bodies", index.grid.len() as f64);
     stats.add_time(Stage::BroadPhase, start.elapsed());
+}
+
+/// Keeps the stored tick of the last sync comparable with the present one, as Bevy does with
+/// every system's last run (a tick more than `u32::MAX` old would wrap and look new).
+fn clamp_synced_tick(check: On<CheckChangeTicks>, index: Option<ResMut<BroadPhaseIndex>>) {
+    if let Some(mut index) = index
+        && let Some(tick) = index.synced_at.as_mut()
+    {
+        tick.check_tick(*check);
+    }
 }
 
 impl BroadPhaseIndex {
