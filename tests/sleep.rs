@@ -554,3 +554,30 @@ fn a_pendulum_swinging_10_degrees_never_sleeps_in_5_s_and_keeps_8_degrees() {
         widest.to_degrees()
     );
 }
+
+/// `SleepingDisabled` keeps a body awake, and the ball resting against it too (its island),
+/// while a ball alone beside them sleeps within 2 s; given to that sleeper, it wakes it at the
+/// next step.
+#[test]
+fn a_body_with_sleeping_disabled_and_its_island_stay_awake_3s_and_the_marker_wakes_a_sleeper() {
+    let mut app = sleepy_app();
+    let sleepless = common::ball(&mut app, Vec3::new(0.0, 0.0, 0.5));
+    app.world_mut()
+        .entity_mut(sleepless)
+        .insert(SleepingDisabled);
+    // Touching it: one island.
+    let neighbour = common::ball(&mut app, Vec3::new(0.999, 0.0, 0.5));
+    let alone = common::ball(&mut app, Vec3::new(10.0, 0.0, 0.5));
+    let mut alone_slept = false;
+    for _ in 0..180 {
+        urto::step(app.world_mut(), 1).unwrap();
+        assert!(!asleep(&app, sleepless) && !asleep(&app, neighbour));
+        alone_slept |= asleep(&app, alone);
+    }
+    assert!(alone_slept && asleep(&app, alone), "the lone ball sleeps");
+    app.world_mut().entity_mut(alone).insert(SleepingDisabled);
+    urto::step(app.world_mut(), 1).unwrap();
+    assert!(!asleep(&app, alone), "the marker wakes a sleeper");
+    urto::step(app.world_mut(), 120).unwrap();
+    assert!(!asleep(&app, alone));
+}

@@ -40,7 +40,7 @@ pub use joint::{
 };
 pub use mass::{ComputedMass, DEFAULT_DENSITY, Density, Mass};
 pub(crate) use sleeping::SleepTransitions;
-pub use sleeping::{SleepState, Sleeping, SleepingIslands};
+pub use sleeping::{SleepState, Sleeping, SleepingDisabled, SleepingIslands};
 
 use crate::bounding::Aabb;
 #[cfg(feature = "mesh-io")]

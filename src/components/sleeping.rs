@@ -27,6 +27,13 @@ use std::collections::HashMap;
 #[component(on_add = note_fell_asleep, on_remove = note_woke)]
 pub struct Sleeping;
 
+/// Keeps a body awake: it never falls asleep, and neither does the island it touches (as a body
+/// on a spring). For a body that must not freeze at a slow turning point, a player's body, or
+/// one moved by game code each step (Avian's `SleepingDisabled`, rapier's `can_sleep(false)`).
+/// Given to a sleeping body, it wakes it and its island at the next step.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SleepingDisabled;
+
 /// A body's progress towards sleep and, asleep, what it slept with.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 pub struct SleepState {

@@ -53,7 +53,7 @@ impl Plugin for SleepPlugin {
             .init_required::<SleepingIslands>()
             .add_systems(
                 PhysicsSchedule,
-                (wake_on_game_changes, wake_islands)
+                (wake_on_game_changes, wake_the_sleepless, wake_islands)
                     .chain()
                     .run_if(sleep_enabled)
                     .in_set(PrepareWake),
@@ -157,6 +157,20 @@ fn wake_islands(
     }
 }
 
+/// Sleeping bodies given [`SleepingDisabled`].
+type SleepingSleepless = (With<Sleeping>, With<SleepingDisabled>);
+
+/// A sleeping body given [`SleepingDisabled`] wakes, and its island with it (no archetype
+/// matches while no sleeper has the marker: nothing to pay).
+fn wake_the_sleepless(
+    mut sleepers: Query<(Entity, &mut SleepState), SleepingSleepless>,
+    mut waker: Waker,
+) {
+    for (e, mut state) in &mut sleepers {
+        waker.wake(e, Some(&mut state));
+    }
+}
+
 /// With sleeping switched off, nothing stays asleep.
 fn wake_everything(
     mut sleepers: Query<(Entity, &mut SleepState), With<Sleeping>>,
@@ -188,7 +202,12 @@ type CandidateFilter = (
     Without<Quarantined>,
     Without<ChildOf>,
     Without<Spring>,
+    Without<SleepingDisabled>,
 );
+
+/// Bodies that never sleep and keep what they touch awake: bodies on springs (their pull is not
+/// in the contacts the islands are built from) and bodies with [`SleepingDisabled`].
+type NeverSleeps = (Or<(With<Spring>, With<SleepingDisabled>)>, Without<Static>);
 
 /// What a body in a contact is to the islands (sleeping bodies have no slot: they are looked
 /// up only when a contact names them, so a sleeping island costs no work per step here).
@@ -223,7 +242,7 @@ struct IslandScratch {
 fn fall_asleep(
     mut bodies: Query<Candidate, CandidateFilter>,
     sleepers: Query<&SleepState, With<Sleeping>>,
-    never_sleep: Query<(), (With<Spring>, Without<Static>)>,
+    never_sleep: Query<(), NeverSleeps>,
     contacts: Option<Res<Contacts>>,
     joints: Query<&Joint, ActiveJoint>,
     settings: Res<SleepSettings>,
@@ -342,7 +361,7 @@ fn link_contact(
     s: &mut IslandScratch,
     (body, other): (Entity, Entity),
     sleepers: &Query<&SleepState, With<Sleeping>>,
-    never_sleep: &Query<(), (With<Spring>, Without<Static>)>,
+    never_sleep: &Query<(), NeverSleeps>,
 ) {
     let Some(&Slot::Awake(i)) = s.slots.get(&body) else {
         return;
