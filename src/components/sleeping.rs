@@ -27,10 +27,13 @@ use std::collections::HashMap;
 #[component(on_add = note_fell_asleep, on_remove = note_woke)]
 pub struct Sleeping;
 
-/// Keeps a body awake: it never falls asleep, and neither does the island it touches (as a body
-/// on a spring). For a body that must not freeze at a slow turning point, a player's body, or
-/// one moved by game code each step (Avian's `SleepingDisabled`, rapier's `can_sleep(false)`).
-/// Given to a sleeping body, it wakes it and its island at the next step.
+/// Keeps a body awake: it never falls asleep, and neither do the awake bodies of its island (as
+/// with a body on a spring). For a body that must not freeze at a slow turning point, a
+/// player's body, or one moved by game code each step (Avian's `SleepingDisabled`, rapier's
+/// `can_sleep(false)`). Given to a sleeping body, it wakes it and its island at the next step;
+/// taken away, the body's stillness counts from zero. It goes on the root body (a compound's
+/// parts have no sleep of their own). An island already asleep that it comes to rest against
+/// wakes only as for any body: when it is approached faster than the wake speed.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SleepingDisabled;
 

@@ -289,6 +289,7 @@ fn sync_broad_phase(
     mut commands: Commands,
     (hierarchy, mut warned): (Option<Res<HierarchyInstalled>>, Local<bool>),
     ticks: SystemChangeTick,
+    sleeping: Query<(), With<Sleeping>>,
 ) {
     if hierarchy.is_none() && !*warned {
         *warned = true;
@@ -336,6 +337,10 @@ fn sync_broad_phase(
     }
     for row in back.iter().filter_map(|e| roots.get(*e).ok()) {
         index.upsert(row, &lookahead);
+        // A new id starts awake: a sleeper given its volume back is left out of the pairs.
+        if sleeping.contains(row.0) {
+            index.proxies.set_asleep(row.0, true);
+        }
     }
     // Changed since this system last ran, and since the other one did too (the later of the
     // two runs; `clamp_synced_tick` keeps the stored one comparable, as Bevy keeps a system's).

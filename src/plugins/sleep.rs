@@ -161,13 +161,21 @@ fn wake_islands(
 type SleepingSleepless = (With<Sleeping>, With<SleepingDisabled>);
 
 /// A sleeping body given [`SleepingDisabled`] wakes, and its island with it (no archetype
-/// matches while no sleeper has the marker: nothing to pay).
+/// matches while no sleeper has the marker: nothing to pay); a body that loses the marker
+/// counts its stillness from zero (it was not counted while it had it).
 fn wake_the_sleepless(
     mut sleepers: Query<(Entity, &mut SleepState), SleepingSleepless>,
+    mut awake: Query<&mut SleepState, Without<Sleeping>>,
+    mut freed: RemovedComponents<SleepingDisabled>,
     mut waker: Waker,
 ) {
     for (e, mut state) in &mut sleepers {
         waker.wake(e, Some(&mut state));
+    }
+    for e in freed.read() {
+        if let Ok(mut state) = awake.get_mut(e) {
+            state.restart();
+        }
     }
 }
 
