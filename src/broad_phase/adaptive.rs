@@ -139,6 +139,9 @@ impl AdaptiveSweep {
     /// gain nothing, a settling pile makes under 5).
     pub const DENSE_SWAPS_PER_BODY: f64 = 20.0;
 
+    /// Dense commits in a row that move the bodies into the segmented SAP.
+    pub const DENSE_COMMITS: u32 = 2;
+
     /// Bodies from which dense motion moves them into the segmented SAP (a smaller scene's
     /// sweep costs microseconds either way).
     pub const DENSE_SCENE: usize = 1_000;
@@ -222,7 +225,7 @@ impl AdaptiveSweep {
                 self.dense = if dense { self.dense + 1 } else { 0 };
                 if self.strikes >= Self::STRIKES {
                     Some(Engine::FromScratch(Box::default()))
-                } else if self.dense >= Self::STRIKES {
+                } else if self.dense >= Self::DENSE_COMMITS {
                     self.regions_entered(true)
                 } else {
                     None

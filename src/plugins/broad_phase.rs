@@ -227,7 +227,7 @@ impl Plugin for BroadPhasePlugin {
     }
 }
 
-/// What the broad phase needs to know of a root body.
+/// What the broad phase needs to know of a root body (last: whether it sleeps).
 type Indexed<'a> = (
     Entity,
     &'a BoundingVolume,
@@ -235,6 +235,7 @@ type Indexed<'a> = (
     Option<&'a Velocity>,
     Option<&'a AngularVelocity>,
     Option<&'a GravityScale>,
+    Has<Sleeping>,
 );
 /// [`Indexed`] with the change ticks, to tell what changed since the last sync of either
 /// schedule.
@@ -253,6 +254,7 @@ type IndexedRow<'a> = (
     Option<&'a Velocity>,
     Option<&'a AngularVelocity>,
     Option<&'a GravityScale>,
+    bool,
 );
 type Root = (Without<ChildOf>, Without<Quarantined>);
 /// A moving body's margin follows its velocity, so a new velocity re-indexes it.
@@ -289,7 +291,6 @@ fn sync_broad_phase(
     mut commands: Commands,
     (hierarchy, mut warned): (Option<Res<HierarchyInstalled>>, Local<bool>),
     ticks: SystemChangeTick,
-    sleeping: Query<(), With<Sleeping>>,
 ) {
     if hierarchy.is_none() && !*warned {
         *warned = true;
@@ -316,10 +317,9 @@ fn sync_broad_phase(
             back.push(e);
         }
     }
-    let removed = back.len();
-    back.extend(despawned.read());
-    for &e in &back[removed..] {
+    for e in despawned.read() {
         index.forget(e);
+        back.push(e);
     }
     for e in gone.iter() {
         index.forget(e);
@@ -337,10 +337,6 @@ fn sync_broad_phase(
     }
     for row in back.iter().filter_map(|e| roots.get(*e).ok()) {
         index.upsert(row, &lookahead);
-        // A new id starts awake: a sleeper given its volume back is left out of the pairs.
-        if sleeping.contains(row.0) {
-            index.proxies.set_asleep(row.0, true);
-        }
     }
     // Changed since this system last ran, and since the other one did too (the later of the
     // two runs; `clamp_synced_tick` keeps the stored one comparable, as Bevy keeps a system's).
@@ -359,7 +355,16 @@ fn sync_broad_phase(
         ];
         let moved = stamps.into_iter().flatten().any(newer);
         if moved {
-            let row = (e, &*bv, is_static, v.as_deref(), w.as_deref(), g.as_deref());
+            // `changed` holds no sleeper.
+            let row = (
+                e,
+                &*bv,
+                is_static,
+                v.as_deref(),
+                w.as_deref(),
+                g.as_deref(),
+                false,
+            );
             index.upsert(row, &lookahead);
         }
     }
@@ -406,7 +411,7 @@ impl BroadPhaseIndex {
 
     /// Registers a new root or moves a known one (re-registering it if its kind changed); a
     /// root with nothing to collide (an empty volume) is dropped.
-    fn upsert(&mut self, (e, bv, is_static, v, w, g): IndexedRow, lookahead: &Lookahead) {
+    fn upsert(&mut self, (e, bv, is_static, v, w, g, asleep): IndexedRow, lookahead: &Lookahead) {
         if !bv.0.is_valid() {
             self.forget(e);
             return;
@@ -439,6 +444,11 @@ impl BroadPhaseIndex {
                     Proxy::Moving(id) => self.moving_batch.push((id, aabb, BodyKind::Dynamic)),
                     Proxy::Static(id) => self.static_batch.push((id, aabb)),
                     Proxy::Unbounded => {}
+                }
+                // A new id starts awake; a sleeper (its volume put back, or the index made
+                // again) stays out of the pairs.
+                if asleep {
+                    self.proxies.set_asleep(e, true);
                 }
             }
         }

@@ -281,12 +281,13 @@ impl BvTree for EcsTree<'_, '_, '_, '_> {
 /// Whether a body is static or asleep (see [`crate::plugins::sleep`]).
 pub(crate) type Dormancy = (Has<Static>, Has<Sleeping>);
 
-/// What a root body's part in its pairs' speculative margins depends on.
+/// What a root body's part in its pairs' speculative margins depends on, and whether it is
+/// static or asleep (one lookup a body a step for both).
 type Motion<'a> = (
     Has<Static>,
     Option<&'a Velocity>,
     Option<&'a AngularVelocity>,
-    &'a BoundingVolume,
+    Option<&'a BoundingVolume>,
     Option<&'a GravityScale>,
     (
         Option<&'a ComputedMass>,
@@ -312,7 +313,6 @@ fn moves(mass: Option<&ComputedMass>, locked: Option<&LockedAxes>, asleep: bool)
 fn compute_contacts(
     pairs: Res<BroadPhasePairs>,
     nodes: Query<Node, Without<Quarantined>>,
-    dormancy: Query<Dormancy>,
     motion: Query<Motion>,
     layers: Query<&CollisionLayers>,
     sensors: Query<(), With<Sensor>>,
@@ -340,17 +340,21 @@ fn compute_contacts(
     debug.pairs.clear();
     visits.clear();
     let lookahead = lookahead.get();
-    let margin = |e: Entity| match motion.get(e) {
-        Ok((false, v, w, bv, g, (m, locked, asleep))) => {
-            lookahead.motion(v, w, bv, g, moves(m, locked, asleep))
+    // A body's margin, and whether it takes part in no simulation (static or asleep).
+    let motion_of = |e: Entity| match motion.get(e) {
+        Ok((false, v, w, Some(bv), g, (m, locked, asleep))) => (
+            lookahead.motion(v, w, bv, g, moves(m, locked, asleep)),
+            dormant(Some((false, asleep))),
+        ),
+        Ok((is_static, .., (_, _, asleep))) => {
+            (BodyMotion::default(), dormant(Some((is_static, asleep))))
         }
-        _ => BodyMotion::default(),
+        Err(_) => (BodyMotion::default(), dormant(None)),
     };
     let start = Instant::now();
     contacts.pairs.clear();
     overlaps.pairs.clear();
     let sleeping = sleep.is_some_and(|s| s.enabled);
-    let dormant = |e: Entity| dormant(dormancy.get(e).ok());
     // Layers and sensors are per collider (a compound's parts may differ), and a scene without
     // any pays no lookup for them.
     let (any_layers, any_sensors) = (!layers.is_empty(), !sensors.is_empty());
@@ -363,10 +367,13 @@ fn compute_contacts(
     let mut bodies = std::mem::take(&mut scratch.bodies);
     bodies.clear();
     let mut facts = |e: Entity| {
-        *bodies.entry(e).or_insert_with(|| BodyFacts {
-            margin: margin(e),
-            dormant: sleeping && dormant(e),
-            compound: matches!(nodes.get(e), Ok((.., Some(_)))),
+        *bodies.entry(e).or_insert_with(|| {
+            let (margin, dormant) = motion_of(e);
+            BodyFacts {
+                margin,
+                dormant: sleeping && dormant,
+                compound: matches!(nodes.get(e), Ok((.., Some(_)))),
+            }
         })
     };
     for &(a, b) in &pairs.pairs {

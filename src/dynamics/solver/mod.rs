@@ -176,6 +176,12 @@ impl Default for SoftStepSettings {
 }
 
 impl SoftStepSettings {
+    /// These settings, or the defaults where they are unusable: what [`Solver::step`] steps
+    /// with (the lookahead reads the substep count from here too).
+    pub fn usable(self) -> Self {
+        self.validated().unwrap_or_default()
+    }
+
     /// The settings if every number is usable: `1..=MAX_SUBSTEPS` substeps,
     /// `1..=MAX_RELAX_ITERATIONS` relax passes (contacts and joints), stiffnesses,
     /// damping ratio, restitution threshold and warm-start distance finite and `>= 0`, push-out
@@ -285,7 +291,7 @@ impl Solver {
     ) {
         // The settings are public: unusable ones (a NaN stiffness, u32::MAX substeps) step with
         // the defaults rather than hang or spread NaN.
-        let s = self.settings.validated().unwrap_or_default();
+        let s = self.settings.usable();
         self.settings = s;
         // A step that returns early bounds nothing.
         self.bounded_joints = 0;

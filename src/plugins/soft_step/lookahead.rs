@@ -84,9 +84,7 @@ impl LookaheadParams<'_> {
             .solver
             .as_ref()
             // The count the solver will step with: unusable settings step with the defaults.
-            .map_or(1, |s| {
-                s.solver.settings.validated().unwrap_or_default().substeps
-            });
+            .map_or(1, |s| s.solver.settings.usable().substeps);
         Lookahead::new(
             self.margin.as_deref(),
             self.timestep.as_deref(),
