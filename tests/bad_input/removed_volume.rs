@@ -25,11 +25,7 @@ fn a_ground_whose_volume_is_removed_and_put_back_holds_its_ball_within_1cm_for_1
     });
     urto::step(app.world_mut(), 30).unwrap();
     let rest = app.world().get::<Position>(ball).unwrap().0;
-    let volume = *app.world().get::<BoundingVolume>(ground).unwrap();
-    app.world_mut()
-        .entity_mut(ground)
-        .remove::<BoundingVolume>()
-        .insert(volume);
+    common::put_volume_back(&mut app, ground);
     for step in 0..60 {
         urto::step(app.world_mut(), 1).unwrap();
         let now = app.world().get::<Position>(ball).unwrap().0;

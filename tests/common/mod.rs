@@ -129,6 +129,18 @@ pub fn ball(app: &mut App, at: Vec3) -> bevy_ecs::entity::Entity {
         .id()
 }
 
+/// Removes `e`'s `BoundingVolume` and puts the same one back, as a game may between steps.
+pub fn put_volume_back(app: &mut App, e: bevy_ecs::entity::Entity) {
+    let volume = *app
+        .world()
+        .get::<BoundingVolume>(e)
+        .expect("a body with a volume");
+    app.world_mut()
+        .entity_mut(e)
+        .remove::<BoundingVolume>()
+        .insert(volume);
+}
+
 /// A dynamic unit box (1 kg) centred `z` above the origin, at rest.
 pub fn crate_box(app: &mut App, z: f32) -> bevy_ecs::entity::Entity {
     app.world_mut()

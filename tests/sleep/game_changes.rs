@@ -68,11 +68,7 @@ fn a_sleeper_given_its_volume_back_stays_out_of_the_pairs() {
     urto::step(app.world_mut(), 120).unwrap();
     assert!(asleep(&app, ball));
     assert_eq!(counter(&app, "broad_phase/static_pairs"), 0.0);
-    let volume = *app.world().get::<BoundingVolume>(ball).unwrap();
-    app.world_mut()
-        .entity_mut(ball)
-        .remove::<BoundingVolume>()
-        .insert(volume);
+    common::put_volume_back(&mut app, ball);
     for _ in 0..10 {
         urto::step(app.world_mut(), 1).unwrap();
         assert!(asleep(&app, ball));
