@@ -14,7 +14,7 @@
 //! function is monotone, so that cell is the larger of the two boxes' min cells on each axis,
 //! and the test needs no shared state between regions.
 
-use super::pair_diff::{diff_sorted, merge_sorted};
+use super::pair_diff::diff_sorted;
 use super::{Pair, ProxyId};
 use crate::bounding::Aabb;
 
@@ -86,8 +86,16 @@ pub(super) struct Region {
     /// Bodies that changed this commit and touched this cell before or after (arrivals,
     /// departures and movers), in any order, perhaps repeated.
     pub changed: Vec<ProxyId>,
-    /// The pairs this region owns, sorted.
+    /// The pairs this region owns: sorted after a full sweep, the changed members' new pairs
+    /// appended after a sweep of few (sorted again by the next full sweep, which diffs them).
     pub owned: Vec<Pair>,
+    /// Whether pairs were appended to `owned` since it was last sorted.
+    pub owned_unsorted: bool,
+    /// At least the longest member's length on the sweep axis, rounded up: how far back a
+    /// changed member's backward walk must look. Found by the first sweep of few after a full
+    /// sweep (`None` until then: full sweeps do not need it); from then on it only grows (a
+    /// member that leaves does not lower it), which keeps it an upper bound.
+    pub longest: Option<f32>,
     /// Queued for this commit's sweep.
     pub dirty: bool,
 }
@@ -96,13 +104,17 @@ pub(super) struct Region {
 pub(super) trait BodyView {
     /// The body's sweep entry (axes in `axes` order), if it belongs to `cell` now.
     fn entry(&self, id: ProxyId, cell: [i32; 3], axes: [usize; 3]) -> Option<Entry>;
+    /// The sweep-axis min the body's entries carry since the last commit (where to look for
+    /// them). Only a hint: a body not found there is looked for member by member.
+    fn swept_lo(&self, id: ProxyId) -> f32;
     /// One past the largest id.
     fn id_bound(&self) -> usize;
 }
 
 /// `Entry::owner`'s bit for a static body.
 const STATIC: u32 = 1;
-/// `Entry::owner`'s bit for a body that changed this commit (ids use bits 1 to 30).
+/// `Entry::owner`'s bit, during a sweep of few changed members, for a changed one (ids use
+/// bits 1 to 30).
 const FRESH: u32 = 1 << 31;
 
 /// One member as the sweep reads it: 40 bytes, so a region's entries stay in a few cache
@@ -115,14 +127,14 @@ pub(super) struct Entry {
     pub hi: f32,
     /// `[min_u, max_u, min_v, max_v]` on the other two axes.
     pub cross: [f32; 4],
-    /// `id << 1 | STATIC`, plus `FRESH` while the body changed this commit.
+    /// `id << 1 | STATIC`, plus `FRESH` while a sweep of few changed members runs.
     pub owner: u32,
     /// The cell of the box's min corner, sweep axis first.
     pub low_cell: [i32; 3],
 }
 
 impl Entry {
-    /// The (fresh) entry of a box for the axis order `[axis, u, v]`.
+    /// The entry of a box for the axis order `[axis, u, v]`.
     #[inline]
     pub fn new(
         aabb: &Aabb,
@@ -138,7 +150,7 @@ impl Entry {
             lo: min[axis],
             hi: max[axis],
             cross: [min[u], max[u], min[v], max[v]],
-            owner: id << 1 | u32::from(is_static) | FRESH,
+            owner: id << 1 | u32::from(is_static),
             low_cell: [range.lo[axis], range.lo[u], range.lo[v]],
         }
     }
@@ -166,8 +178,10 @@ pub(super) struct SweepScratch {
     found: Vec<Pair>,
     /// Owned pairs of changed members (few changed).
     dropped: Vec<Pair>,
-    /// The kept and the found pairs merged (few changed).
-    merged: Vec<Pair>,
+    /// The changed members' new entries (few changed).
+    moved: Vec<Entry>,
+    /// Where the changed members' entries are after the move (few changed).
+    at: Vec<usize>,
 }
 
 impl SweepScratch {
@@ -188,8 +202,9 @@ impl SweepScratch {
     /// Heap bytes held.
     pub fn memory_bytes(&self) -> usize {
         self.met.capacity() * std::mem::size_of::<u32>()
-            + (self.found.capacity() + self.dropped.capacity() + self.merged.capacity())
-                * std::mem::size_of::<Pair>()
+            + (self.found.capacity() + self.dropped.capacity()) * std::mem::size_of::<Pair>()
+            + self.moved.capacity() * std::mem::size_of::<Entry>()
+            + self.at.capacity() * std::mem::size_of::<usize>()
     }
 }
 
@@ -213,9 +228,9 @@ impl Region {
     /// this region owns now, appending the difference with the last ones to `added` and
     /// `removed`. Returns the change in the number of members and the work done.
     ///
-    /// When few members changed, only they are swept (against their neighbours in sweep
-    /// order), and the last pairs between unchanged members are kept: a region with one mover
-    /// among thirty costs one body's sweep, not thirty.
+    /// When few members changed, only they are read, moved and swept (against their
+    /// neighbours in sweep order), and the last pairs between unchanged members are kept: a
+    /// region with one mover among thirty costs about one body's sweep, not thirty.
     pub fn sweep(
         &mut self,
         bodies: &impl BodyView,
@@ -224,48 +239,53 @@ impl Region {
         changes: (&mut Vec<Pair>, &mut Vec<Pair>),
     ) -> (isize, SweepCounts) {
         let before = self.entries.len() as isize;
-        let few = self.changed.len() * 4 < self.entries.len();
-        // The sweep number the changed ids carry in `met`.
-        let changed = self.refresh(bodies, frame.axes, scratch, few);
-        let swaps = sort_entries(&mut self.entries);
         let [axis, u, v] = frame.axes;
         let cell = [self.cell[axis], self.cell[u], self.cell[v]];
-        let tests = if few {
-            self.sweep_few(cell, changed, scratch, changes)
+        let counts = if self.changed.len() * 4 < self.entries.len() {
+            self.sweep_few(bodies, frame.axes, cell, scratch, changes)
         } else {
-            self.sweep_all(cell, scratch, changes)
+            self.sweep_all(bodies, frame.axes, cell, scratch, changes)
         };
         self.changed.clear();
-        (
-            self.entries.len() as isize - before,
-            SweepCounts { swaps, tests },
-        )
+        (self.entries.len() as isize - before, counts)
     }
 
-    /// Every pair found again and diffed against the last ones.
+    /// Every member read again, re-sorted and swept, and the pairs diffed against the last
+    /// ones.
     fn sweep_all(
         &mut self,
+        bodies: &impl BodyView,
+        axes: [usize; 3],
         cell: [i32; 3],
         scratch: &mut SweepScratch,
         (added, removed): (&mut Vec<Pair>, &mut Vec<Pair>),
-    ) -> u64 {
+    ) -> SweepCounts {
+        self.refresh_all(bodies, axes, scratch);
+        let swaps = sort_entries(&mut self.entries);
+        self.longest = None;
         let tests = sweep_owned(&self.entries, cell, &mut scratch.found);
         scratch.found.sort_unstable();
+        if std::mem::take(&mut self.owned_unsorted) {
+            self.owned.sort_unstable();
+        }
         diff_sorted(&self.owned, &scratch.found, added, removed);
         self.set_owned(&scratch.found);
-        tests
+        SweepCounts { swaps, tests }
     }
 
-    /// The changed members' pairs found again; the others kept. Only the changed members'
-    /// pairs are sorted and diffed (the kept ones stay sorted), then merged back. `changed`
-    /// is the number [`Self::refresh`] marked the changed ids with.
+    /// The changed members moved to their new places and their pairs found again; the others
+    /// kept. Only the changed members' old and new pairs are sorted and diffed; the new ones
+    /// are appended to the kept ones.
     fn sweep_few(
         &mut self,
+        bodies: &impl BodyView,
+        axes: [usize; 3],
         cell: [i32; 3],
-        changed: u32,
         scratch: &mut SweepScratch,
         (added, removed): (&mut Vec<Pair>, &mut Vec<Pair>),
-    ) -> u64 {
+    ) -> SweepCounts {
+        let changed = scratch.next_sweep_number(bodies.id_bound());
+        let swaps = self.move_changed(bodies, axes, changed, scratch);
         let met = &scratch.met;
         let unchanged = |id: ProxyId| met[id as usize] != changed;
         let dropped = &mut scratch.dropped;
@@ -277,12 +297,22 @@ impl Region {
             }
             keep
         });
-        let tests = sweep_changed(&self.entries, cell, &mut scratch.found);
+        let tests = sweep_changed(
+            &self.entries,
+            &scratch.at,
+            self.longest.unwrap_or(0.0),
+            cell,
+            &mut scratch.found,
+        );
+        for &i in &scratch.at {
+            self.entries[i].owner &= !FRESH;
+        }
         scratch.found.sort_unstable();
+        scratch.dropped.sort_unstable();
         diff_sorted(&scratch.dropped, &scratch.found, added, removed);
-        merge_sorted(&self.owned, &scratch.found, &mut scratch.merged);
-        self.set_owned(&scratch.merged);
-        tests
+        self.owned.extend_from_slice(&scratch.found);
+        self.owned_unsorted |= !scratch.found.is_empty();
+        SweepCounts { swaps, tests }
     }
 
     /// Copies the new owned pairs in. Copied, not swapped with the scratch buffer: a swap
@@ -293,32 +323,18 @@ impl Region {
         self.owned.extend_from_slice(pairs);
     }
 
-    /// Re-reads the members (all of them, or, when `few`, the changed ones, clearing the
-    /// others' fresh mark), drops those that left, and appends the changed ids not among them.
-    /// The changed ids are told apart by two sweep numbers in `met` (no sorting, no search):
-    /// `pending` until found among the members or appended, then `seen`, which is returned for
-    /// [`Self::sweep_few`].
-    fn refresh(
+    /// Re-reads every member, drops those that left, and appends the changed ids not among
+    /// them (told apart by this sweep's number in `met`: no sorting, no search).
+    fn refresh_all(
         &mut self,
         bodies: &impl BodyView,
         axes: [usize; 3],
         scratch: &mut SweepScratch,
-        few: bool,
-    ) -> u32 {
-        let pending = scratch.next_sweep_number(bodies.id_bound());
+    ) {
         let seen = scratch.next_sweep_number(bodies.id_bound());
         let (cell, met) = (self.cell, &mut scratch.met);
-        if few {
-            for &id in &self.changed {
-                met[id as usize] = pending;
-            }
-        }
         self.entries.retain_mut(|e| {
             let id = e.id();
-            if few && met[id as usize] != pending {
-                e.owner &= !FRESH;
-                return true;
-            }
             met[id as usize] = seen;
             bodies
                 .entry(id, cell, axes)
@@ -330,8 +346,98 @@ impl Region {
                 self.entries.extend(bodies.entry(id, cell, axes));
             }
         }
-        seen
     }
+
+    /// Brings each changed body's entry up to date at its sorted place, marked `FRESH`: found
+    /// by binary search on the sweep-axis min it carries (so the unchanged members are not
+    /// read), re-read, and moved by insertion to its new place (a few places under coherence);
+    /// an arrival is inserted, a departure removed. The changed members' places end in
+    /// `scratch.at`, and each changed id carries `changed` in `met`. Returns the places the
+    /// entries passed (insertion sort's swaps).
+    fn move_changed(
+        &mut self,
+        bodies: &impl BodyView,
+        axes: [usize; 3],
+        changed: u32,
+        scratch: &mut SweepScratch,
+    ) -> u64 {
+        let (moved, met) = (&mut scratch.moved, &mut scratch.met);
+        moved.clear();
+        let mut swaps = 0;
+        for &id in &self.changed {
+            if std::mem::replace(&mut met[id as usize], changed) == changed {
+                continue;
+            }
+            let from = find(&self.entries, id, bodies.swept_lo(id));
+            match (from, bodies.entry(id, self.cell, axes)) {
+                (Some(at), Some(mut entry)) => {
+                    entry.owner |= FRESH;
+                    self.entries[at] = entry;
+                    swaps += settle(&mut self.entries, at);
+                    moved.push(entry);
+                }
+                (Some(at), None) => {
+                    self.entries.remove(at);
+                }
+                (None, Some(mut entry)) => {
+                    entry.owner |= FRESH;
+                    let to = self.entries.partition_point(|e| e.lo < entry.lo);
+                    self.entries.insert(to, entry);
+                    moved.push(entry);
+                }
+                (None, None) => {}
+            }
+        }
+        self.longest = Some(match self.longest {
+            Some(longest) => moved
+                .iter()
+                .fold(longest, |m, e| m.max((e.hi - e.lo).next_up())),
+            None => longest_member(&self.entries),
+        });
+        scratch.at.clear();
+        let entries = &self.entries;
+        let places = moved.iter().filter_map(|e| find(entries, e.id(), e.lo));
+        scratch.at.extend(places);
+        swaps
+    }
+}
+
+/// Moves the entry at `at` left or right until `entries` is sorted by `lo` again (it is but
+/// for that entry); returns the places it passed.
+fn settle(entries: &mut [Entry], at: usize) -> u64 {
+    let mut j = at;
+    while j > 0 && entries[j].lo < entries[j - 1].lo {
+        entries.swap(j, j - 1);
+        j -= 1;
+    }
+    while j + 1 < entries.len() && entries[j + 1].lo < entries[j].lo {
+        entries.swap(j, j + 1);
+        j += 1;
+    }
+    at.abs_diff(j) as u64
+}
+
+/// Where `id`'s entry is among `entries` (sorted by `lo`), looked for first among those whose
+/// `lo` is `lo`, then, if not there, member by member (an arrival, or a stale hint).
+fn find(entries: &[Entry], id: ProxyId, lo: f32) -> Option<usize> {
+    let start = entries.partition_point(|e| e.lo < lo);
+    let near = entries[start..]
+        .iter()
+        .take_while(|e| e.lo == lo)
+        .position(|e| e.id() == id);
+    near.map(|k| start + k)
+        .or_else(|| entries.iter().position(|e| e.id() == id))
+}
+
+/// The longest member's length on the sweep axis, rounded up: `hi - lo` rounded to nearest
+/// can fall short of the true length, and then `a.lo - longest` would stop a backward walk one
+/// member early (a touching pair lost). `next_up` is monotone, so rounding the largest length
+/// up is rounding each (one call, not one per member).
+fn longest_member(entries: &[Entry]) -> f32 {
+    entries
+        .iter()
+        .fold(0.0f32, |m, e| m.max(e.hi - e.lo))
+        .next_up()
 }
 
 /// Insertion sort by `lo` with a swap budget, then a sort from scratch if it ran out; returns
@@ -393,21 +499,21 @@ fn sweep_owned(entries: &[Entry], cell: [i32; 3], found: &mut Vec<Pair>) -> u64 
     tests
 }
 
-/// Each changed member swept against its neighbours: forward over the members starting
-/// before it ends, backward over those that may still reach it (no further back than the
-/// longest member), skipping changed ones backward (their own forward sweep finds the pair).
-fn sweep_changed(entries: &[Entry], cell: [i32; 3], found: &mut Vec<Pair>) -> u64 {
+/// Each changed member (at the places `at`, marked `FRESH`) swept against its neighbours:
+/// forward over the members starting before it ends, backward over those that may still reach
+/// it (no further back than `longest`), skipping changed ones backward (their own forward sweep
+/// finds the pair).
+fn sweep_changed(
+    entries: &[Entry],
+    at: &[usize],
+    longest: f32,
+    cell: [i32; 3],
+    found: &mut Vec<Pair>,
+) -> u64 {
     found.clear();
-    // Rounded up: `hi - lo` rounded to nearest can fall short of the true length, and then
-    // `a.lo - longest` would stop the backward walk one member early (a touching pair lost).
-    // `next_up` is monotone, so rounding the largest length up is rounding each (one call,
-    // not one per member: it was a tenth of a sparse step's instructions).
-    let longest = entries
-        .iter()
-        .fold(0.0f32, |m, e| m.max(e.hi - e.lo))
-        .next_up();
     let mut tests = 0;
-    for (i, a) in entries.iter().enumerate().filter(|(_, e)| e.is_fresh()) {
+    for &i in at {
+        let a = &entries[i];
         for b in entries[i + 1..].iter().take_while(|b| b.lo <= a.hi) {
             tests += 1;
             found.extend(owned_pair(a, b, cell));
@@ -424,47 +530,5 @@ fn sweep_changed(entries: &[Entry], cell: [i32; 3], found: &mut Vec<Pair>) -> u6
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_range_holds_the_cells_of_its_corners_and_counts_them() {
-        let aabb = Aabb {
-            min: glam::Vec3::new(-0.5, 0.0, 3.9),
-            max: glam::Vec3::new(1.5, 0.9, 4.1),
-        };
-        let range = CellRange::of(&aabb, 1.0);
-        assert_eq!(range.lo, [-1, 0, 3]);
-        assert_eq!(range.hi, [1, 0, 4]);
-        assert_eq!(range.count(), 6);
-        assert_eq!(range.cells().count(), 6);
-        assert!(range.cells().all(|c| range.contains(c)));
-        let huge = Aabb {
-            min: glam::Vec3::splat(-f32::MAX),
-            max: glam::Vec3::splat(f32::MAX),
-        };
-        assert!(CellRange::of(&huge, 1.0).count() > 1 << 40);
-    }
-
-    #[test]
-    fn sort_entries_counts_swaps_and_falls_back_when_over_budget() {
-        let entry = |lo: f32, owner: u32| Entry {
-            lo,
-            hi: lo,
-            cross: [0.0; 4],
-            owner: owner << 1,
-            low_cell: [0; 3],
-        };
-        let mut nearly: Vec<Entry> = [0.0, 2.0, 1.0, 3.0]
-            .iter()
-            .zip(0..)
-            .map(|(&lo, i)| entry(lo, i))
-            .collect();
-        assert_eq!(sort_entries(&mut nearly), 1);
-        assert!(nearly.windows(2).all(|w| w[0].lo <= w[1].lo));
-        let mut reversed: Vec<Entry> = (0..100).map(|i| entry(-(i as f32), i)).collect();
-        let swaps = sort_entries(&mut reversed);
-        assert!(swaps <= REGION_SWAP_BUDGET * 100 + 100, "{swaps}");
-        assert!(reversed.windows(2).all(|w| w[0].lo <= w[1].lo));
-    }
-}
+#[path = "region_tests.rs"]
+mod tests;

@@ -1,0 +1,142 @@
+//! Tests of a region's sweep ([`super::Region`]): cell ranges, the sort's budget, and sweeps of
+//! few changed members against brute force.
+
+use super::*;
+
+#[test]
+fn a_range_holds_the_cells_of_its_corners_and_counts_them() {
+    let aabb = Aabb {
+        min: glam::Vec3::new(-0.5, 0.0, 3.9),
+        max: glam::Vec3::new(1.5, 0.9, 4.1),
+    };
+    let range = CellRange::of(&aabb, 1.0);
+    assert_eq!(range.lo, [-1, 0, 3]);
+    assert_eq!(range.hi, [1, 0, 4]);
+    assert_eq!(range.count(), 6);
+    assert_eq!(range.cells().count(), 6);
+    assert!(range.cells().all(|c| range.contains(c)));
+    let huge = Aabb {
+        min: glam::Vec3::splat(-f32::MAX),
+        max: glam::Vec3::splat(f32::MAX),
+    };
+    assert!(CellRange::of(&huge, 1.0).count() > 1 << 40);
+}
+
+#[test]
+fn sort_entries_counts_swaps_and_falls_back_when_over_budget() {
+    let entry = |lo: f32, owner: u32| Entry {
+        lo,
+        hi: lo,
+        cross: [0.0; 4],
+        owner: owner << 1,
+        low_cell: [0; 3],
+    };
+    let mut nearly: Vec<Entry> = [0.0, 2.0, 1.0, 3.0]
+        .iter()
+        .zip(0..)
+        .map(|(&lo, i)| entry(lo, i))
+        .collect();
+    assert_eq!(sort_entries(&mut nearly), 1);
+    assert!(nearly.windows(2).all(|w| w[0].lo <= w[1].lo));
+    let mut reversed: Vec<Entry> = (0..100).map(|i| entry(-(i as f32), i)).collect();
+    let swaps = sort_entries(&mut reversed);
+    assert!(swaps <= REGION_SWAP_BUDGET * 100 + 100, "{swaps}");
+    assert!(reversed.windows(2).all(|w| w[0].lo <= w[1].lo));
+}
+
+/// Boxes inside the cell `[0, 8)³`; `lie` makes every position hint wrong.
+struct Boxes {
+    boxes: Vec<Option<Aabb>>,
+    swept: Vec<f32>,
+    lie: bool,
+}
+
+impl BodyView for Boxes {
+    fn entry(&self, id: ProxyId, cell: [i32; 3], axes: [usize; 3]) -> Option<Entry> {
+        let aabb = self.boxes[id as usize]?;
+        let range = CellRange::of(&aabb, 1.0 / 8.0);
+        range
+            .contains(cell)
+            .then(|| Entry::new(&aabb, id, false, &range, axes))
+    }
+    fn swept_lo(&self, id: ProxyId) -> f32 {
+        if self.lie {
+            -1.0
+        } else {
+            self.swept[id as usize]
+        }
+    }
+    fn id_bound(&self) -> usize {
+        self.boxes.len()
+    }
+}
+
+fn brute_force(boxes: &[Option<Aabb>]) -> Vec<Pair> {
+    let mut pairs = Vec::new();
+    for (i, a) in boxes.iter().enumerate() {
+        for (j, b) in boxes.iter().enumerate().skip(i + 1) {
+            if let (Some(a), Some(b)) = (a, b)
+                && a.intersects(b)
+            {
+                pairs.push(Pair::ordered(i as ProxyId, j as ProxyId));
+            }
+        }
+    }
+    pairs
+}
+
+/// Sweeps of two changed members among forty (moves, departures, arrivals) keep exactly
+/// the brute-force pairs, with right position hints and with wrong ones (each entry then
+/// found member by member).
+#[test]
+fn sweeps_of_few_changed_keep_exactly_the_brute_force_pairs_whatever_the_hints() {
+    for lie in [false, true] {
+        let mut seed = 0x9e37_79b9_u32;
+        let mut unit = move || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (seed >> 8) as f32 / (1u32 << 24) as f32
+        };
+        let mut random_box = || {
+            let min = glam::Vec3::new(unit(), unit(), unit()) * 7.0;
+            Aabb {
+                min,
+                max: min + glam::Vec3::splat(0.3 + unit()),
+            }
+        };
+        let boxes: Vec<Option<Aabb>> = (0..40).map(|_| Some(random_box())).collect();
+        let mut view = Boxes {
+            swept: vec![0.0; 40],
+            boxes,
+            lie,
+        };
+        let mut region = Region::default();
+        let frame = SweepFrame {
+            axes: [0, 1, 2],
+            inverse_size: 1.0 / 8.0,
+        };
+        let mut scratch = SweepScratch::default();
+        let (mut added, mut removed) = (Vec::new(), Vec::new());
+        region.changed.extend(0..40);
+        for step in 0..200u32 {
+            region.sweep(&view, frame, &mut scratch, (&mut added, &mut removed));
+            let mut owned = region.owned.clone();
+            owned.sort_unstable();
+            assert_eq!(owned, brute_force(&view.boxes), "step {step}, lie {lie}");
+            for (id, aabb) in view.boxes.iter().enumerate() {
+                view.swept[id] = aabb.map_or(0.0, |b| b.min.x);
+            }
+            for id in [step * 7 % 40, step * 13 % 40 + 1].map(|i| i.min(39)) {
+                // Mostly small moves, now and then a departure or an arrival.
+                view.boxes[id as usize] = match (step % 9, view.boxes[id as usize]) {
+                    (0, _) => None,
+                    (_, Some(b)) => Some(Aabb {
+                        min: b.min + 0.05,
+                        max: b.max + 0.05,
+                    }),
+                    (_, None) => Some(random_box()),
+                };
+                region.changed.push(id);
+            }
+        }
+    }
+}
