@@ -67,9 +67,6 @@ struct Slot {
     /// its cells finds its regions without hashing.
     homes: [u32; HOMES],
     home_count: u8,
-    /// The sweep-axis min of the box as of the last commit, which its region entries carry:
-    /// where a region looks for them when the body changes.
-    swept_lo: f32,
 }
 
 /// Regions a slot remembers (a box up to two cells wide on every axis).
@@ -85,7 +82,6 @@ impl Default for Slot {
             placed: Placement::Absent,
             homes: [0; HOMES],
             home_count: 0,
-            swept_lo: 0.0,
         }
     }
 }
@@ -104,11 +100,6 @@ impl BodyView for Slots<'_> {
             }
             _ => None,
         }
-    }
-
-    #[inline]
-    fn swept_lo(&self, id: ProxyId) -> f32 {
-        self.0[id as usize].swept_lo
     }
 
     fn id_bound(&self) -> usize {
@@ -519,11 +510,8 @@ impl BroadPhase for RegionSweep {
             }
             self.changed = changed;
         }
-        let axis = self.layout.map_or(0, |l| l.frame.axes[0]);
         for &id in &self.changed {
-            let slot = &mut self.slots[id as usize];
-            slot.queued = false;
-            slot.swept_lo = slot.aabb.min.to_array()[axis];
+            self.slots[id as usize].queued = false;
         }
         self.changed.clear();
         self.large_changed = false;
