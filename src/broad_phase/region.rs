@@ -224,6 +224,20 @@ pub(super) struct SweepFrame {
 }
 
 impl Region {
+    /// Asks the cache for what a sweep reads first: the changed ids, the owned pairs and the
+    /// members (up to 1 KiB of them).
+    pub fn prefetch(&self) {
+        if let Some(first) = self.changed.first() {
+            super::regions::prefetch(first);
+        }
+        if let Some(first) = self.owned.first() {
+            super::regions::prefetch(first);
+        }
+        for entry in self.entries.iter().step_by(2).take(16) {
+            super::regions::prefetch(entry);
+        }
+    }
+
     /// Brings the entries up to date with the changed bodies, re-sorts them and finds the pairs
     /// this region owns now, appending the difference with the last ones to `added` and
     /// `removed`. Returns the change in the number of members and the work done.

@@ -24,6 +24,10 @@
 //!   of up to six tunings follows a layout; then every [`RegionSweep::CHECK_PERIOD`] commits
 //!   the occupancy is checked again with a band twice as wide. Boxes of median extent 1e-6 or
 //!   less (points) start from the bounds' size over `∛n` instead.
+//! - **Prefetch.** While one queued region is swept, the next one's changed ids, owned pairs
+//!   and members are asked for, and the one after it: in a sparse step most of the time is
+//!   waiting for memory (1 % of 100k boxes moving, caches flushed between steps: 1.28 → 0.95 ms
+//!   a step).
 //! - **Memory** grows with the largest id, as the contract says: about 90 bytes an id (the box,
 //!   the placement and up to eight remembered regions), plus 40 bytes per region membership.
 //! - **Net changes.** Each region diffs its new pairs against its last ones; removals are
@@ -44,6 +48,15 @@ use crate::bounding::Aabb;
 use crate::pair_hash::{PairHashBuilder, hash_map_bytes};
 use std::collections::HashMap;
 use std::mem::size_of;
+
+/// Asks the cache for the line holding `x` (a hint; nothing on other targets).
+#[inline]
+pub(super) fn prefetch<T>(x: &T) {
+    #[cfg(target_arch = "x86_64")]
+    safe_arch::prefetch_t0(x);
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = x;
+}
 
 /// Where a body sits as of the last commit.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -495,7 +508,13 @@ impl BroadPhase for RegionSweep {
                 self.place(id, layout.frame.inverse_size);
             }
             let dirty = std::mem::take(&mut self.dirty);
-            for &at in &dirty {
+            for (k, &at) in dirty.iter().enumerate() {
+                if let Some(&ahead) = dirty.get(k + 2) {
+                    prefetch(&self.regions[ahead as usize]);
+                }
+                if let Some(&next) = dirty.get(k + 1) {
+                    self.regions[next as usize].prefetch();
+                }
                 self.sweep_region(at, layout.frame);
             }
             self.dirty = dirty;
