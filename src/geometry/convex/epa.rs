@@ -423,8 +423,10 @@ fn witnesses(poly: &Polytope, face: Face) -> Penetration {
         (0.0, 0.0)
     };
     let bary = [1.0 - u - v, u, v];
-    let on_a = p0.a * bary[0] + p1.a * bary[1] + p2.a * bary[2];
-    let on_b = p0.b * bary[0] + p1.b * bary[1] + p2.b * bary[2];
+    let a = [p0.a, p1.a, p2.a].map(Vec3::as_dvec3);
+    let b = [p0.b, p1.b, p2.b].map(Vec3::as_dvec3);
+    let on_a = a[0] * bary[0] + a[1] * bary[1] + a[2] * bary[2];
+    let on_b = b[0] * bary[0] + b[1] * bary[1] + b[2] * bary[2];
     Penetration {
         normal: face.normal.as_vec3(),
         depth: face.distance.max(0.0) as f32,
@@ -516,8 +518,8 @@ mod tests {
         for w in corners {
             poly.add_vertex(SupportPoint {
                 w,
-                a: w,
-                b: DVec3::ZERO,
+                a: w.as_vec3(),
+                b: Vec3::ZERO,
             });
         }
         for [i, j, k, opposite] in [[0u8, 1, 2, 3], [0, 3, 1, 2], [0, 2, 3, 1], [1, 3, 2, 0]] {
@@ -536,8 +538,8 @@ mod tests {
         let far = DVec3::splat(10.0); // sees three of the four faces
         let point = SupportPoint {
             w: far,
-            a: far,
-            b: DVec3::ZERO,
+            a: far.as_vec3(),
+            b: Vec3::ZERO,
         };
         let seed = (0..4).find(|&f| unit_tetrahedron().sees(f, far)).unwrap();
         // Either other seen face broken: met first, or met while the third waits on the
@@ -559,8 +561,8 @@ mod tests {
         let new = sound
             .add_vertex(SupportPoint {
                 w: far,
-                a: far,
-                b: DVec3::ZERO,
+                a: far.as_vec3(),
+                b: Vec3::ZERO,
             })
             .unwrap();
         assert!(sound.expand(seed, new));

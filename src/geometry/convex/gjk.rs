@@ -33,26 +33,54 @@ const ABSOLUTE_FRACTION: f64 = 1e-6;
 /// The cores count as overlapping when `|v|` is below this fraction of the pair's size.
 const OVERLAP_FRACTION: f64 = 1e-6;
 
-/// A vertex of the Minkowski difference with the two support points that made it.
+/// A vertex of the Minkowski difference with the two support points that made it. The support
+/// points stay in f32, as the shapes gave them (48 bytes, not 72: GJK and EPA copy these).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct SupportPoint {
-    /// `a − b`.
+    /// `a − b`, in f64.
     pub w: DVec3,
     /// The support point of A.
-    pub a: DVec3,
+    pub a: Vec3,
     /// The support point of B.
-    pub b: DVec3,
+    pub b: Vec3,
 }
 
 /// The support point of `A − B` along `dir`.
 #[inline]
 pub(crate) fn support(a: &ConvexPart, b: &ConvexPart, dir: DVec3) -> SupportPoint {
     let d = dir.as_vec3();
-    let (pa, pb) = (a.support(d).as_dvec3(), b.support(-d).as_dvec3());
+    let (pa, pb) = (a.support(d), b.support(-d));
     SupportPoint {
-        w: pa - pb,
+        w: pa.as_dvec3() - pb.as_dvec3(),
         a: pa,
         b: pb,
+    }
+}
+
+/// Which vertices of a simplex support its point closest to the origin, with that point's
+/// barycentric weights: found without touching the simplex, applied by [`Simplex::reduce`].
+#[derive(Clone, Copy, Debug)]
+struct Reduction {
+    ids: [usize; 3],
+    weights: [f64; 3],
+    len: usize,
+}
+
+impl Reduction {
+    fn one(i: usize) -> Self {
+        Self {
+            ids: [i, 0, 0],
+            weights: [1.0, 0.0, 0.0],
+            len: 1,
+        }
+    }
+
+    fn two([i, j]: [usize; 2], [wi, wj]: [f64; 2]) -> Self {
+        Self {
+            ids: [i, j, 0],
+            weights: [wi, wj, 0.0],
+            len: 2,
+        }
     }
 }
 
@@ -70,16 +98,31 @@ impl Simplex {
         self.len += 1;
     }
 
-    /// Keeps the listed vertices with these weights.
-    fn keep<const N: usize>(&mut self, ids: [usize; N], weights: [f64; N]) -> DVec3 {
-        let old = self.points;
+    /// The point a reduction stands for: its vertices' weighted sum.
+    fn point_of(&self, r: &Reduction) -> DVec3 {
         let mut v = DVec3::ZERO;
-        for (k, (&i, &w)) in ids.iter().zip(&weights).enumerate() {
-            self.points[k] = old[i];
-            self.weights[k] = w;
-            v += old[i].w * w;
+        for (&i, &w) in r.ids[..r.len].iter().zip(&r.weights) {
+            v += self.points[i].w * w;
         }
-        self.len = N;
+        v
+    }
+
+    /// Keeps the reduction's vertices with its weights; returns its point.
+    fn reduce(&mut self, r: Reduction) -> DVec3 {
+        let v = self.point_of(&r);
+        // Read before written: a kept vertex may move to a slot another one is read from.
+        // (Spelled out per count: a gathered array of three went through `memcpy`.)
+        let [i, j, k] = r.ids;
+        match r.len {
+            1 => self.points[0] = self.points[i],
+            2 => [self.points[0], self.points[1]] = [self.points[i], self.points[j]],
+            _ => {
+                [self.points[0], self.points[1], self.points[2]] =
+                    [self.points[i], self.points[j], self.points[k]]
+            }
+        }
+        self.weights[..3].copy_from_slice(&r.weights);
+        self.len = r.len;
         v
     }
 
@@ -88,8 +131,8 @@ impl Simplex {
         let mut pa = DVec3::ZERO;
         let mut pb = DVec3::ZERO;
         for (p, &w) in self.points[..self.len].iter().zip(&self.weights) {
-            pa += p.a * w;
-            pb += p.b * w;
+            pa += p.a.as_dvec3() * w;
+            pb += p.b.as_dvec3() * w;
         }
         (pa, pb)
     }
@@ -97,70 +140,76 @@ impl Simplex {
     /// Reduces the simplex to the vertices supporting its point closest to the origin and
     /// returns that point; `None` when a tetrahedron encloses the origin.
     fn closest(&mut self) -> Option<DVec3> {
-        match self.len {
-            1 => Some(self.keep([0], [1.0])),
-            2 => Some(self.closest_on_segment(0, 1)),
-            3 => Some(self.closest_on_triangle(0, 1, 2)),
-            _ => self.closest_on_tetrahedron(),
-        }
+        let r = match self.len {
+            1 => Reduction::one(0),
+            2 => self.on_segment(0, 1),
+            3 => self.on_triangle(0, 1, 2),
+            _ => self.on_tetrahedron()?,
+        };
+        Some(self.reduce(r))
     }
 
-    fn closest_on_segment(&mut self, i: usize, j: usize) -> DVec3 {
+    fn on_segment(&self, i: usize, j: usize) -> Reduction {
         let (a, b) = (self.points[i].w, self.points[j].w);
         let ab = b - a;
         let len2 = ab.length_squared();
         let t = if len2 > 0.0 { -a.dot(ab) / len2 } else { 0.0 };
         if t <= 0.0 {
-            self.keep([i], [1.0])
+            Reduction::one(i)
         } else if t >= 1.0 {
-            self.keep([j], [1.0])
+            Reduction::one(j)
         } else {
-            self.keep([i, j], [1.0 - t, t])
+            Reduction::two([i, j], [1.0 - t, t])
         }
     }
 
     /// Ericson's `ClosestPtPointTriangle` for the origin, by Voronoi regions.
-    fn closest_on_triangle(&mut self, i: usize, j: usize, k: usize) -> DVec3 {
+    fn on_triangle(&self, i: usize, j: usize, k: usize) -> Reduction {
         let (a, b, c) = (self.points[i].w, self.points[j].w, self.points[k].w);
         let (ab, ac) = (b - a, c - a);
         let (d1, d2) = (-ab.dot(a), -ac.dot(a));
         if d1 <= 0.0 && d2 <= 0.0 {
-            return self.keep([i], [1.0]);
+            return Reduction::one(i);
         }
         let (d3, d4) = (-ab.dot(b), -ac.dot(b));
         if d3 >= 0.0 && d4 <= d3 {
-            return self.keep([j], [1.0]);
+            return Reduction::one(j);
         }
         let vc = d1 * d4 - d3 * d2;
         if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
             let t = d1 / (d1 - d3);
-            return self.keep([i, j], [1.0 - t, t]);
+            return Reduction::two([i, j], [1.0 - t, t]);
         }
         let (d5, d6) = (-ab.dot(c), -ac.dot(c));
         if d6 >= 0.0 && d5 <= d6 {
-            return self.keep([k], [1.0]);
+            return Reduction::one(k);
         }
         let vb = d5 * d2 - d1 * d6;
         if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
             let t = d2 / (d2 - d6);
-            return self.keep([i, k], [1.0 - t, t]);
+            return Reduction::two([i, k], [1.0 - t, t]);
         }
         let va = d3 * d6 - d5 * d4;
         if va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 {
             let t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-            return self.keep([j, k], [1.0 - t, t]);
+            return Reduction::two([j, k], [1.0 - t, t]);
         }
         let sum = va + vb + vc;
         if sum <= 0.0 || !sum.is_finite() {
             // A degenerate (flat) triangle: its first edge (GJK's next support point restores
             // the rest).
-            return self.closest_on_segment(i, j);
+            return self.on_segment(i, j);
         }
         let (v, w) = (vb / sum, vc / sum);
-        self.keep([i, j, k], [1.0 - v - w, v, w])
+        Reduction {
+            ids: [i, j, k],
+            weights: [1.0 - v - w, v, w],
+            len: 3,
+        }
     }
 
-    fn closest_on_tetrahedron(&mut self) -> Option<DVec3> {
+    /// The closest of the faces the origin lies beyond; `None` when it is inside all four.
+    fn on_tetrahedron(&self) -> Option<Reduction> {
         const FACES: [[usize; 4]; 4] = [[0, 1, 2, 3], [0, 3, 1, 2], [0, 2, 3, 1], [1, 3, 2, 0]];
         let w = self.points.map(|p| p.w);
         // A nearly flat tetrahedron (three support points bunched on a curved rim) cannot tell
@@ -170,7 +219,7 @@ impl Simplex {
             .fold(0.0f64, f64::max);
         let volume6 = (w[1] - w[0]).cross(w[2] - w[0]).dot(w[3] - w[0]).abs();
         let flat = volume6 <= FLAT_VOLUME_FRACTION * longest * longest * longest;
-        let mut best: Option<(f64, Simplex, DVec3)> = None;
+        let mut best: Option<(f64, Reduction)> = None;
         let mut outside_any = false;
         for [i, j, k, opposite] in FACES {
             let n = (w[j] - w[i]).cross(w[k] - w[i]);
@@ -180,19 +229,17 @@ impl Simplex {
             // vertex; a flat tetrahedron (both zero) is searched face by face.
             if origin_side * other_side < 0.0 || other_side == 0.0 || flat {
                 outside_any = true;
-                let mut face = *self;
-                let v = face.closest_on_triangle(i, j, k);
-                if best.as_ref().is_none_or(|b| v.length_squared() < b.0) {
-                    best = Some((v.length_squared(), face, v));
+                let face = self.on_triangle(i, j, k);
+                let d2 = self.point_of(&face).length_squared();
+                if best.as_ref().is_none_or(|b| d2 < b.0) {
+                    best = Some((d2, face));
                 }
             }
         }
         if !outside_any {
             return None;
         }
-        let (_, face, v) = best?;
-        *self = face;
-        Some(v)
+        Some(best?.1)
     }
 }
 

@@ -62,6 +62,9 @@ pub(crate) struct ConvexPart<'a> {
     /// [`ConvexPart::size`], found once: a hull's is a pass over its vertices, and every GJK,
     /// EPA and clip of the query reads it.
     size: f32,
+    /// Whether `pose` turns (a pair's first part sits at the identity: its support points need
+    /// no rotation there and back, a fifth of a hull pair's support work).
+    turned: bool,
 }
 
 /// The supporting feature of a core along a direction, in the query's frame: its points, and the
@@ -129,6 +132,7 @@ impl<'a> ConvexPart<'a> {
             rounding,
             pose,
             size: core_size(core) + rounding,
+            turned: pose.rotation != glam::Quat::IDENTITY,
         })
     }
 
@@ -140,6 +144,7 @@ impl<'a> ConvexPart<'a> {
             rounding: 0.0,
             pose: Isometry::IDENTITY,
             size: core_size(core),
+            turned: false,
         }
     }
 
@@ -166,6 +171,11 @@ impl<'a> ConvexPart<'a> {
         }
         if let Core::Triangle(v) = self.core {
             return farthest(&v, dir);
+        }
+        if !self.turned {
+            // What the identity rotation gives, bit for bit: `+ 0` turns -0 into +0, as the
+            // rotation's sums do.
+            return self.local_support(dir + Vec3::ZERO) + self.pose.translation;
         }
         let local = self.pose.inverse_transform_vector(dir);
         self.pose.transform_point(self.local_support(local))
