@@ -5,7 +5,7 @@
 //! passes few others, and a region holds tens of bodies, not the whole scene), with a budget:
 //! past `REGION_SWAP_BUDGET · n` swaps the region finishes with a sort from scratch, the rule
 //! of [`super::AdaptiveSweep`] brought down to one region. The sweep is Ericson's forward
-//! sweep (*Real-Time Collision Detection*, §7.5.2) over struct-of-arrays scratch.
+//! sweep (*Real-Time Collision Detection*, §7.5.2) over the members' compact entries.
 //!
 //! **Who reports a pair.** A box belongs to every cell it touches, so two boxes may share
 //! several regions. Each pair is reported by exactly one: the region whose cell holds the
@@ -20,6 +20,11 @@ use crate::bounding::Aabb;
 
 /// Insertion sort gives up and sorts from scratch past this many swaps per member.
 const REGION_SWAP_BUDGET: u64 = 8;
+
+/// A sweep of few changed members takes at most this many (ids, repeats included): each is
+/// looked for by a scan of the members and checked against every owned pair, so more would
+/// cost more than the full sweep does.
+const MAX_FEW: usize = 16;
 
 /// The integer cell of a coordinate (monotone in `v`; saturates at the `i32` range).
 ///
@@ -81,7 +86,8 @@ pub(super) struct Region {
     /// The cell.
     pub cell: [i32; 3],
     /// The members' sweep entries, sorted along the sweep axis as of the last sweep. An
-    /// unchanged body's entry is kept as it is: only changed bodies are read again.
+    /// unchanged body's entry is kept as it is: a sweep of few changed members reads only
+    /// theirs again.
     pub entries: Vec<Entry>,
     /// Bodies that changed this commit and touched this cell before or after (arrivals,
     /// departures and movers), in any order, perhaps repeated.
@@ -225,7 +231,7 @@ pub(super) struct SweepFrame {
 
 impl Region {
     /// Asks the cache for what a sweep reads first: the changed ids, the owned pairs and the
-    /// members (up to 1 KiB of them).
+    /// members (a line in every 80 bytes of the first 32).
     pub fn prefetch(&self) {
         if let Some(first) = self.changed.first() {
             super::regions::prefetch(first);
@@ -255,7 +261,8 @@ impl Region {
         let before = self.entries.len() as isize;
         let [axis, u, v] = frame.axes;
         let cell = [self.cell[axis], self.cell[u], self.cell[v]];
-        let counts = if self.changed.len() * 4 < self.entries.len() {
+        let few = self.changed.len() * 4 < self.entries.len() && self.changed.len() <= MAX_FEW;
+        let counts = if few {
             self.sweep_few(bodies, frame.axes, cell, scratch, changes)
         } else {
             self.sweep_all(bodies, frame.axes, cell, scratch, changes)
@@ -298,9 +305,9 @@ impl Region {
         scratch: &mut SweepScratch,
         (added, removed): (&mut Vec<Pair>, &mut Vec<Pair>),
     ) -> SweepCounts {
-        let swaps = self.move_changed(bodies, axes, scratch);
-        // The changed ids, not `met`: a region's few ids stay in registers, where `met` was a
-        // cache miss per partner id (a third of a sparse step's misses).
+        let (swaps, longest) = self.move_changed(bodies, axes, scratch);
+        // The changed ids (at most `MAX_FEW`), not `met`: a scan of a few ids in cache, where
+        // `met` was a cache miss per partner id (a third of a sparse step's misses).
         let ids = &scratch.ids;
         let unchanged = |id: ProxyId| ids.iter().all(|&c| c != id);
         let dropped = &mut scratch.dropped;
@@ -315,7 +322,7 @@ impl Region {
         let tests = sweep_changed(
             &self.entries,
             &scratch.at,
-            self.longest.unwrap_or(0.0),
+            longest,
             cell,
             &mut scratch.found,
         );
@@ -367,14 +374,15 @@ impl Region {
     /// among the members by id (the unchanged members' bodies are not read), re-read, and
     /// moved by insertion to its new place (a few places under coherence);
     /// an arrival is inserted, a departure removed. The changed members' places end in
-    /// `scratch.at`, the changed ids (each once) in `scratch.ids`. Returns the places the
-    /// entries passed (insertion sort's swaps).
+    /// `scratch.at`, the changed ids (each once) in `scratch.ids`. Returns the
+    /// places the entries passed (insertion sort's swaps) and the bound on the members'
+    /// length.
     fn move_changed(
         &mut self,
         bodies: &impl BodyView,
         axes: [usize; 3],
         scratch: &mut SweepScratch,
-    ) -> u64 {
+    ) -> (u64, f32) {
         // Tells repeated ids apart.
         let changed = scratch.next_sweep_number(bodies.id_bound());
         let (moved, met, ids) = (&mut scratch.moved, &mut scratch.met, &mut scratch.ids);
@@ -406,17 +414,20 @@ impl Region {
                 (None, None) => {}
             }
         }
-        self.longest = Some(match self.longest {
+        let longest = match self.longest {
             Some(longest) => moved
                 .iter()
                 .fold(longest, |m, e| m.max((e.hi - e.lo).next_up())),
             None => longest_member(&self.entries),
-        });
+        };
+        self.longest = Some(longest);
+        // Each moved entry's place (at most `MAX_FEW` scans; a pass over every member for its
+        // fresh mark cost a sparse step 3 % more instructions).
         scratch.at.clear();
         let entries = &self.entries;
         let places = moved.iter().filter_map(|e| find(entries, e.id()));
         scratch.at.extend(places);
-        swaps
+        (swaps, longest)
     }
 }
 

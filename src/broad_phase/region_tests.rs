@@ -74,10 +74,11 @@ fn brute_force(boxes: &[Option<Aabb>]) -> Vec<Pair> {
     pairs
 }
 
-/// Sweeps of two changed members among forty (moves, departures, arrivals, one repeated id)
-/// keep exactly the brute-force pairs, and the entries stay sorted and unmarked.
+/// Sweeps of two changed members among forty (moves, departures, arrivals, one repeated id),
+/// every tenth step twenty (a full sweep between sweeps of few), keep exactly the brute-force
+/// pairs and report exactly their changes; the entries stay sorted and unmarked.
 #[test]
-fn sweeps_of_few_changed_keep_exactly_the_brute_force_pairs() {
+fn sweeps_of_few_and_full_sweeps_keep_exactly_the_brute_force_pairs_and_changes() {
     let mut seed = 0x9e37_79b9_u32;
     let mut unit = move || {
         seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
@@ -98,24 +99,48 @@ fn sweeps_of_few_changed_keep_exactly_the_brute_force_pairs() {
     };
     let mut scratch = SweepScratch::default();
     let (mut added, mut removed) = (Vec::new(), Vec::new());
+    let mut last: Vec<Pair> = Vec::new();
     region.changed.extend(0..40);
     for step in 0..300u32 {
+        added.clear();
+        removed.clear();
         region.sweep(&view, frame, &mut scratch, (&mut added, &mut removed));
         let mut owned = region.owned.clone();
         owned.sort_unstable();
-        assert_eq!(owned, brute_force(&view.0), "step {step}");
+        let now = brute_force(&view.0);
+        assert_eq!(owned, now, "step {step}");
+        added.sort_unstable();
+        removed.sort_unstable();
+        let new: Vec<Pair> = now.iter().filter(|p| !last.contains(p)).copied().collect();
+        let gone: Vec<Pair> = last.iter().filter(|p| !now.contains(p)).copied().collect();
+        assert_eq!((&added, &removed), (&new, &gone), "step {step}");
+        last = now;
         assert!(region.entries.windows(2).all(|w| w[0].lo <= w[1].lo));
         assert!(region.entries.iter().all(|e| !e.is_fresh()));
         let first = step * 7 % 40;
-        for id in [first, (step * 13 + 1) % 40, first] {
-            // Mostly small moves, now and then a departure or an arrival.
+        let ids: Vec<u32> = if step % 10 == 9 {
+            (0..20).map(|k| (first + 2 * k) % 40).collect()
+        } else {
+            vec![first, (step * 13 + 1) % 40, first]
+        };
+        for id in ids {
+            // Mostly small moves (towards the cell's middle, so no box drifts out), now and
+            // then a departure or an arrival.
             let slot = &mut view.0[id as usize];
             *slot = match (step % 9, *slot) {
                 (0, _) => None,
-                (_, Some(b)) => Some(Aabb {
-                    min: b.min + 0.05,
-                    max: b.max + 0.05,
-                }),
+                (_, Some(b)) => {
+                    let towards = b.min.cmplt(glam::Vec3::splat(3.5));
+                    let shift = glam::Vec3::select(
+                        towards,
+                        glam::Vec3::splat(0.05),
+                        glam::Vec3::splat(-0.05),
+                    );
+                    Some(Aabb {
+                        min: b.min + shift,
+                        max: b.max + shift,
+                    })
+                }
                 (_, None) => Some(random_box()),
             };
             region.changed.push(id);

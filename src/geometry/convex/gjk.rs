@@ -208,7 +208,8 @@ impl Simplex {
         }
     }
 
-    /// The closest of the faces the origin lies beyond; `None` when it is inside all four.
+    /// The closest of the faces the origin lies beyond (of every face, when the tetrahedron is
+    /// flat); `None` when it is inside all four.
     fn on_tetrahedron(&self) -> Option<Reduction> {
         const FACES: [[usize; 4]; 4] = [[0, 1, 2, 3], [0, 3, 1, 2], [0, 2, 3, 1], [1, 3, 2, 0]];
         let w = self.points.map(|p| p.w);

@@ -62,8 +62,9 @@ pub(crate) struct ConvexPart<'a> {
     /// [`ConvexPart::size`], found once: a hull's is a pass over its vertices, and every GJK,
     /// EPA and clip of the query reads it.
     size: f32,
-    /// Whether `pose` turns (a pair's first part sits at the identity: its support points need
-    /// no rotation there and back, a fifth of a hull pair's support work).
+    /// Whether `pose` turns (a convex pair's first part sits at the identity: its support
+    /// points need no rotation there and back, a fifth of a hull pair's support work). Set
+    /// with the pose, which nothing changes afterwards.
     turned: bool,
 }
 
@@ -173,9 +174,12 @@ impl<'a> ConvexPart<'a> {
             return farthest(&v, dir);
         }
         if !self.turned {
-            // What the identity rotation gives, bit for bit: `+ 0` turns -0 into +0, as the
-            // rotation's sums do.
-            return self.local_support(dir + Vec3::ZERO) + self.pose.translation;
+            // What the identity rotation gives, bit for bit: its sums turn a support point's
+            // -0 into +0 (so does `+ 0`, before the translation, which may hold a -0). The
+            // direction's signs of zero change no support point's value, only, at most, the
+            // sign of a zero coordinate, which the same `+ 0` then clears.
+            let point = self.local_support(dir + Vec3::ZERO) + Vec3::ZERO;
+            return point + self.pose.translation;
         }
         let local = self.pose.inverse_transform_vector(dir);
         self.pose.transform_point(self.local_support(local))
