@@ -397,14 +397,8 @@ fn bad_rotational_input_is_quarantined_and_spreads_nothing() {
 
 #[test]
 fn a_spinning_ball_stays_awake_and_setting_a_spin_wakes_a_sleeper() {
-    let mut app = common::app();
-    app.insert_resource(Gravity::EARTH_Z_UP)
-        .insert_resource(SleepSettings {
-            enabled: true,
-            ..Default::default()
-        });
-    app.world_mut()
-        .spawn((Collider::half_space(Vec3::Z), Static));
+    // Sleeping is on by default.
+    let mut app = common::on_ground(common::app());
     let spinner = app
         .world_mut()
         .spawn((

@@ -391,16 +391,6 @@ fn changes_since(before: &[Pair], now: &[Pair]) -> (Vec<Pair>, Vec<Pair>) {
     (added, removed)
 }
 
-/// The pairs of `a` and `b` as sorted sets are equal (a test helper: the structures list
-/// pairs in different orders).
-#[cfg(test)]
-fn same_pairs(a: &[Pair], b: &[Pair]) -> bool {
-    let mut a = a.to_vec();
-    a.sort_unstable();
-    let (added, removed) = changes_since(&a, b);
-    added.is_empty() && removed.is_empty()
-}
-
 #[cfg(test)]
 #[path = "adaptive_tests.rs"]
 mod tests;

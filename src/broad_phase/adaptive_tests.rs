@@ -12,6 +12,27 @@ fn row_box(i: u32, step: u32) -> Aabb {
     Aabb::from_center_half_extents(c, Vec3::splat(0.5))
 }
 
+/// The pairs of `a` and `b` as sorted sets are equal (the structures list pairs in different
+/// orders).
+fn same_pairs(a: &[Pair], b: &[Pair]) -> bool {
+    let mut a = a.to_vec();
+    a.sort_unstable();
+    let (added, removed) = changes_since(&a, b);
+    added.is_empty() && removed.is_empty()
+}
+
+/// Asserts that `got` reports the same pairs (in any order) and the same changes as `want`;
+/// `context` names the step or case in the failure message.
+fn assert_same_pairs_and_changes(
+    got: &dyn BroadPhase,
+    want: &dyn BroadPhase,
+    context: impl std::fmt::Display,
+) {
+    assert!(same_pairs(got.pairs(), want.pairs()), "{context}");
+    assert_eq!(got.added(), want.added(), "{context}");
+    assert_eq!(got.removed(), want.removed(), "{context}");
+}
+
 #[test]
 fn a_jittering_row_of_2000_falls_back_and_keeps_the_brute_force_pairs_and_changes() {
     let mut adaptive = AdaptiveSweep::new();
@@ -43,9 +64,7 @@ fn a_jittering_row_of_2000_falls_back_and_keeps_the_brute_force_pairs_and_change
         }
         adaptive.commit();
         brute.commit();
-        assert!(same_pairs(adaptive.pairs(), brute.pairs()), "step {step}");
-        assert_eq!(adaptive.added(), brute.added(), "step {step}");
-        assert_eq!(adaptive.removed(), brute.removed(), "step {step}");
+        assert_same_pairs_and_changes(&adaptive, &brute, format_args!("step {step}"));
         let from_scratch = adaptive.is_sorting_from_scratch();
         // The recording's `broad_phase/rebuilt_from_scratch` counter reads this.
         assert_eq!(adaptive.stats().rebuilt, from_scratch, "step {step}");
@@ -87,12 +106,7 @@ fn a_cloud_of_24000_moves_into_regions_and_back_below_10000_with_exact_pairs() {
         }
         adaptive.commit();
         reference.commit();
-        assert!(
-            same_pairs(adaptive.pairs(), reference.pairs()),
-            "step {step}"
-        );
-        assert_eq!(adaptive.added(), reference.added(), "step {step}");
-        assert_eq!(adaptive.removed(), reference.removed(), "step {step}");
+        assert_same_pairs_and_changes(&adaptive, &reference, format_args!("step {step}"));
         assert_eq!(
             adaptive.is_in_regions(),
             live >= 10_000,
@@ -165,12 +179,7 @@ fn a_row_falls_back_at_its_first_commit_iff_it_swapped_twice_the_budget_with_exa
             spent >= 2.0,
             "jitter {amplitude}: {spent} budgets"
         );
-        assert!(
-            same_pairs(adaptive.pairs(), bare.pairs()),
-            "jitter {amplitude}"
-        );
-        assert_eq!(adaptive.added(), bare.added(), "jitter {amplitude}");
-        assert_eq!(adaptive.removed(), bare.removed(), "jitter {amplitude}");
+        assert_same_pairs_and_changes(&adaptive, &bare, format_args!("jitter {amplitude}"));
         assert!(!bare.added().is_empty() && !bare.removed().is_empty());
         outcomes[usize::from(fell_back)] = true;
     }
@@ -225,12 +234,7 @@ fn a_densely_moving_cloud_of_3000_uses_the_regions_until_it_calms_with_exact_pai
             }
             sweep.commit();
         }
-        assert!(
-            same_pairs(adaptive.pairs(), reference.pairs()),
-            "step {step}"
-        );
-        assert_eq!(adaptive.added(), reference.added(), "step {step}");
-        assert_eq!(adaptive.removed(), reference.removed(), "step {step}");
+        assert_same_pairs_and_changes(&adaptive, &reference, format_args!("step {step}"));
         let swaps = bare.stats().endpoint_swaps as f64;
         if step < calm_from {
             let dense = AdaptiveSweep::DENSE_SWAPS_PER_BODY * n as f64;

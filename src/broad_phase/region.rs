@@ -96,12 +96,12 @@ pub(super) struct Region {
     /// appended after a sweep of few (sorted again by the next full sweep, which diffs them).
     pub owned: Vec<Pair>,
     /// Whether pairs were appended to `owned` since it was last sorted.
-    pub owned_unsorted: bool,
+    owned_unsorted: bool,
     /// At least the longest member's length on the sweep axis, rounded up: how far back a
     /// changed member's backward walk must look. Found by the first sweep of few after a full
     /// sweep (`None` until then: full sweeps do not need it); from then on it only grows (a
     /// member that leaves does not lower it), which keeps it an upper bound.
-    pub longest: Option<f32>,
+    longest: Option<f32>,
     /// Queued for this commit's sweep.
     pub dirty: bool,
 }
@@ -172,8 +172,7 @@ impl Entry {
 /// Reusable buffers of the sweeps.
 #[derive(Debug, Default)]
 pub(super) struct SweepScratch {
-    /// Per id, the number of the last region sweep that met it (many changed) or marked it
-    /// changed (few changed).
+    /// Per id, the number of the last full region sweep that met it.
     met: Vec<u32>,
     /// This region sweep's number.
     sweep_number: u32,
@@ -181,8 +180,6 @@ pub(super) struct SweepScratch {
     found: Vec<Pair>,
     /// Owned pairs of changed members (few changed).
     dropped: Vec<Pair>,
-    /// The changed members' new entries (few changed).
-    moved: Vec<Entry>,
     /// The changed ids, each once (few changed).
     ids: Vec<ProxyId>,
     /// Where the changed members' entries are after the move (few changed).
@@ -208,7 +205,6 @@ impl SweepScratch {
     pub fn memory_bytes(&self) -> usize {
         self.met.capacity() * std::mem::size_of::<u32>()
             + (self.found.capacity() + self.dropped.capacity()) * std::mem::size_of::<Pair>()
-            + self.moved.capacity() * std::mem::size_of::<Entry>()
             + self.ids.capacity() * std::mem::size_of::<ProxyId>()
             + self.at.capacity() * std::mem::size_of::<usize>()
     }
@@ -230,6 +226,13 @@ pub(super) struct SweepFrame {
 }
 
 impl Region {
+    /// Gives a free region to `cell`, keeping its buffers. (A region is freed once a sweep left
+    /// it empty, and only a full sweep can: the bounds below are reset for the new cell all
+    /// the same.)
+    pub fn reuse(&mut self, cell: [i32; 3]) {
+        (self.cell, self.longest, self.owned_unsorted) = (cell, None, false);
+    }
+
     /// Asks the cache for what a sweep reads first: the changed ids, the owned pairs and the
     /// members (a line in every 80 bytes of the first 32).
     pub fn prefetch(&self) {
@@ -383,14 +386,12 @@ impl Region {
         axes: [usize; 3],
         scratch: &mut SweepScratch,
     ) -> (u64, f32) {
-        // Tells repeated ids apart.
-        let changed = scratch.next_sweep_number(bodies.id_bound());
-        let (moved, met, ids) = (&mut scratch.moved, &mut scratch.met, &mut scratch.ids);
-        moved.clear();
+        let ids = &mut scratch.ids;
         ids.clear();
         let mut swaps = 0;
         for &id in &self.changed {
-            if std::mem::replace(&mut met[id as usize], changed) == changed {
+            // At most `MAX_FEW` ids: a scan in cache tells repeated ones apart.
+            if ids.contains(&id) {
                 continue;
             }
             ids.push(id);
@@ -400,7 +401,6 @@ impl Region {
                     entry.owner |= FRESH;
                     self.entries[at] = entry;
                     swaps += settle(&mut self.entries, at);
-                    moved.push(entry);
                 }
                 (Some(at), None) => {
                     self.entries.remove(at);
@@ -409,24 +409,24 @@ impl Region {
                     entry.owner |= FRESH;
                     let to = self.entries.partition_point(|e| e.lo < entry.lo);
                     self.entries.insert(to, entry);
-                    moved.push(entry);
                 }
                 (None, None) => {}
             }
         }
-        let longest = match self.longest {
-            Some(longest) => moved
-                .iter()
-                .fold(longest, |m, e| m.max((e.hi - e.lo).next_up())),
-            None => longest_member(&self.entries),
-        };
-        self.longest = Some(longest);
-        // Each moved entry's place (at most `MAX_FEW` scans; a pass over every member for its
-        // fresh mark cost a sparse step 3 % more instructions).
+        // Each changed member's place (at most `MAX_FEW` scans; a pass over every member for its
+        // fresh mark cost a sparse step 3 % more instructions); a departure has none.
         scratch.at.clear();
         let entries = &self.entries;
-        let places = moved.iter().filter_map(|e| find(entries, e.id()));
-        scratch.at.extend(places);
+        scratch
+            .at
+            .extend(ids.iter().filter_map(|&id| find(entries, id)));
+        let longest = match self.longest {
+            Some(longest) => scratch.at.iter().fold(longest, |m, &i| {
+                m.max((entries[i].hi - entries[i].lo).next_up())
+            }),
+            None => longest_member(entries),
+        };
+        self.longest = Some(longest);
         (swaps, longest)
     }
 }

@@ -366,8 +366,7 @@ impl RegionSweep {
         if at as usize == self.regions.len() {
             self.regions.push(Region::default());
         }
-        let region = &mut self.regions[at as usize];
-        (region.cell, region.longest, region.owned_unsorted) = (cell, None, false);
+        self.regions[at as usize].reuse(cell);
         self.cells.insert(cell, at);
         at
     }

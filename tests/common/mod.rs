@@ -152,6 +152,14 @@ pub fn crate_box(app: &mut App, z: f32) -> bevy_ecs::entity::Entity {
         .id()
 }
 
+/// `app` with Earth's gravity along -z and a static ground: the half-space z <= 0.
+pub fn on_ground(mut app: App) -> App {
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    app.world_mut()
+        .spawn((Collider::half_space(Vec3::Z), Static));
+    app
+}
+
 /// An app at 60 Hz, one substep.
 pub fn app() -> App {
     app_with(1.0 / 60.0, 1)

@@ -11,16 +11,9 @@ use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
 use urto::prelude::*;
 
+/// An app on the ground with the default settings, in which sleeping is on.
 fn sleepy_app() -> App {
-    let mut app = common::app();
-    app.insert_resource(Gravity::EARTH_Z_UP)
-        .insert_resource(SleepSettings {
-            enabled: true,
-            ..Default::default()
-        });
-    app.world_mut()
-        .spawn((Collider::half_space(Vec3::Z), Static));
-    app
+    common::on_ground(common::app())
 }
 
 fn asleep(app: &App, e: Entity) -> bool {

@@ -107,9 +107,8 @@ impl Simplex {
         v
     }
 
-    /// Keeps the reduction's vertices with its weights; returns its point.
-    fn reduce(&mut self, r: Reduction) -> DVec3 {
-        let v = self.point_of(&r);
+    /// Keeps the reduction's vertices with its weights.
+    fn reduce(&mut self, r: Reduction) {
         // Read before written: a kept vertex may move to a slot another one is read from.
         // (Spelled out per count: a gathered array of three went through `memcpy`.)
         let [i, j, k] = r.ids;
@@ -123,7 +122,6 @@ impl Simplex {
         }
         self.weights[..3].copy_from_slice(&r.weights);
         self.len = r.len;
-        v
     }
 
     /// The weighted sum of the vertices' A points and B points: the closest points' witnesses.
@@ -137,16 +135,17 @@ impl Simplex {
         (pa, pb)
     }
 
-    /// Reduces the simplex to the vertices supporting its point closest to the origin and
-    /// returns that point; `None` when a tetrahedron encloses the origin.
-    fn closest(&mut self) -> Option<DVec3> {
+    /// The simplex's point closest to the origin and the vertices supporting it (the simplex
+    /// untouched: GJK keeps it as it is when the point makes no progress); `None` when a
+    /// tetrahedron encloses the origin.
+    fn closest(&self) -> Option<(Reduction, DVec3)> {
         let r = match self.len {
             1 => Reduction::one(0),
             2 => self.on_segment(0, 1),
             3 => self.on_triangle(0, 1, 2),
-            _ => self.on_tetrahedron()?,
+            _ => return self.on_tetrahedron(),
         };
-        Some(self.reduce(r))
+        Some((r, self.point_of(&r)))
     }
 
     fn on_segment(&self, i: usize, j: usize) -> Reduction {
@@ -209,8 +208,8 @@ impl Simplex {
     }
 
     /// The closest of the faces the origin lies beyond (of every face, when the tetrahedron is
-    /// flat); `None` when it is inside all four.
-    fn on_tetrahedron(&self) -> Option<Reduction> {
+    /// flat) and its closest point; `None` when the origin is inside all four.
+    fn on_tetrahedron(&self) -> Option<(Reduction, DVec3)> {
         const FACES: [[usize; 4]; 4] = [[0, 1, 2, 3], [0, 3, 1, 2], [0, 2, 3, 1], [1, 3, 2, 0]];
         let w = self.points.map(|p| p.w);
         // A nearly flat tetrahedron (three support points bunched on a curved rim) cannot tell
@@ -220,8 +219,7 @@ impl Simplex {
             .fold(0.0f64, f64::max);
         let volume6 = (w[1] - w[0]).cross(w[2] - w[0]).dot(w[3] - w[0]).abs();
         let flat = volume6 <= FLAT_VOLUME_FRACTION * longest * longest * longest;
-        let mut best: Option<(f64, Reduction)> = None;
-        let mut outside_any = false;
+        let mut best: Option<(f64, Reduction, DVec3)> = None;
         for [i, j, k, opposite] in FACES {
             let n = (w[j] - w[i]).cross(w[k] - w[i]);
             let origin_side = -n.dot(w[i]);
@@ -229,18 +227,15 @@ impl Simplex {
             // The origin is beyond this face when it is on the side away from the fourth
             // vertex; a flat tetrahedron (both zero) is searched face by face.
             if origin_side * other_side < 0.0 || other_side == 0.0 || flat {
-                outside_any = true;
                 let face = self.on_triangle(i, j, k);
-                let d2 = self.point_of(&face).length_squared();
+                let point = self.point_of(&face);
+                let d2 = point.length_squared();
                 if best.as_ref().is_none_or(|b| d2 < b.0) {
-                    best = Some((d2, face));
+                    best = Some((d2, face, point));
                 }
             }
         }
-        if !outside_any {
-            return None;
-        }
-        Some(best?.1)
+        best.map(|(_, face, point)| (face, point))
     }
 }
 
@@ -277,17 +272,18 @@ pub(crate) fn gjk(a: &ConvexPart, b: &ConvexPart) -> Gjk {
                 break;
             }
         }
-        let before = simplex;
         simplex.push(w);
-        let Some(closest) = simplex.closest() else {
+        let Some((reduction, closest)) = simplex.closest() else {
             return Gjk::Overlapping(simplex);
         };
         let v2 = closest.length_squared();
         if !v2.is_finite() || v2 >= last {
-            // No progress (rounding in a nearly flat simplex): the previous answer stands.
-            simplex = before;
+            // No progress (rounding in a nearly flat simplex): the previous answer stands,
+            // without the new point.
+            simplex.len -= 1;
             break;
         }
+        simplex.reduce(reduction);
         v = closest;
         if v2 <= overlap * overlap {
             return Gjk::Overlapping(simplex);

@@ -58,7 +58,7 @@ pub(crate) enum Core<'a> {
 pub(crate) struct ConvexPart<'a> {
     pub core: Core<'a>,
     pub rounding: f32,
-    pub pose: Isometry,
+    pose: Isometry,
     /// [`ConvexPart::size`], found once: a hull's is a pass over its vertices, and every GJK,
     /// EPA and clip of the query reads it.
     size: f32,
@@ -133,6 +133,8 @@ impl<'a> ConvexPart<'a> {
             rounding,
             pose,
             size: core_size(core) + rounding,
+            // Exactly the identity (not `RelativePose::rotation_free`, which also takes
+            // -IDENTITY): the case checked to give the rotation's bits.
             turned: pose.rotation != glam::Quat::IDENTITY,
         })
     }
