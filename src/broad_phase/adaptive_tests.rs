@@ -274,3 +274,42 @@ fn a_calm_cloud_stays_incremental() {
     assert_eq!(adaptive.fallbacks(), 0);
     assert!(!adaptive.is_sorting_from_scratch());
 }
+
+/// A 40 × 40 net of boxes in one vertical plane (the joint grid's shape), jumping up to 3 m a
+/// step: insertion sort loses and the bodies sort from scratch, where every column of 40
+/// shares its interval on the sweep axis (about 30 box tests per body that find nothing);
+/// after two such commits they move into the regions (a quarter of the tests there). The
+/// pairs and changes stay the brute force's throughout.
+#[test]
+fn a_jumping_net_of_1600_leaves_the_sort_from_scratch_for_the_regions_with_exact_pairs() {
+    let at = |i: u32, step: u32| {
+        let (column, row) = ((i / 40) as f32, (i % 40) as f32);
+        let jump = ((i * 7 + step * 5 + i * step) % 61) as f32 * 0.1 - 3.0;
+        let c = Vec3::new(column, 0.0, row + jump);
+        Aabb::from_center_half_extents(c, Vec3::splat(0.4))
+    };
+    let (mut adaptive, mut brute) = (AdaptiveSweep::new(), BruteForce::new());
+    let bodies: Vec<_> = (0..1600)
+        .map(|i| (i, at(i, 0), BodyKind::Dynamic))
+        .collect();
+    adaptive.insert_bulk(&bodies).unwrap();
+    brute.insert_bulk(&bodies).unwrap();
+    let (mut was_from_scratch, mut dense_sweeps) = (false, 0);
+    for step in 1..=12 {
+        for i in 0..1600 {
+            adaptive.update(i, at(i, step)).unwrap();
+            brute.update(i, at(i, step)).unwrap();
+        }
+        adaptive.commit();
+        brute.commit();
+        assert_same_pairs_and_changes(&adaptive, &brute, format_args!("step {step}"));
+        if adaptive.is_sorting_from_scratch() {
+            was_from_scratch = true;
+            let idle = adaptive.stats().pair_tests as f64 - adaptive.pairs().len() as f64;
+            dense_sweeps += usize::from(idle > AdaptiveSweep::DENSE_TESTS_PER_BODY * 1600.0);
+        }
+    }
+    assert!(was_from_scratch && adaptive.fallbacks() == 1);
+    assert!(dense_sweeps >= 1, "the sweeps from scratch were crowded");
+    assert!(adaptive.is_in_regions());
+}
