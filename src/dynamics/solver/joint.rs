@@ -177,9 +177,11 @@ impl JointConstraint {
             delta_center: bodies.centers[b] - bodies.centers[a],
             point: PointRows::default(),
         };
-        // The bodies have not moved yet.
+        // The bodies have not moved yet. The point rows' `K⁻¹` waits for the packing: a
+        // joint in lanes takes it there, four at a time ([`Self::take_point_mass`] for the
+        // others).
         let start = BodyState::default();
-        c.refresh(&start, &start);
+        c.move_rows(&start, &start);
         c
     }
 
@@ -197,12 +199,23 @@ impl JointConstraint {
     /// Takes the point rows where bodies `sa`, `sb` are now (after their positions moved),
     /// from their motion since the step's start.
     pub(super) fn refresh(&mut self, sa: &BodyState, sb: &BodyState) {
+        self.move_rows(sa, sb);
+        self.take_point_mass();
+    }
+
+    /// The anchors and the separation where bodies `sa`, `sb` are now.
+    fn move_rows(&mut self, sa: &BodyState, sb: &BodyState) {
         let r_a = sa.delta_rotation * self.anchors[0];
         let r_b = sb.delta_rotation * self.anchors[1];
         self.point.anchors = (r_a, r_b);
         self.point.separation =
             self.delta_center + sb.delta_position - sa.delta_position + r_b - r_a;
+    }
+
+    /// The point rows' `K⁻¹` at the anchors as they are.
+    pub(super) fn take_point_mass(&mut self) {
         if self.holds_point {
+            let (r_a, r_b) = self.point.anchors;
             self.point.inverse_mass = inverse_mass(point_mass(&self.masses, r_a, r_b));
         }
     }

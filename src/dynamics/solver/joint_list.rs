@@ -73,6 +73,8 @@ impl JointList {
                 bodies.orientations[joint.b as usize],
             );
             if let Some(mut extra) = JointExtra::prepare(joint, &c.masses, turns) {
+                // The extra rows are held at the point rows' mass.
+                c.take_point_mass();
                 let start = BodyState::default();
                 extra.refresh(&c.masses, (&start, &start), &c.point, &c.impulses);
                 c.extra = Some(self.extras.len() as u32);
@@ -124,7 +126,8 @@ impl JointList {
     }
 
     /// Packs the free ball joints into batches over `bodies` slots (after the carried impulses
-    /// are bounded: the batches take them as they are).
+    /// are bounded: the batches take them as they are); a free ball joint left to be solved
+    /// one at a time (it moves no body) takes its point rows' mass here, a batch in its lanes.
     fn pack(&mut self, bodies: usize) {
         let joints = &self.joints;
         self.batching.pack_by(joints.len(), bodies, |i| {
@@ -134,6 +137,13 @@ impl JointList {
             j.is_free_ball()
                 .then(|| moved.map(|(slot, dynamic)| dynamic.then_some(slot)))
         });
+        for &i in self.batching.one_by_one() {
+            let joint = &mut self.joints[i as usize];
+            if joint.is_free_ball() {
+                joint.take_point_mass();
+            }
+        }
+        let joints = &self.joints;
         self.batching
             .refill(&mut self.batches, |b, members| b.repack(members, joints));
     }
