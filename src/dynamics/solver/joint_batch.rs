@@ -61,14 +61,17 @@ impl JointBatch {
         self.writes =
             [0, 1].map(|k| std::array::from_fn(|l| lanes[l].is_some_and(|j| j.masses.dynamic[k])));
         // Generic gathers, not `&dyn Fn` readers: inlined, they halve a joint step's packing.
-        let vectors = |f: fn(&JointConstraint) -> Vec3| gather_vectors(&lanes, f);
+        let vectors =
+            |f: fn(&JointConstraint) -> Vec3| gather(&lanes, Vec3::ZERO, f, Vec3x4::gather);
+        let matrices =
+            |f: fn(&JointConstraint) -> Mat3| gather(&lanes, Mat3::ZERO, f, Mat3x4::gather);
         self.inverse_mass = [
             vectors(|j| j.masses.inverse_mass[0]),
             vectors(|j| j.masses.inverse_mass[1]),
         ];
         self.inverse_inertia = [
-            gather_matrices(&lanes, |j| j.masses.inverse_inertia[0]),
-            gather_matrices(&lanes, |j| j.masses.inverse_inertia[1]),
+            matrices(|j| j.masses.inverse_inertia[0]),
+            matrices(|j| j.masses.inverse_inertia[1]),
         ];
         self.anchors = [vectors(|j| j.anchors[0]), vectors(|j| j.anchors[1])];
         self.delta_center = vectors(|j| j.delta_center);
@@ -165,22 +168,16 @@ fn per_axis(p: Vec3x4, w: Vec3x4) -> Vec3x4 {
     }
 }
 
-/// A vector of each lane's joint (zero in padding lanes), in lanes.
+/// A value `f` reads from each lane's joint (`zero` in padding lanes), laid out in lanes by
+/// `wide`.
 #[inline(always)]
-fn gather_vectors(
+fn gather<T: Copy, W>(
     lanes: &[Option<&JointConstraint>; LANES],
-    f: impl Fn(&JointConstraint) -> Vec3,
-) -> Vec3x4 {
-    Vec3x4::gather(lanes.map(|j| j.map_or(Vec3::ZERO, &f)))
-}
-
-/// A matrix of each lane's joint (zero in padding lanes), in lanes.
-#[inline(always)]
-fn gather_matrices(
-    lanes: &[Option<&JointConstraint>; LANES],
-    f: impl Fn(&JointConstraint) -> Mat3,
-) -> Mat3x4 {
-    Mat3x4::gather(lanes.map(|j| j.map_or(Mat3::ZERO, &f)))
+    zero: T,
+    f: impl Fn(&JointConstraint) -> T,
+    wide: impl Fn([T; LANES]) -> W,
+) -> W {
+    wide(lanes.map(|j| j.map_or(zero, &f)))
 }
 
 #[cfg(test)]
