@@ -39,7 +39,10 @@
 //! hanging in one vertical plane, as the joint grid's net of 10,000 balls, share their
 //! intervals column by column on either axis of the plane (49 idle tests a body): in the
 //! regions the net's broad phase takes 10 million instructions a step instead of 16.6
-//! (`valgrind --tool=callgrind`; the 10k cloud, mixed sizes and the row make under one). Measured
+//! (`valgrind --tool=callgrind`; the 10k cloud, mixed sizes and the row make under one).
+//! Such a scene probes back like dense motion: every [`AdaptiveSweep::PROBE_PERIOD`] commits
+//! it costs one losing incremental commit and two sweeps from scratch (one more fallback
+//! counted each time). Idle tests count static pairs too, which the regions test as well. Measured
 //! in one run of `peers/benches/broad_phase.rs` (swaps per body per commit: SAP time →
 //! segmented time): the 10k cloud 58: 2.48 → 1.75–1.81 ms (two runs), 10k boxes of mixed sizes 34: 1.98 →
 //! 1.96 ms, the 1k cloud 12: 0.135 → 0.127 ms; and 10,000 balls flying in a box

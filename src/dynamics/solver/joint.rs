@@ -140,7 +140,8 @@ pub struct JointConstraint {
     pub(super) anchors: [Vec3; 2],
     /// `c_b − c_a` at the step's start.
     pub(super) delta_center: Vec3,
-    /// The point rows where the bodies are now ([`Self::refresh`]).
+    /// The point rows where the bodies are now ([`Self::refresh`]); a joint solved in lanes
+    /// keeps its `K⁻¹` in its batch, not here.
     pub(super) point: PointRows,
 }
 
@@ -152,7 +153,9 @@ pub(super) struct PointRows {
     /// Anchor to anchor, `c_b + r_b − c_a − r_a`.
     pub separation: Vec3,
     /// The point rows' `K⁻¹` (taken where the anchors are, as Box2D does: a step-start one
-    /// overshot on a fast-swinging chain and diverged); zero for joints without point rows.
+    /// overshot on a fast-swinging chain and diverged), for joints solved one at a time; not
+    /// taken (the default) for joints without point rows and for joints in lanes, whose
+    /// batches take theirs.
     pub inverse_mass: Mat3,
 }
 
@@ -178,8 +181,7 @@ impl JointConstraint {
             point: PointRows::default(),
         };
         // The bodies have not moved yet. The point rows' `K⁻¹` waits for the packing: a
-        // joint in lanes takes it there, four at a time ([`Self::take_point_mass`] for the
-        // others).
+        // joint in lanes takes it there, four at a time (`take_point_mass` for the others).
         let start = BodyState::default();
         c.move_rows(&start, &start);
         c

@@ -127,7 +127,8 @@ impl JointList {
 
     /// Packs the free ball joints into batches over `bodies` slots (after the carried impulses
     /// are bounded: the batches take them as they are); a free ball joint left to be solved
-    /// one at a time (it moves no body) takes its point rows' mass here, a batch in its lanes.
+    /// one at a time (it moves no dynamic body) takes its point rows' mass here (zero, but the
+    /// default is not), a batch in its lanes.
     fn pack(&mut self, bodies: usize) {
         let joints = &self.joints;
         self.batching.pack_by(joints.len(), bodies, |i| {
@@ -248,6 +249,12 @@ impl JointList {
         }
         let bodies = self.batching.bodies();
         self.pack(bodies);
+    }
+
+    /// The batches, and the joints solved one at a time.
+    #[cfg(test)]
+    pub(super) fn packing(&self) -> (&[JointBatch], &[u32]) {
+        (&self.batches, self.batching.one_by_one())
     }
 
     /// How many joints ride in lanes next to another.
