@@ -56,6 +56,9 @@ impl JointList {
         let n = bodies.len() as u32;
         self.joints.clear();
         self.extras.clear();
+        // Where the next joint's kept impulses should be: the joints come in key order, as
+        // the cache is kept, so each is found in one read (a binary search otherwise).
+        let mut next_kept = 0;
         for joint in inputs {
             let usable = joint.frame_a.is_usable()
                 && joint.frame_b.is_usable()
@@ -64,9 +67,14 @@ impl JointList {
                 continue;
             }
             let mut c = JointConstraint::prepare(joint, bodies);
-            if let Ok(i) = self.cache.binary_search_by_key(&joint.key, |e| e.0) {
+            let kept = match self.cache.get(next_kept) {
+                Some(e) if e.0 == joint.key => Ok(next_kept),
+                _ => self.cache.binary_search_by_key(&joint.key, |e| e.0),
+            };
+            if let Ok(i) = kept {
                 c.impulses = self.cache[i].1;
                 c.impulses.keep_rows_of(&joint.kind);
+                next_kept = i + 1;
             }
             let turns = (
                 bodies.orientations[joint.a as usize],
