@@ -21,6 +21,14 @@ fn same_pairs(a: &[Pair], b: &[Pair]) -> bool {
     added.is_empty() && removed.is_empty()
 }
 
+/// Inserts `n` dynamic boxes, box `i` at `at(i)`, into each of `sweeps`.
+fn fill<const K: usize>(n: u32, at: impl Fn(u32) -> Aabb, sweeps: [&mut dyn BroadPhase; K]) {
+    let bodies: Vec<_> = (0..n).map(|i| (i, at(i), BodyKind::Dynamic)).collect();
+    for sweep in sweeps {
+        sweep.insert_bulk(&bodies).unwrap();
+    }
+}
+
 /// Asserts that `got` reports the same pairs (in any order) and the same changes as `want`;
 /// `context` names the step or case in the failure message.
 fn assert_same_pairs_and_changes(
@@ -37,11 +45,7 @@ fn assert_same_pairs_and_changes(
 fn a_jittering_row_of_2000_falls_back_and_keeps_the_brute_force_pairs_and_changes() {
     let mut adaptive = AdaptiveSweep::new();
     let mut brute = BruteForce::new();
-    let bodies: Vec<_> = (0..2000)
-        .map(|i| (i, row_box(i, 0), BodyKind::Dynamic))
-        .collect();
-    adaptive.insert_bulk(&bodies).unwrap();
-    brute.insert_bulk(&bodies).unwrap();
+    fill(2000, |i| row_box(i, 0), [&mut adaptive, &mut brute]);
     let mut was_from_scratch = false;
     for step in 1..=(AdaptiveSweep::PROBE_PERIOD + 10) {
         // Body 5 leaves every seventh step and comes back the next, so the changes are
@@ -84,11 +88,7 @@ fn a_cloud_of_24000_moves_into_regions_and_back_below_10000_with_exact_pairs() {
         Aabb::from_center_half_extents(c, Vec3::splat(0.5))
     };
     let (mut adaptive, mut reference) = (AdaptiveSweep::new(), SortAndSweep::new());
-    let bodies: Vec<_> = (0..24_000)
-        .map(|i| (i, at(i, 0), BodyKind::Dynamic))
-        .collect();
-    adaptive.insert_bulk(&bodies).unwrap();
-    reference.insert_bulk(&bodies).unwrap();
+    fill(24_000, |i| at(i, 0), [&mut adaptive, &mut reference]);
     let mut live: u32 = 24_000;
     for step in 1..=12 {
         if step > 6 {
@@ -120,10 +120,7 @@ fn a_cloud_of_24000_moves_into_regions_and_back_below_10000_with_exact_pairs() {
 #[test]
 fn a_jittering_row_falls_back_within_3_steps_with_an_empty_commit_between_steps() {
     let mut adaptive = AdaptiveSweep::new();
-    let bodies: Vec<_> = (0..2000)
-        .map(|i| (i, row_box(i, 0), BodyKind::Dynamic))
-        .collect();
-    adaptive.insert_bulk(&bodies).unwrap();
+    fill(2000, |i| row_box(i, 0), [&mut adaptive]);
     adaptive.commit();
     for step in 1..=3 {
         for i in 0..2000 {
@@ -155,11 +152,9 @@ fn a_row_falls_back_at_its_first_commit_iff_it_swapped_twice_the_budget_with_exa
     let budget = AdaptiveSweep::SWAPS_PER_SORT_UNIT * n as f64 * (n as f64).log2();
     let mut outcomes = [false, false];
     for amplitude in [0.0, 1e-4, 3e-4, 1e-3, 4e-3, 0.02] {
-        let bodies: Vec<_> = (0..n).map(|i| (i, at(i, 0.0), BodyKind::Dynamic)).collect();
         let mut adaptive = AdaptiveSweep::new();
         let mut bare: IncrementalSap = IncrementalSap::default();
-        adaptive.insert_bulk(&bodies).unwrap();
-        bare.insert_bulk(&bodies).unwrap();
+        fill(n, |i| at(i, 0.0), [&mut adaptive, &mut bare]);
         adaptive.commit();
         bare.commit();
         for i in 1..n {
@@ -207,17 +202,18 @@ fn a_densely_moving_cloud_of_3000_uses_the_regions_until_it_calms_with_exact_pai
         );
         Aabb::from_center_half_extents(base + (shake - 0.5) * jitter, Vec3::splat(0.5))
     };
-    let bodies: Vec<_> = (0..n)
-        .map(|i| (i, at(i, 0, 0.2), BodyKind::Dynamic))
-        .collect();
     let (mut adaptive, mut reference) = (AdaptiveSweep::new(), SortAndSweep::new());
     let mut bare: IncrementalSap = IncrementalSap::default();
+    fill(
+        n,
+        |i| at(i, 0, 0.2),
+        [&mut adaptive, &mut reference, &mut bare],
+    );
     for sweep in [
         &mut adaptive as &mut dyn BroadPhase,
         &mut reference,
         &mut bare,
     ] {
-        sweep.insert_bulk(&bodies).unwrap();
         sweep.commit();
     }
     let budget = AdaptiveSweep::swap_budget(n as usize);
@@ -261,10 +257,7 @@ fn a_calm_cloud_stays_incremental() {
         let c = c + Vec3::X * 0.001 * ((i + step) % 5) as f32;
         Aabb::from_center_half_extents(c, Vec3::splat(0.5))
     };
-    let bodies: Vec<_> = (0..2700)
-        .map(|i| (i, at(i, 0), BodyKind::Dynamic))
-        .collect();
-    adaptive.insert_bulk(&bodies).unwrap();
+    fill(2700, |i| at(i, 0), [&mut adaptive]);
     for step in 1..60 {
         for i in 0..2700 {
             adaptive.update(i, at(i, step)).unwrap();
@@ -289,11 +282,7 @@ fn a_jumping_net_of_1600_leaves_the_sort_from_scratch_for_the_regions_with_exact
         Aabb::from_center_half_extents(c, Vec3::splat(0.4))
     };
     let (mut adaptive, mut brute) = (AdaptiveSweep::new(), BruteForce::new());
-    let bodies: Vec<_> = (0..1600)
-        .map(|i| (i, at(i, 0), BodyKind::Dynamic))
-        .collect();
-    adaptive.insert_bulk(&bodies).unwrap();
-    brute.insert_bulk(&bodies).unwrap();
+    fill(1600, |i| at(i, 0), [&mut adaptive, &mut brute]);
     let (mut was_from_scratch, mut dense_sweeps) = (false, 0);
     for step in 1..=12 {
         for i in 0..1600 {

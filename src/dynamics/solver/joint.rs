@@ -146,17 +146,28 @@ pub struct JointConstraint {
 }
 
 /// A joint's anchors where the bodies are now, and the point rows' effective mass there.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct PointRows {
     /// `r_a`, `r_b`: the anchors from the centres of mass (world).
     pub anchors: (Vec3, Vec3),
     /// Anchor to anchor, `c_b + r_b − c_a − r_a`.
     pub separation: Vec3,
     /// The point rows' `K⁻¹` (taken where the anchors are, as Box2D does: a step-start one
-    /// overshot on a fast-swinging chain and diverged), for joints solved one at a time; not
-    /// taken (the default) for joints without point rows and for joints in lanes, whose
-    /// batches take theirs.
+    /// overshot on a fast-swinging chain and diverged), for joints solved one at a time; zero
+    /// until taken: for joints without point rows, for joints in lanes (their batches take
+    /// theirs), and for a free ball joint that moves no dynamic body (whose `K` is zero).
     pub inverse_mass: Mat3,
+}
+
+impl Default for PointRows {
+    /// No anchors, and a zero `K⁻¹` (glam's default matrix is the identity, which would push).
+    fn default() -> Self {
+        Self {
+            anchors: (Vec3::ZERO, Vec3::ZERO),
+            separation: Vec3::ZERO,
+            inverse_mass: Mat3::ZERO,
+        }
+    }
 }
 
 impl JointConstraint {

@@ -285,8 +285,8 @@ mod tests {
 
     /// Every joint's point rows' `K⁻¹` is taken before the step's first pass: in the lanes for
     /// the batched free ball joints (within 1e-5 of the scalar formula), and the scalar one
-    /// exactly for those solved one at a time (a limited ball joint, a ball joint between two
-    /// static bodies, whose `K⁻¹` is zero where the default is the identity).
+    /// exactly for those solved one at a time (a limited ball joint, and a ball joint between
+    /// two static bodies, whose `K⁻¹` is zero).
     #[test]
     fn every_point_mass_is_taken_at_prepare_in_lanes_within_1e_5_and_one_at_a_time_exactly() {
         let (mut bodies, mut inputs) = net(3);

@@ -134,9 +134,9 @@ impl JointList {
     }
 
     /// Packs the free ball joints into batches over `bodies` slots (after the carried impulses
-    /// are bounded: the batches take them as they are); a free ball joint left to be solved
-    /// one at a time (it moves no dynamic body) takes its point rows' mass here (zero, but the
-    /// default is not), a batch in its lanes.
+    /// are bounded: the batches take them as they are), each batch taking its point rows' mass
+    /// in its lanes. A free ball joint left to be solved one at a time moves no dynamic body:
+    /// its `K⁻¹` is the zero it starts with.
     fn pack(&mut self, bodies: usize) {
         let joints = &self.joints;
         self.batching.pack_by(joints.len(), bodies, |i| {
@@ -146,13 +146,6 @@ impl JointList {
             j.is_free_ball()
                 .then(|| moved.map(|(slot, dynamic)| dynamic.then_some(slot)))
         });
-        for &i in self.batching.one_by_one() {
-            let joint = &mut self.joints[i as usize];
-            if joint.is_free_ball() {
-                joint.take_point_mass();
-            }
-        }
-        let joints = &self.joints;
         self.batching
             .refill(&mut self.batches, |b, members| b.repack(members, joints));
     }
