@@ -108,7 +108,7 @@ pub use settings::{ContactSettings, Gravity, Integration, PhysicsTimestep, Setti
 pub mod prelude {
     pub use crate::components::*;
     pub use crate::dynamics::Integrator;
-    pub use crate::dynamics::solver::SoftStepSettings;
+    pub use crate::dynamics::solver::{FrictionModel, SoftStepSettings};
     pub use crate::plugins::{
         CollisionEnd, CollisionEnded, CollisionEventsEnabled, CollisionStart, CollisionStarted,
         ContactData, PointProjection, RayHit, SoftStepPlugin, SpatialQuery, SpatialQueryFilter,

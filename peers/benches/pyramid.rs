@@ -22,7 +22,7 @@ use criterion::{
 use glam::{Quat, Vec3};
 use rapier3d::prelude as rp;
 use std::time::Duration;
-use urto::dynamics::solver::SoftStepSettings;
+use urto::dynamics::solver::{FrictionModel, SoftStepSettings};
 use urto::prelude::*;
 
 #[path = "common/fresh_runs.rs"]
@@ -90,19 +90,39 @@ struct Urto {
     bodies: Vec<bevy_ecs::entity::Entity>,
 }
 
-/// urto's defaults (sleeping by islands), the same awake, and awake with one relax pass per
-/// substep (Box2D's count) to show what the default's second pass costs: `(label, relax
-/// passes, sleeping)`.
-const URTO_VARIANTS: [(&str, u32, bool); 3] = [
-    ("urto", 2, true),
-    ("urto (no sleep)", 2, false),
-    ("urto (no sleep, relax 1)", 1, false),
+/// urto's defaults (sleeping by islands), the same awake, awake with one relax pass per
+/// substep (Box2D's count) to show what the default's second pass costs, and awake with
+/// friction per patch (rapier's friction model: three friction rows a contact instead of
+/// eight), with two relax passes and with one (rapier's work per substep): `(label, relax
+/// passes, sleeping, friction)`.
+const URTO_VARIANTS: [(&str, u32, bool, FrictionModel); 5] = [
+    ("urto", 2, true, FrictionModel::PerPoint),
+    ("urto (no sleep)", 2, false, FrictionModel::PerPoint),
+    (
+        "urto (no sleep, relax 1)",
+        1,
+        false,
+        FrictionModel::PerPoint,
+    ),
+    ("urto (no sleep, patch)", 2, false, FrictionModel::Patch),
+    (
+        "urto (no sleep, patch, relax 1)",
+        1,
+        false,
+        FrictionModel::Patch,
+    ),
 ];
 
 impl Urto {
-    fn new(start: &[Vec3], relax_iterations: u32, can_sleep: bool) -> Self {
+    fn new(
+        start: &[Vec3],
+        relax_iterations: u32,
+        can_sleep: bool,
+        friction: FrictionModel,
+    ) -> Self {
         let settings = SoftStepSettings {
             relax_iterations,
+            friction,
             ..Default::default()
         };
         let mut app = App::new();
@@ -236,8 +256,8 @@ fn bench_pyramid(c: &mut Criterion) {
     let n = start.len();
 
     let mut default_run = None;
-    for (label, relax, can_sleep) in URTO_VARIANTS {
-        let mut v = Urto::new(&start, relax, can_sleep);
+    for (label, relax, can_sleep, friction) in URTO_VARIANTS {
+        let mut v = Urto::new(&start, relax, can_sleep, friction);
         let all_asleep_at = run_watching_sleep(&mut v, |u| u.step(1), Urto::asleep, n);
         let (drift, sag) = quality(&start, &v.positions());
         let turned = {
@@ -284,12 +304,12 @@ fn bench_pyramid(c: &mut Criterion) {
         .sampling_mode(SamplingMode::Flat)
         .measurement_time(Duration::from_secs(10))
         .throughput(Throughput::Elements(u64::from(STEPS)));
-    for (label, relax, can_sleep) in URTO_VARIANTS {
+    for (label, relax, can_sleep, friction) in URTO_VARIANTS {
         group.bench_function(BenchmarkId::new(label, n), |b| {
             b.iter_custom(|iters| {
                 timed(
                     iters,
-                    || Urto::new(&start, relax, can_sleep),
+                    || Urto::new(&start, relax, can_sleep, friction),
                     |u| u.step(STEPS),
                 )
             })

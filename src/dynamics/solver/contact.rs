@@ -29,9 +29,11 @@
 //! pass solves again without bias, removing the velocity the push-out added, and friction
 //! (Coulomb, both tangent rows clamped together to the disc `μ λ_n`) is solved in the relax
 //! pass only, as Box2D does: friction in the biased pass fights the push-out and lets stacks
-//! creep.
+//! creep. Under [`FrictionModel::Patch`] the points carry no friction rows: the contact's
+//! [`PatchFriction`] (two rows at the points' centre and a twist) takes their place.
 
 use super::body::{BodyParams, BodyState, same_on_every_axis};
+use super::patch_friction::{FrictionModel, PatchFriction};
 use super::rolling::RollingRows;
 use super::softness::Softness;
 use crate::geometry::MAX_MANIFOLD_POINTS;
@@ -135,6 +137,9 @@ pub struct ContactConstraint {
     pub dynamic: [bool; 2],
     /// The rolling-resistance rows (none unless the pair has a lever arm).
     pub rolling: RollingRows,
+    /// The friction rows of the whole patch under [`FrictionModel::Patch`] (the points' own
+    /// tangent rows are then zero and unused).
+    pub patch: Option<PatchFriction>,
     /// How fast the external accelerations (gravity, forces) close the gap along the normal:
     /// `(a_b − a_a)·n` (m/s²), to carry a speculative point's approach speed on to the moment
     /// it touches.
@@ -160,7 +165,7 @@ impl RowPart {
     /// The row along `dir` at anchors `ra`, `rb`; `linear` is its translational part
     /// `d·W_a d + d·W_b d` (the same for every point of a contact, so computed once).
     #[inline]
-    fn new(
+    pub(super) fn new(
         pa: &BodyParams,
         pb: &BodyParams,
         ra: Vec3,
@@ -212,13 +217,14 @@ fn point_velocity(s: &BodyState, r: Vec3) -> Vec3 {
 }
 
 impl ContactConstraint {
-    /// Builds the rows from detection data at the step's start (`centers`: centres of mass).
+    /// Builds the rows from detection data at the step's start (`centers`: centres of mass),
+    /// with friction rows per point or per patch as `model` says.
     pub fn prepare(
         input: &ContactInput,
         centers: &[Vec3],
         states: &[BodyState],
         params: &[BodyParams],
-        softness: Softness,
+        (softness, model): (Softness, FrictionModel),
     ) -> Self {
         let mut c = Self {
             a: 0,
@@ -236,9 +242,10 @@ impl ContactConstraint {
             translation_locked: false,
             dynamic: [false; 2],
             rolling: RollingRows::default(),
+            patch: None,
             closing_acceleration: 0.0,
         };
-        c.refill(input, centers, states, params, softness);
+        c.refill(input, centers, states, params, (softness, model));
         c
     }
 
@@ -254,7 +261,7 @@ impl ContactConstraint {
         centers: &[Vec3],
         states: &[BodyState],
         params: &[BodyParams],
-        softness: Softness,
+        (softness, model): (Softness, FrictionModel),
     ) {
         let (ia, ib) = (input.a as usize, input.b as usize);
         let (pa, pb) = (&params[ia], &params[ib]);
@@ -270,6 +277,7 @@ impl ContactConstraint {
         let along = |d: Vec3| (d, if uniform { w.x } else { w.dot(d * d) });
         let (normal, sides) = (along(n), tangents.map(along));
         let count = (input.count as usize).min(MAX_MANIFOLD_POINTS);
+        let per_point = model == FrictionModel::PerPoint;
         for (cp, p) in self.points.iter_mut().zip(&input.points[..count]) {
             let ra = p.point - centers[ia];
             let rb = p.point - centers[ib];
@@ -279,7 +287,11 @@ impl ContactConstraint {
                 anchor_b: rb,
                 base_separation: p.separation - (rb - ra).dot(n),
                 normal_row: RowPart::new(pa, pb, ra, rb, normal),
-                tangent_rows: sides.map(|t| RowPart::new(pa, pb, ra, rb, t)),
+                tangent_rows: if per_point {
+                    sides.map(|t| RowPart::new(pa, pb, ra, rb, t))
+                } else {
+                    [RowPart::default(); 2]
+                },
                 relative_velocity: relative.dot(n),
                 ..Default::default()
             };
@@ -304,6 +316,16 @@ impl ContactConstraint {
             tangents,
             [pa.inverse_inertia, pb.inverse_inertia],
         );
+        self.patch = (!per_point && count > 0).then(|| {
+            let points = input.points.map(|p| p.point);
+            PatchFriction::new(
+                [pa, pb],
+                &points[..count],
+                [centers[ia], centers[ib]],
+                n,
+                sides,
+            )
+        });
     }
 
     /// The used points.
@@ -317,14 +339,23 @@ impl ContactConstraint {
         let mut pair = Pair::load(self, states);
         for cp in self.points() {
             pair.push(self, self.normal, &cp.normal_row, cp.normal_impulse);
-            for k in 0..2 {
-                pair.push(
-                    self,
-                    self.tangents[k],
-                    &cp.tangent_rows[k],
-                    cp.tangent_impulse[k],
-                );
+            if self.patch.is_none() {
+                for k in 0..2 {
+                    pair.push(
+                        self,
+                        self.tangents[k],
+                        &cp.tangent_rows[k],
+                        cp.tangent_impulse[k],
+                    );
+                }
             }
+        }
+        if let Some(patch) = &self.patch {
+            for k in 0..2 {
+                let (t, row) = (self.tangents[k], &patch.tangent_rows[k]);
+                pair.push(self, t, row, patch.tangent_impulse[k]);
+            }
+            pair.twist(patch, patch.twist_impulse);
         }
         if self.rolling.arm > 0.0 {
             let Pair { wa, wb, .. } = &mut pair;
@@ -384,31 +415,13 @@ impl ContactConstraint {
             cp.max_normal_impulse = cp.max_normal_impulse.max(total);
         }
         if !use_bias && self.friction > 0.0 {
-            let (t0, t1) = (self.tangents[0], self.tangents[1]);
-            let masses = (self.inverse_mass, self.friction);
-            for cp in &mut self.points[..count] {
-                let [old0, old1] = cp.tangent_impulse;
-                if cp.normal_impulse == 0.0 && old0 == 0.0 && old1 == 0.0 {
-                    // No normal force, no friction held: the row would change nothing (a
-                    // speculative point still apart, as between a pyramid's side neighbours).
-                    continue;
-                }
-                let [r0, r1] = &cp.tangent_rows;
-                // Written out, not `[0, 1].map(..)`: the array map's drain was a tenth of the
-                // solver's instructions (callgrind).
-                let w0 = old0 - r0.mass * pair.along(t0, r0);
-                let w1 = old1 - r1.mass * pair.along(t1, r1);
-                let limit = masses.1 * cp.normal_impulse;
-                let length = (w0 * w0 + w1 * w1).sqrt();
-                let scale = if length > limit && length > 0.0 {
-                    limit / length
-                } else {
-                    1.0
-                };
-                let (new0, new1) = (w0 * scale, w1 * scale);
-                pair.push_with(masses.0, t0, r0, new0 - old0);
-                pair.push_with(masses.0, t1, r1, new1 - old1);
-                cp.tangent_impulse = [new0, new1];
+            if let Some(patch) = &mut self.patch {
+                let normal = self.points[..count].iter().map(|p| p.normal_impulse);
+                let limits = patch.limits(self.friction, normal);
+                let directions = (self.normal, self.tangents);
+                pair.solve_patch(patch, limits, directions, self.inverse_mass);
+            } else {
+                self.solve_point_friction(&mut pair);
             }
         }
         if !use_bias && self.rolling.arm > 0.0 {
@@ -417,6 +430,26 @@ impl ContactConstraint {
             self.rolling.solve(wa, wb, self.tangents, normal);
         }
         pair.store(self, states);
+    }
+
+    /// Coulomb friction at each point: both tangent rows clamped together to the disc
+    /// `μ λ_n` of the point's own normal impulse.
+    fn solve_point_friction(&mut self, pair: &mut Pair) {
+        for cp in &mut self.points[..self.count as usize] {
+            let [old0, old1] = cp.tangent_impulse;
+            if cp.normal_impulse == 0.0 && old0 == 0.0 && old1 == 0.0 {
+                // No normal force, no friction held: the row would change nothing (a
+                // speculative point still apart, as between a pyramid's side neighbours).
+                continue;
+            }
+            let limit = self.friction * cp.normal_impulse;
+            cp.tangent_impulse = pair.solve_disc(
+                &cp.tangent_rows,
+                self.tangents,
+                cp.tangent_impulse,
+                (limit, self.inverse_mass),
+            );
+        }
     }
 
     /// After the substeps: points that approached faster than `threshold` and pushed get the
@@ -482,6 +515,60 @@ impl Pair {
         self.wb += row.turn[1] * lambda;
     }
 
+    /// Two tangent rows clamped together to the disc `|λ| ≤ limit` (Coulomb friction, at a
+    /// point or a patch centre): the new accumulated impulses from the `old` ones.
+    fn solve_disc(
+        &mut self,
+        [r0, r1]: &[RowPart; 2],
+        [t0, t1]: [Vec3; 2],
+        [old0, old1]: [f32; 2],
+        (limit, inverse_mass): (f32, [Vec3; 2]),
+    ) -> [f32; 2] {
+        // Written out, not `[0, 1].map(..)`: the array map's drain was a tenth of the
+        // solver's instructions (callgrind).
+        let w0 = old0 - r0.mass * self.along(t0, r0);
+        let w1 = old1 - r1.mass * self.along(t1, r1);
+        let length = (w0 * w0 + w1 * w1).sqrt();
+        let scale = if length > limit && length > 0.0 {
+            limit / length
+        } else {
+            1.0
+        };
+        let (new0, new1) = (w0 * scale, w1 * scale);
+        self.push_with(inverse_mass, t0, r0, new0 - old0);
+        self.push_with(inverse_mass, t1, r1, new1 - old1);
+        [new0, new1]
+    }
+
+    /// A patch's friction ([`PatchFriction`]): the twist about the normal `n`, then the
+    /// tangent disc at the centre, within `(μ Σλ_i, μ Σλ_i d_i)`.
+    fn solve_patch(
+        &mut self,
+        patch: &mut PatchFriction,
+        (limit, twist_limit): (f32, f32),
+        (n, tangents): (Vec3, [Vec3; 2]),
+        inverse_mass: [Vec3; 2],
+    ) {
+        let old = patch.twist_impulse;
+        if limit == 0.0 && old == 0.0 && patch.tangent_impulse == [0.0; 2] {
+            // No normal force, no friction held (a speculative contact still apart).
+            return;
+        }
+        let wanted = old - patch.twist_mass * n.dot(self.wb - self.wa);
+        let twist = wanted.max(-twist_limit).min(twist_limit);
+        self.twist(patch, twist - old);
+        patch.twist_impulse = twist;
+        let rows = &patch.tangent_rows;
+        patch.tangent_impulse =
+            self.solve_disc(rows, tangents, patch.tangent_impulse, (limit, inverse_mass));
+    }
+
+    /// An angular impulse `λ n` on B, `−λ n` on A (the twist row).
+    fn twist(&mut self, patch: &PatchFriction, lambda: f32) {
+        self.wa -= patch.twist_turn[0] * lambda;
+        self.wb += patch.twist_turn[1] * lambda;
+    }
+
     fn store(self, c: &ContactConstraint, states: &mut [BodyState]) {
         if c.dynamic[0] {
             let s = &mut states[c.a as usize];
@@ -544,7 +631,14 @@ mod tests {
             Softness::new(60.0, 10.0, 1.0 / 240.0),
         );
         let prepare = |c: &ContactInput, s| {
-            ContactConstraint::prepare(c, &bodies.centers, &bodies.states, &bodies.params, s)
+            let model = FrictionModel::PerPoint;
+            ContactConstraint::prepare(
+                c,
+                &bodies.centers,
+                &bodies.states,
+                &bodies.params,
+                (s, model),
+            )
         };
         // Last step's constraint: four points with impulses, flipped, rolling.
         let mut reused = prepare(&input(0, 1, 4, 2.0), soft);
@@ -560,7 +654,7 @@ mod tests {
             &bodies.centers,
             &bodies.states,
             &bodies.params,
-            stiff,
+            (stiff, FrictionModel::PerPoint),
         );
         let fresh = prepare(&next, stiff);
         assert_eq!(reused.points(), fresh.points());

@@ -25,7 +25,8 @@
 //!       a dynamic body's speed at most [`SoftStepSettings::max_linear_speed`] and every
 //!       body's turn at most [`SoftStepSettings::max_rotation_per_substep`]; the joints' rows
 //!       are taken again where the bodies now are;
-//!    5. **relax** — passes without bias, friction and rolling resistance included (two over
+//!    5. **relax** — passes without bias, friction (per point, or per patch:
+//!       [`FrictionModel`]) and rolling resistance included (two over
 //!       the contacts and one over the joints by default, see
 //!       [`SoftStepSettings::relax_iterations`] and
 //!       [`SoftStepSettings::joint_relax_iterations`]);
@@ -72,6 +73,7 @@ mod joint_list;
 pub mod joint_rows;
 pub mod lanes;
 pub mod ordered_batches;
+pub mod patch_friction;
 pub mod rolling;
 pub mod softness;
 pub mod warm_start;
@@ -86,6 +88,7 @@ pub use joint::{
     HeldLoad, JointConstraint, JointFrame, JointImpulses, JointInput, JointKind, JointLimit,
     JointMotor,
 };
+pub use patch_friction::FrictionModel;
 pub use rolling::RollingRows;
 pub use softness::Softness;
 pub use warm_start::WarmStartCache;
@@ -153,6 +156,8 @@ pub struct SoftStepSettings {
     pub joint_hertz: f32,
     /// Damping ratio of the joints' error correction (Box2D v3: 2).
     pub joint_damping_ratio: f32,
+    /// Friction rows per contact point or per contact patch ([`FrictionModel`]).
+    pub friction: FrictionModel,
 }
 
 impl Default for SoftStepSettings {
@@ -171,6 +176,7 @@ impl Default for SoftStepSettings {
             max_linear_speed: 400.0,
             joint_hertz: 60.0,
             joint_damping_ratio: 2.0,
+            friction: FrictionModel::default(),
         }
     }
 }
@@ -494,9 +500,9 @@ impl Solver {
         let softness = |c: &ContactInput| {
             let immovable = |i: u32| bodies.params[i as usize].is_immovable();
             if immovable(c.a) || immovable(c.b) {
-                static_soft
+                (static_soft, s.friction)
             } else {
-                soft
+                (soft, s.friction)
             }
         };
         let (centers, states, params) = (&bodies.centers, &bodies.states, &bodies.params);

@@ -154,7 +154,7 @@ impl OrderedBatches {
 mod tests {
     use super::*;
     use crate::dynamics::solver::{
-        BodyInput, ContactInput, ContactPointInput, Softness, SolverBodies,
+        BodyInput, ContactInput, ContactPointInput, FrictionModel, Softness, SolverBodies,
     };
     use glam::{Quat, Vec3};
 
@@ -202,7 +202,7 @@ mod tests {
                     &bodies.centers,
                     &bodies.states,
                     &bodies.params,
-                    softness,
+                    (softness, FrictionModel::PerPoint),
                 );
                 c.points[0].normal_impulse = 0.05;
                 c

@@ -17,6 +17,7 @@ const MARGIN: f32 = 0.02;
 
 mod capsules;
 mod convex;
+mod friction_models;
 mod ghost_edges;
 mod joints;
 mod locked_axes;
@@ -255,9 +256,11 @@ fn stack(scene: &mut Scene, n: usize, half: f32, x: f32) -> Vec<usize> {
 }
 
 /// The largest distance any box of a stack of `n` ends from where it rested after the first
-/// second, over the next `seconds`, and how far the stack sank in that first second.
-fn stack_drift(n: usize, seconds: f32) -> (f32, f32) {
+/// second, over the next `seconds`, and how far the stack sank in that first second, with
+/// friction as `model` says.
+fn stack_drift(n: usize, seconds: f32, model: FrictionModel) -> (f32, f32) {
     let mut scene = Scene::default();
+    scene.solver.settings.friction = model;
     scene.ground(Vec3::Z);
     let boxes = stack(&mut scene, n, 0.5, 0.0);
     let top_start = scene.bodies[*boxes.last().unwrap()].center.z;
@@ -276,7 +279,7 @@ fn stack_drift(n: usize, seconds: f32) -> (f32, f32) {
 
 #[test]
 fn a_stack_of_10_boxes_stands_10_s_with_drift_under_1_cm_and_sags_under_1_cm() {
-    let (drift, sag) = stack_drift(10, 10.0);
+    let (drift, sag) = stack_drift(10, 10.0, FrictionModel::PerPoint);
     eprintln!("10 boxes: drift {drift} m, sag {sag} m");
     assert!(drift < 0.01, "drift {drift} m");
     assert!(sag < 0.01, "sag {sag} m");
@@ -284,7 +287,7 @@ fn a_stack_of_10_boxes_stands_10_s_with_drift_under_1_cm_and_sags_under_1_cm() {
 
 #[test]
 fn a_stack_of_20_boxes_stands_10_s_with_drift_under_1_cm_and_sags_under_4_cm() {
-    let (drift, sag) = stack_drift(20, 10.0);
+    let (drift, sag) = stack_drift(20, 10.0, FrictionModel::PerPoint);
     eprintln!("20 boxes: drift {drift} m, sag {sag} m");
     assert!(drift < 0.01, "drift {drift} m");
     assert!(sag < 0.04, "sag {sag} m");
@@ -325,8 +328,14 @@ fn a_heavy_box_on_a_light_one_holds_within_1_cm_and_moves_under_5_mm_at_100_to_1
 
 #[test]
 fn a_tall_box_pushed_at_its_top_tips_over_and_pushed_at_its_base_slides() {
+    tall_box_pushed(FrictionModel::PerPoint);
+}
+
+/// A tall box pushed high tips over; pushed low, it slides.
+fn tall_box_pushed(model: FrictionModel) {
     for (height, push, tips) in [(1.9f32, 15.0, true), (0.1, 9.0, false)] {
         let mut scene = Scene::default();
+        scene.solver.settings.friction = model;
         scene.ground(Vec3::Z);
         let half = Vec3::new(0.2, 0.2, 1.0);
         let b = scene.add(
@@ -358,10 +367,11 @@ fn a_tall_box_pushed_at_its_top_tips_over_and_pushed_at_its_base_slides() {
 }
 
 /// The largest distance a box of a 20-row pyramid (210 boxes) moved in `seconds`, with
-/// `relax` passes per substep.
-fn pyramid_drift(relax: u32, seconds: f32) -> f32 {
+/// `relax` passes per substep and friction as `model` says.
+fn pyramid_drift(relax: u32, seconds: f32, model: FrictionModel) -> f32 {
     let mut scene = Scene::default();
     scene.solver.settings.relax_iterations = relax;
+    scene.solver.settings.friction = model;
     scene.ground(Vec3::Z);
     let half = 0.25;
     let mut boxes = Vec::new();
@@ -389,7 +399,7 @@ fn pyramid_drift(relax: u32, seconds: f32) -> f32 {
 
 #[test]
 fn a_20_row_pyramid_of_210_boxes_stands_3_s_with_drift_under_1_cm() {
-    let drift = pyramid_drift(2, 3.0);
+    let drift = pyramid_drift(2, 3.0, FrictionModel::PerPoint);
     eprintln!("pyramid: drift {drift} m");
     assert!(drift < 0.01, "drift {drift} m");
 }
@@ -399,7 +409,7 @@ fn a_20_row_pyramid_of_210_boxes_stands_3_s_with_drift_under_1_cm() {
 /// two passes.
 #[test]
 fn a_20_row_pyramid_stands_5_s_with_box2ds_single_relax_pass_drifting_under_3_cm() {
-    let drift = pyramid_drift(1, 5.0);
+    let drift = pyramid_drift(1, 5.0, FrictionModel::PerPoint);
     eprintln!("pyramid, relax 1: drift {drift} m");
     assert!(drift < 0.03, "drift {drift} m");
 }

@@ -7,7 +7,8 @@
 //! the same result on every run), with each point's anchor in A's body frame. A new point takes
 //! the impulses of the nearest old point of the same pair within `match_distance` — the
 //! persistent-manifold rule of Bullet — since the shape tests here report no feature ids; the
-//! friction impulse is kept as a world vector and projected on the new tangents.
+//! friction impulse is kept as a world vector and projected on the new tangents. Under friction
+//! per patch the contact's one friction impulse and its twist are kept the same way, by key.
 
 use super::contact::ContactConstraint;
 use crate::geometry::MAX_MANIFOLD_POINTS;
@@ -28,6 +29,8 @@ struct StoredContact {
     key: u128,
     points: [StoredPoint; MAX_MANIFOLD_POINTS],
     count: u8,
+    /// The patch's friction impulse (world) and twist impulse, under friction per patch.
+    patch: Option<(Vec3, f32)>,
 }
 
 /// The impulses of the last step, by pair key.
@@ -92,6 +95,11 @@ impl WarmStartCache {
                     cp.tangent_impulse = tangents.map(|t| f.dot(t) * scale);
                 }
             }
+            if let (Some(patch), Some((f, twist))) = (&mut c.patch, old.patch) {
+                let f = f - normal * f.dot(normal);
+                patch.tangent_impulse = tangents.map(|t| f.dot(t) * scale);
+                patch.twist_impulse = twist * scale;
+            }
         }
     }
 
@@ -115,10 +123,15 @@ impl WarmStartCache {
                         + c.tangents[1] * cp.tangent_impulse[1],
                 };
             }
+            let patch = c.patch.map(|p| {
+                let [f0, f1] = p.tangent_impulse;
+                (c.tangents[0] * f0 + c.tangents[1] * f1, p.twist_impulse)
+            });
             self.contacts.push(StoredContact {
                 key: c.key,
                 points,
                 count: c.count,
+                patch,
             });
         }
     }
