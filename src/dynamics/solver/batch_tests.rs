@@ -1,0 +1,178 @@
+//! Tests of `batch.rs`.
+
+use super::*;
+use crate::dynamics::solver::{
+    BodyInput, ContactInput, ContactPointInput, FrictionModel, Softness, SolverBodies,
+};
+use glam::Quat;
+
+/// Six moving, turning bodies and three contacts between disjoint pairs, with 4, 2 and 1
+/// points, some apart (speculative) and some penetrating, carrying impulses from a warm
+/// start, with friction rows as `model` says.
+fn scene(model: FrictionModel) -> (SolverBodies, Vec<ContactConstraint>) {
+    let mut bodies = SolverBodies::default();
+    for i in 0..6 {
+        let f = i as f32;
+        bodies.push(BodyInput {
+            center: Vec3::new(f, 0.3 * f, 0.0),
+            orientation: Quat::from_rotation_y(0.2 * f),
+            linear_velocity: Vec3::new(0.5 - f * 0.2, 0.1 * f, -1.0 + 0.3 * f),
+            angular_velocity: Vec3::new(0.7, -0.2 * f, 0.4),
+            inverse_mass: 1.0 / (1.0 + f),
+            inverse_principal_inertia: Vec3::new(2.0, 3.0, 1.0 + f),
+            ..Default::default()
+        });
+    }
+    for (i, s) in bodies.states.iter_mut().enumerate() {
+        s.delta_position = Vec3::new(0.01, -0.02, 0.003 * i as f32);
+        s.delta_rotation = Quat::from_rotation_z(0.01 * i as f32);
+    }
+    let softness = Softness::new(60.0, 10.0, 1.0 / 240.0);
+    let constraints = [(0u32, 1u32, 4u8), (2, 3, 2), (4, 5, 1)]
+        .iter()
+        .enumerate()
+        .map(|(k, &(a, b, count))| {
+            let mut input = ContactInput {
+                a,
+                b,
+                normal: Vec3::new(0.1, 0.2 * k as f32, 1.0).normalize(),
+                friction: 0.6,
+                restitution: 0.0,
+                rolling_resistance: 0.0,
+                points: [ContactPointInput::default(); MAX_MANIFOLD_POINTS],
+                count,
+                key: k as u128,
+            };
+            for (j, p) in input.points.iter_mut().enumerate() {
+                *p = ContactPointInput {
+                    point: Vec3::new(a as f32 + 0.5, 0.2 * j as f32, 0.1 * k as f32),
+                    separation: 0.01 * (j as f32 - 1.5),
+                };
+            }
+            let mut c = ContactConstraint::prepare(
+                &input,
+                &bodies.centers,
+                &bodies.states,
+                &bodies.params,
+                (softness, model),
+            );
+            for (j, p) in c.points.iter_mut().enumerate() {
+                p.normal_impulse = 0.1 * j as f32;
+                p.tangent_impulse = [0.02, -0.01 * j as f32];
+            }
+            if let Some(patch) = &mut c.patch {
+                patch.tangent_impulse = [0.03, -0.02];
+                patch.twist_impulse = 0.01 * k as f32;
+            }
+            c
+        })
+        .collect();
+    (bodies, constraints)
+}
+
+#[test]
+fn a_batch_of_disjoint_contacts_solves_as_the_scalar_rows_do_within_1e_5_with_friction_per_point_and_per_patch()
+ {
+    for model in [FrictionModel::PerPoint, FrictionModel::Patch] {
+        batch_against_scalar(model);
+    }
+}
+
+fn batch_against_scalar(model: FrictionModel) {
+    let (bodies, constraints) = scene(model);
+    let (h, push) = (1.0 / 240.0, 3.0);
+    let mut scalar_states = bodies.states.clone();
+    let mut scalar = constraints.clone();
+    for c in &mut scalar {
+        c.flip = true;
+        c.warm_start(&mut scalar_states);
+        c.solve(&mut scalar_states, 1.0 / h, push, true);
+        c.solve(&mut scalar_states, 1.0 / h, push, false);
+    }
+    let mut batch_states = bodies.states.clone();
+    let mut batched = constraints.clone();
+    let mut batch = ContactBatch::pack(&[0, 1, 2], &constraints).unwrap();
+    assert!(ContactBatch::pack(&[], &constraints).is_none());
+    assert!(ContactBatch::pack(&[0, 1, 2, 0, 1], &constraints).is_none());
+    assert!(ContactBatch::pack(&[0, 7], &constraints).is_none());
+    batch.warm_start(&mut batch_states);
+    batch.solve(&mut batch_states, 1.0 / h, push, true, true);
+    batch.solve(&mut batch_states, 1.0 / h, push, false, true);
+    batch.unpack(&mut batched);
+    for (s, b) in scalar_states.iter().zip(&batch_states) {
+        assert!(
+            (s.linear_velocity - b.linear_velocity).length() < 1e-5,
+            "{s:?} {b:?}"
+        );
+        assert!((s.angular_velocity - b.angular_velocity).length() < 1e-5);
+    }
+    for (s, b) in scalar.iter().zip(&batched) {
+        for (ps, pb) in s.points().iter().zip(b.points()) {
+            assert!(
+                (ps.normal_impulse - pb.normal_impulse).abs() < 1e-5,
+                "{ps:?} {pb:?}"
+            );
+            assert!((ps.tangent_impulse[0] - pb.tangent_impulse[0]).abs() < 1e-5);
+            assert!((ps.tangent_impulse[1] - pb.tangent_impulse[1]).abs() < 1e-5);
+            assert!((ps.relative_velocity - pb.relative_velocity).abs() < 1e-5);
+            assert_eq!(ps.max_normal_impulse > 0.0, pb.max_normal_impulse > 0.0);
+        }
+        assert_eq!(s.patch.is_some(), model == FrictionModel::Patch);
+        if let (Some(ps), Some(pb)) = (s.patch, b.patch) {
+            for k in 0..2 {
+                assert!((ps.tangent_impulse[k] - pb.tangent_impulse[k]).abs() < 1e-5);
+            }
+            assert!(
+                (ps.twist_impulse - pb.twist_impulse).abs() < 1e-5,
+                "{ps:?} {pb:?}"
+            );
+        }
+    }
+    // The friction rows acted: a patch's twist moved off its warm start where its points
+    // pushed apart from the centre.
+    if model == FrictionModel::Patch {
+        let twists = batched
+            .iter()
+            .filter_map(|c| c.patch.map(|p| p.twist_impulse));
+        assert!(twists.zip([0.0, 0.01]).any(|(t, start)| t != start));
+    }
+    // Something happened: the contacts pushed.
+    assert!(
+        batched
+            .iter()
+            .any(|c| c.points().iter().any(|p| p.normal_impulse > 0.0))
+    );
+    assert_ne!(batch_states, bodies.states);
+}
+
+#[test]
+fn a_batch_repacked_over_a_fuller_one_solves_bit_for_bit_as_a_fresh_pack() {
+    // The solver refills last step's batches in place: a batch whose lane 0 held four
+    // points, refilled with contacts of two and one, must leave no trace of the old ones.
+    let (bodies, constraints) = scene(FrictionModel::PerPoint);
+    let solve = |batch: &mut ContactBatch| {
+        let mut states = bodies.states.clone();
+        batch.warm_start(&mut states);
+        batch.solve(&mut states, 240.0, 3.0, true, false);
+        batch.solve(&mut states, 240.0, 3.0, false, true);
+        states
+    };
+    let mut reused = ContactBatch::pack(&[0], &constraints).unwrap();
+    assert!(reused.repack(&[1, 2], &constraints));
+    let mut fresh = ContactBatch::pack(&[1, 2], &constraints).unwrap();
+    assert_eq!(solve(&mut reused), solve(&mut fresh));
+    let unpacked = |batch: &ContactBatch| {
+        let mut out = constraints.clone();
+        batch.unpack(&mut out);
+        out
+    };
+    assert_eq!(unpacked(&reused), unpacked(&fresh));
+    // Three lanes down to one: the lanes left over hold nothing of before.
+    let mut shrunk = ContactBatch::pack(&[0, 1, 2], &constraints).unwrap();
+    assert!(shrunk.repack(&[2], &constraints));
+    let mut single = ContactBatch::pack(&[2], &constraints).unwrap();
+    assert_eq!(solve(&mut shrunk), solve(&mut single));
+    assert_eq!(unpacked(&shrunk), unpacked(&single));
+    // A refused repack says so.
+    assert!(!reused.repack(&[9], &constraints));
+}
