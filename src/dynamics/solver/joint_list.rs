@@ -54,8 +54,9 @@ impl JointList {
     /// The usable joints of `inputs`, seeded with their impulses of the last step.
     fn gather(&mut self, bodies: &SolverBodies, inputs: &[JointInput]) {
         let n = bodies.len() as u32;
-        self.joints.clear();
         self.extras.clear();
+        // Last step's joints are refilled in place; only new places are built.
+        let mut count = 0;
         // Where the next joint's kept impulses should be: the joints come in key order, as
         // the cache is kept, so each is found in one read (a binary search otherwise).
         let mut next_kept = 0;
@@ -66,7 +67,13 @@ impl JointList {
             if joint.a >= n || joint.b >= n || joint.a == joint.b || !usable {
                 continue;
             }
-            let mut c = JointConstraint::prepare(joint, bodies);
+            if let Some(slot) = self.joints.get_mut(count) {
+                slot.refill(joint, bodies);
+            } else {
+                self.joints.push(JointConstraint::prepare(joint, bodies));
+            }
+            let c = &mut self.joints[count];
+            count += 1;
             let kept = match self.cache.get(next_kept) {
                 Some(e) if e.0 == joint.key => Ok(next_kept),
                 _ => self.cache.binary_search_by_key(&joint.key, |e| e.0),
@@ -88,8 +95,8 @@ impl JointList {
                 c.extra = Some(self.extras.len() as u32);
                 self.extras.push(extra);
             }
-            self.joints.push(c);
         }
+        self.joints.truncate(count);
     }
 
     /// Holds the impulses each joint carries into the step to what could change a body's
@@ -277,5 +284,65 @@ impl JointList {
         self.cache
             .extend(self.joints.iter().map(|j| (j.key, j.impulses)));
         self.cache.sort_unstable_by_key(|e| e.0);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dynamics::solver::{BodyInput, JointFrame, JointKind, JointLimit};
+    use glam::{Quat, Vec3};
+
+    #[test]
+    fn joints_refilled_over_last_steps_equal_fresh_ones_on_every_value() {
+        let mut bodies = SolverBodies::default();
+        for i in 0..4 {
+            let f = i as f32;
+            bodies.push(BodyInput {
+                center: Vec3::new(f, 0.1 * f, 0.0),
+                orientation: Quat::from_rotation_z(0.3 * f),
+                inverse_mass: 1.0 / (1.0 + f),
+                inverse_principal_inertia: Vec3::new(1.0, 2.0, 3.0),
+                ..Default::default()
+            });
+        }
+        let frame = |x: f32| JointFrame {
+            anchor: Vec3::new(x, 0.2, -0.1),
+            basis: Quat::IDENTITY,
+        };
+        let joint = |a, b, kind, key| JointInput {
+            a,
+            b,
+            frame_a: frame(0.5),
+            frame_b: frame(-0.5),
+            kind,
+            key,
+        };
+        let limit = Some(JointLimit {
+            min: -0.5,
+            max: 0.5,
+        });
+        let hinge = JointKind::Revolute { limit, motor: None };
+        let ball = JointKind::Spherical {
+            swing: None,
+            twist: None,
+        };
+        // Last step: limited hinges (with extra rows) around a ball joint; this step: two
+        // ball joints between other bodies, in the first two places.
+        let last = [
+            joint(0, 1, hinge, 1),
+            joint(1, 2, ball, 2),
+            joint(2, 3, hinge, 3),
+        ];
+        let now = [joint(0, 2, ball, 4), joint(1, 3, ball, 5)];
+        let bound = (400.0, 100.0);
+        let mut reused = JointList::default();
+        reused.prepare(&bodies, &last, bound);
+        assert!(reused.joints()[0].extra.is_some());
+        reused.prepare(&bodies, &now, bound);
+        let mut fresh = JointList::default();
+        fresh.prepare(&bodies, &now, bound);
+        assert_eq!(reused.joints(), fresh.joints());
+        assert_eq!(reused.joints().len(), 2);
     }
 }
