@@ -133,6 +133,8 @@ struct BodyFacts {
     dormant: bool,
     /// It has parts (the scene graph is descended).
     compound: bool,
+    /// Its own collision layers (a compound's parts have theirs: they are read per part).
+    layers: CollisionLayers,
 }
 
 impl Plugin for NarrowPhasePlugin {
@@ -278,8 +280,9 @@ fn compute_contacts(
     let (any_layers, any_sensors) = (!layers.is_empty(), !sensors.is_empty());
     let sensing =
         |x: Entity, y: Entity| any_sensors && (sensors.contains(x) || sensors.contains(y));
+    let layers_of_entity = |x: Entity| layers_of(layers.get(x).ok());
     let interacts = |x: Entity, y: Entity| {
-        !any_layers || layers_of(layers.get(x).ok()).interacts_with(&layers_of(layers.get(y).ok()))
+        !any_layers || layers_of_entity(x).interacts_with(&layers_of_entity(y))
     };
     let jointed = jointed.as_deref().filter(|j| !j.is_empty());
     let mut bodies = std::mem::take(&mut scratch.bodies);
@@ -291,11 +294,23 @@ fn compute_contacts(
                 margin,
                 dormant: sleeping && dormant,
                 compound: matches!(nodes.get(e), Ok((.., Some(_)))),
+                layers: if any_layers {
+                    layers_of_entity(e)
+                } else {
+                    CollisionLayers::default()
+                },
             }
         })
     };
     for &(a, b) in &pairs.pairs {
         let (fa, fb) = (facts(a), facts(b));
+        let simple = !fa.compound && !fb.compound;
+        // Two colliders whose layers keep them apart are dropped first: their layers came
+        // with the facts, where the other tests read more (a net of 10,000 balls on layers of
+        // their own has up to 18,000 candidate pairs a step).
+        if simple && !fa.layers.interacts_with(&fb.layers) {
+            continue;
+        }
         if fa.dormant && fb.dormant {
             continue; // at rest against each other: nothing to compute until one wakes
         }
@@ -303,10 +318,7 @@ fn compute_contacts(
             continue; // a joint keeps them from colliding
         }
         let margin = lookahead.pair(&fa.margin, &fb.margin);
-        if !fa.compound && !fb.compound {
-            if !interacts(a, b) {
-                continue;
-            }
+        if simple {
             if sensing(a, b) {
                 scratch.test_sensor(&nodes, (a, b), (a, b), &mut overlaps);
             } else {
