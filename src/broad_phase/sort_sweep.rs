@@ -24,9 +24,8 @@ struct SweepArrays {
     lo: Vec<f32>,
     /// Max on the sweep axis.
     hi: Vec<f32>,
-    /// `[min_u, max_u, min_v, max_v]` on the other two axes, each in an array of its own, so
-    /// that four boxes' bounds load into SIMD lanes as they lie.
-    cross: [Vec<f32>; 4],
+    /// `[min_u, max_u, min_v, max_v]` on the other two axes.
+    cross: Vec<[f32; 4]>,
     /// `id << 1 | is_static`.
     owner: Vec<u32>,
 }
@@ -35,7 +34,7 @@ impl SweepArrays {
     fn memory_bytes(&self) -> usize {
         self.order.capacity() * size_of::<u64>()
             + (self.lo.capacity() + self.hi.capacity() + self.owner.capacity()) * size_of::<f32>()
-            + self.cross.iter().map(Vec::capacity).sum::<usize>() * size_of::<f32>()
+            + self.cross.capacity() * size_of::<[f32; 4]>()
     }
 }
 
@@ -91,9 +90,7 @@ fn fill_arrays(arrays: &mut SweepArrays, bodies: &BodyStore, axis: usize) {
     arrays.order.sort_unstable();
     arrays.lo.clear();
     arrays.hi.clear();
-    for bounds in &mut arrays.cross {
-        bounds.clear();
-    }
+    arrays.cross.clear();
     arrays.owner.clear();
     for &key in &arrays.order {
         // The low half of the key is the position.
@@ -101,13 +98,7 @@ fn fill_arrays(arrays: &mut SweepArrays, bodies: &BodyStore, axis: usize) {
         let b = &aabbs[at];
         arrays.lo.push(b.min[axis]);
         arrays.hi.push(b.max[axis]);
-        for (bounds, x) in arrays
-            .cross
-            .iter_mut()
-            .zip([b.min[u], b.max[u], b.min[v], b.max[v]])
-        {
-            bounds.push(x);
-        }
+        arrays.cross.push([b.min[u], b.max[u], b.min[v], b.max[v]]);
         let is_static = bodies.kinds()[at] == BodyKind::Static;
         arrays
             .owner
@@ -116,10 +107,7 @@ fn fill_arrays(arrays: &mut SweepArrays, bodies: &BodyStore, axis: usize) {
 }
 
 /// The forward sweep: every pair overlapping on all axes, found from its earlier-starting box;
-/// returns the number of cross-axis tests. The boxes after box `i` are tested four at a time
-/// in SIMD lanes (`wide::f32x4`: eight compares and a mask for four boxes, Terdiman's "box
-/// pruning revisited"), the run's last few one at a time; both find exactly the pairs of
-/// the scalar test, which compares the same floats.
+/// returns the number of cross-axis tests.
 fn sweep(arrays: &SweepArrays, out: &mut Vec<Pair>) -> u64 {
     let SweepArrays {
         lo,
@@ -128,54 +116,49 @@ fn sweep(arrays: &SweepArrays, out: &mut Vec<Pair>) -> u64 {
         owner,
         ..
     } = arrays;
-    let [min_u, max_u, min_v, max_v] = cross;
-    let n = lo.len();
     let mut tests = 0;
-    for i in 0..n {
-        let (end, o) = (hi[i], owner[i]);
-        let c = [min_u[i], max_u[i], min_v[i], max_v[i]];
-        let mut push = |j: usize| {
-            if o & owner[j] & 1 == 0 {
-                out.push(Pair::ordered(o >> 1, owner[j] >> 1));
-            }
-        };
+    for i in 0..lo.len() {
+        let (end, c, o) = (hi[i], cross[i], owner[i]);
         let mut j = i + 1;
-        // Whole groups of four that all start before box `i` ends.
-        let lanes = c.map(f32x4::splat);
-        let groups = fours(lo, j).zip(fours(min_u, j)).zip(fours(max_u, j));
-        let groups = groups.zip(fours(min_v, j)).zip(fours(max_v, j));
-        for ((((starts, lo_u), hi_u), lo_v), hi_v) in groups {
-            if starts[3] > end {
-                break;
+        // Whole groups of four that start before box `i` ends, tested at once in SIMD lanes
+        // (their bounds transposed into `wide::f32x4`s: eight compares and a bit mask,
+        // Terdiman's "box pruning revisited"); a run too short for one (a row of boxes along
+        // the sweep axis) pays one compare for the check.
+        if lo.get(j + 3).is_some_and(|&l| l <= end) {
+            let lanes = c.map(f32x4::splat);
+            let groups = lo[j..].as_chunks::<4>().0.iter();
+            for (starts, four) in groups.zip(cross[j..].as_chunks::<4>().0) {
+                if starts[3] > end {
+                    break;
+                }
+                let [lo_u, hi_u, lo_v, hi_v] = f32x4::transpose(four.map(f32x4::from));
+                let overlap = lanes[0].simd_le(hi_u)
+                    & lo_u.simd_le(lanes[1])
+                    & lanes[2].simd_le(hi_v)
+                    & lo_v.simd_le(lanes[3]);
+                let mut hits = overlap.to_bitmask();
+                while hits != 0 {
+                    let k = j + hits.trailing_zeros() as usize;
+                    if o & owner[k] & 1 == 0 {
+                        out.push(Pair::ordered(o >> 1, owner[k] >> 1));
+                    }
+                    hits &= hits - 1;
+                }
+                j += 4;
             }
-            let overlap = lanes[0].simd_le(f32x4::from(*hi_u))
-                & f32x4::from(*lo_u).simd_le(lanes[1])
-                & lanes[2].simd_le(f32x4::from(*hi_v))
-                & f32x4::from(*lo_v).simd_le(lanes[3]);
-            let mut hits = overlap.to_bitmask();
-            while hits != 0 {
-                push(j + hits.trailing_zeros() as usize);
-                hits &= hits - 1;
-            }
-            j += 4;
         }
-        while j < n && lo[j] <= end {
+        while j < lo.len() && lo[j] <= end {
+            let d = cross[j];
             // `&`, not `&&`: four compares without branches beat unpredictable early exits.
-            let overlap =
-                (c[0] <= max_u[j]) & (min_u[j] <= c[1]) & (c[2] <= max_v[j]) & (min_v[j] <= c[3]);
-            if overlap {
-                push(j);
+            let overlap = (c[0] <= d[1]) & (d[0] <= c[1]) & (c[2] <= d[3]) & (d[2] <= c[3]);
+            if overlap && o & owner[j] & 1 == 0 {
+                out.push(Pair::ordered(o >> 1, owner[j] >> 1));
             }
             j += 1;
         }
         tests += (j - i - 1) as u64;
     }
     tests
-}
-
-/// `bounds` from `from` on, four at a time (a last group of fewer left out).
-fn fours(bounds: &[f32], from: usize) -> std::slice::Iter<'_, [f32; 4]> {
-    bounds[from..].as_chunks::<4>().0.iter()
 }
 
 impl BroadPhase for SortAndSweep {
