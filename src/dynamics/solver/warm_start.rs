@@ -91,13 +91,11 @@ impl WarmStartCache {
                 if let Some((_, p)) = close {
                     cp.normal_impulse = p.normal_impulse.max(0.0) * scale;
                     cp.max_normal_impulse = cp.normal_impulse;
-                    let f = p.friction_impulse - normal * p.friction_impulse.dot(normal);
-                    cp.tangent_impulse = tangents.map(|t| f.dot(t) * scale);
+                    cp.tangent_impulse = on_tangents(p.friction_impulse, normal, tangents, scale);
                 }
             }
             if let (Some(patch), Some((f, twist))) = (&mut c.patch, old.patch) {
-                let f = f - normal * f.dot(normal);
-                patch.tangent_impulse = tangents.map(|t| f.dot(t) * scale);
+                patch.tangent_impulse = on_tangents(f, normal, tangents, scale);
                 patch.twist_impulse = twist * scale;
             }
         }
@@ -119,14 +117,12 @@ impl WarmStartCache {
                 *stored = StoredPoint {
                     local_anchor: to_local * cp.anchor_a,
                     normal_impulse: cp.normal_impulse,
-                    friction_impulse: c.tangents[0] * cp.tangent_impulse[0]
-                        + c.tangents[1] * cp.tangent_impulse[1],
+                    friction_impulse: in_world(c.tangents, cp.tangent_impulse),
                 };
             }
-            let patch = c.patch.map(|p| {
-                let [f0, f1] = p.tangent_impulse;
-                (c.tangents[0] * f0 + c.tangents[1] * f1, p.twist_impulse)
-            });
+            let patch = c
+                .patch
+                .map(|p| (in_world(c.tangents, p.tangent_impulse), p.twist_impulse));
             self.contacts.push(StoredContact {
                 key: c.key,
                 points,
@@ -135,4 +131,16 @@ impl WarmStartCache {
             });
         }
     }
+}
+
+/// A friction impulse kept as a world vector, on the new `tangents` (its part along the new
+/// `normal` dropped), scaled by the substeps' ratio.
+fn on_tangents(f: Vec3, normal: Vec3, tangents: [Vec3; 2], scale: f32) -> [f32; 2] {
+    let f = f - normal * f.dot(normal);
+    tangents.map(|t| f.dot(t) * scale)
+}
+
+/// A friction impulse along `tangents` as a world vector.
+fn in_world(tangents: [Vec3; 2], [f0, f1]: [f32; 2]) -> Vec3 {
+    tangents[0] * f0 + tangents[1] * f1
 }
