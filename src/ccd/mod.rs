@@ -74,6 +74,7 @@
 //! loop on the core alone.
 
 mod advancement;
+mod mover_pairs;
 mod sweep;
 mod sweep_cull;
 mod swept_aabb;
@@ -92,6 +93,7 @@ pub use advancement::{
     Advancement, DEFAULT_MAX_ADVANCEMENT_ITERATIONS, conservative_advancement,
     toi_sphere_by_advancement,
 };
+pub use mover_pairs::{MoverPairScratch, pairs_with_a_fast_body};
 pub use sweep::{CONTACT_TOLERANCE_RELATIVE, InitialOverlap, SphereSweep, SweepError};
 pub use sweep_cull::SweepCull;
 pub use swept_aabb::swept_aabb;

@@ -1,7 +1,10 @@
 //! Continuous collision through the plugin: fast balls never pass a 1 cm wall, while resting
-//! and sliding bodies are left to the contact solver.
+//! and sliding bodies are left to the contact solver; fast bodies never pass through moving
+//! ones ([`movers`]).
 
+#[path = "../common/mod.rs"]
 mod common;
+mod movers;
 
 use bevy_app::App;
 use bevy_ecs::message::Messages;

@@ -17,8 +17,9 @@
 //! spends the rest of the substep from there (up to [`CcdSettings::max_impacts`] impacts). Each
 //! impact also becomes a contact of the substep, so collision messages report it.
 //!
-//! Only static scenery is swept against; fast bodies meeting each other are left to the
-//! discrete step (and substeps). Sensors neither sweep nor stop a sweep, and colliders whose
+//! Moving and sleeping bodies are swept against too, in the pair's relative motion, and a fast
+//! body that meets one first is clamped at that impact for the next step's contact to solve
+//! ([`movers`]). Sensors neither sweep nor stop a sweep, and colliders whose
 //! [`CollisionLayers`] do not interact pass through each other here too, as do bodies a
 //! [`Joint`] keeps from colliding. A body already touching a surface
 //! at the start of its motion is the contact solver's business, not an impact.
@@ -45,8 +46,11 @@ use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
+use movers::{MoverImpact, MoverTable, first_mover_impact, gather_movers};
 use std::borrow::Cow;
 use std::time::Instant;
+
+mod movers;
 
 /// Sweeps fast bodies against static scenery each substep.
 #[derive(Debug, Clone, Default)]
@@ -84,12 +88,14 @@ impl Plugin for CcdPlugin {
         app.init_required::<CcdSettings>()
             .init_required::<CcdImpacts>()
             .init_required::<CcdScratch>()
+            .init_required::<MoverTable>()
             .add_systems(
                 SubstepSchedule,
                 (
                     (
                         record_sweep_starts.before(IntegrateBodies),
-                        sweep_fast_bodies
+                        (gather_movers, sweep_fast_bodies)
+                            .chain()
                             .after(IntegrateBodies)
                             .run_if(legacy_solver),
                     )
@@ -101,7 +107,7 @@ impl Plugin for CcdPlugin {
                         .in_set(SubstepSet::NarrowPhase),
                     // With the rigid-body solver the motion is the solver's: sweep it after
                     // the solve, and report the impacts with the step's collisions.
-                    (sweep_fast_bodies, add_impacts_to_contacts)
+                    (gather_movers, sweep_fast_bodies, add_impacts_to_contacts)
                         .chain()
                         .run_if(not(legacy_solver))
                         .run_if(any_with_component::<Velocity>)
@@ -244,13 +250,12 @@ fn sweep_fast_bodies(
     mut impacts: ResMut<CcdImpacts>,
     mut stats: ResMut<PhysicsStats>,
     jointed: Option<Res<JointedPairs>>,
+    movers: Res<MoverTable>,
 ) {
     impacts.contacts.clear();
     let jointed = jointed.as_deref().filter(|j| !j.is_empty());
-    // Without a broad phase there is no indexed scenery to sweep against.
-    let Some(mut index) = index else {
-        return;
-    };
+    // Without a broad phase there is no indexed scenery to sweep against (moving bodies still).
+    let mut index = index;
     if scratch.starts.is_empty() {
         return;
     }
@@ -258,6 +263,7 @@ fn sweep_fast_bodies(
     let dt = timestep.substep_dt();
     let s = &mut *scratch;
     let (mut parts, mut part_layers) = (Vec::new(), Vec::new());
+    let mut mover_impacts = 0u32;
     for i in 0..s.starts.len() {
         let SweepStart {
             body,
@@ -296,6 +302,19 @@ fn sweep_fast_bodies(
         let free = LockedAxes::of(locked).free_translation_axes();
         let (mut at, mut velocity, mut motion) = (from, v.0, to - from);
         let mut impacted = false;
+        let mut mover = SphereSweep::new(from, radius, motion)
+            .ok()
+            .and_then(|sweep| {
+                first_mover_impact(
+                    i,
+                    (&s.starts[i], &sweep),
+                    (layers, (&parts, &part_layers)),
+                    (&movers, jointed, dt),
+                    (&obstacles, &locals),
+                    &mut s.part_stack,
+                    (&mut s.query, &mut s.contacts),
+                )
+            });
         // The share of the step still to move: each impact uses up its sweep's `t` of what was
         // left (a second impact at t = 0 is not handed a fresh step).
         let mut remaining = 1.0f32;
@@ -305,13 +324,29 @@ fn sweep_fast_bodies(
                 break;
             };
             let sweep = sweep.with_initial_overlap(InitialOverlap::ApproachingOnly);
-            let Some((hit, root, leaf, e_obstacle)) = first_impact(
-                &sweep,
-                (body, layers, jointed, (&parts, &part_layers)),
-                &obstacles,
-                &mut index,
-                s,
-            ) else {
+            let found = index.as_deref_mut().and_then(|index| {
+                let meets = (body, layers, jointed, (&parts[..], &part_layers[..]));
+                first_impact(&sweep, meets, &obstacles, index, s)
+            });
+            // A moving body met before any scenery stops the sweep there (first pass only:
+            // what the body meets after a bounce is the discrete step's).
+            let earlier = |m: &MoverImpact| found.as_ref().is_none_or(|(h, ..)| m.t <= h.t);
+            if let Some(m) = mover.take().filter(earlier) {
+                at = from + (m.center - from) * free;
+                impacted = true;
+                mover_impacts += 1;
+                impacts.contacts.push(ContactPair {
+                    a: body,
+                    b: m.other,
+                    collider_a: body,
+                    collider_b: m.collider,
+                    manifold: ContactManifold::single(-m.hit.normal, m.hit.point, 0.0),
+                    normal_impulse: 0.0,
+                    impact_speed: m.approach,
+                });
+                break;
+            }
+            let Some((hit, root, leaf, e_obstacle)) = found else {
                 at += motion;
                 motion = Vec3::ZERO;
                 break;
@@ -354,6 +389,7 @@ fn sweep_fast_bodies(
         }
     }
     stats.add_counter("ccd/sweeps", s.starts.len() as f64);
+    stats.add_counter("ccd/mover_impacts", mover_impacts as f64);
     stats.add_counter("ccd/impacts", impacts.contacts.len() as f64);
     stats.add_time(Stage::Integrate, start.elapsed());
     stats.count_run("ccd");

@@ -1,0 +1,259 @@
+//! Continuous collision between a fast body and another moving body (or a sleeping one).
+//!
+//! The speculative contacts catch two moving bodies closing by up to their sizes in a step;
+//! past that (two 10 cm balls meeting head on at 10 m/s each, a bullet and a dynamic plank)
+//! they pass through each other, as the static sweep never looks at moving bodies. Here each
+//! fast body of the substep (those [`super::record_sweep_starts`] kept) is swept against the
+//! moving and sleeping bodies its swept box meets ([`pairs_with_a_fast_body`]) in their
+//! *relative* motion: the other body held at its start pose, the fast one's sphere moving by the
+//! difference of the two displacements, refined to its own convex parts as against scenery.
+//!
+//! At the first impact the fast body is clamped there (rapier's CCD "motion clamping"), its
+//! velocity left as it is: the two now touch, and the next step's contact, found by the narrow
+//! phase, solves the collision with the pair's masses, restitution and friction. A fast body
+//! that hits a slow one rides on with it for the rest of the substep (kept touching it, not
+//! left behind where it was hit); two fast bodies that hit each other both stop at the
+//! impact. What this leaves out: the other body's turning during the substep (it is swept at
+//! its end orientation), and what the fast body meets after a bounce off scenery in the same
+//! substep (the discrete step's).
+//!
+//! A substep with no fast body costs nothing here; otherwise one pass over the moving roots
+//! and a sort of those whose boxes meet the swept ones.
+
+use super::{
+    LayeredParts, Mover, NodePose, Obstacle, SweepStart, TOUCHING_TOLERANCE, meeting_parts,
+    sweep_radius,
+};
+use crate::bounding::Aabb;
+use crate::bvh::QueryScratch;
+use crate::ccd::{
+    InitialOverlap, MoverPairScratch, SphereSweep, Toi, pairs_with_a_fast_body, toi_parts_from,
+    toi_sphere_shape,
+};
+use crate::components::*;
+use crate::geometry::Isometry;
+use crate::geometry::contacts::ContactScratch;
+use crate::plugins::joints::JointedPairs;
+use crate::settings::PhysicsTimestep;
+use bevy_ecs::prelude::*;
+use glam::Vec3;
+
+/// A moving root as the sweeps see it in this substep.
+#[derive(Clone, Copy, Debug)]
+struct Other {
+    body: Entity,
+    /// Its root pose at the substep's start: where it ends, moved back by its displacement.
+    start: Isometry,
+    /// How far it moves in the substep.
+    displacement: Vec3,
+    /// Whether it is a fast body itself (stopped at its own impacts, so never ridden on).
+    fast: bool,
+}
+
+/// The moving bodies of the substep and which fast body may meet which, rebuilt each substep
+/// that has a fast body.
+#[derive(Resource, Default)]
+pub(super) struct MoverTable {
+    /// Index-aligned with the swept boxes: the fast bodies first, in the order of the sweep
+    /// starts, then the other moving roots.
+    others: Vec<Other>,
+    boxes: Vec<Aabb>,
+    pairs: Vec<[u32; 2]>,
+    /// `(fast body, other)` in both directions where both are fast, sorted.
+    candidates: Vec<(u32, u32)>,
+    pair_scratch: MoverPairScratch,
+    by_entity: Vec<(Entity, u32)>,
+}
+
+type AnyMovingRoot = (
+    Without<Static>,
+    Without<Sensor>,
+    Without<Quarantined>,
+    Without<ChildOf>,
+);
+
+/// Fills the [`MoverTable`] for this substep's sweep starts (leaves it empty without any).
+pub(super) fn gather_movers(
+    bodies: Query<(Mover, Has<Sleeping>), AnyMovingRoot>,
+    starts: Res<super::CcdScratch>,
+    timestep: Res<PhysicsTimestep>,
+    mut table: ResMut<MoverTable>,
+) {
+    let t = &mut *table;
+    t.others.clear();
+    t.boxes.clear();
+    t.candidates.clear();
+    if starts.starts.is_empty() {
+        return;
+    }
+    let dt = timestep.substep_dt();
+    t.by_entity.clear();
+    t.by_entity.extend(
+        starts
+            .starts
+            .iter()
+            .enumerate()
+            .map(|(i, s)| (s.body, i as u32)),
+    );
+    t.by_entity.sort_unstable();
+    // The fast bodies first, each with the box of its sweep (filled in below).
+    t.others.extend(starts.starts.iter().map(|s| Other {
+        body: s.body,
+        start: Isometry::IDENTITY,
+        displacement: Vec3::ZERO,
+        fast: true,
+    }));
+    t.boxes.resize(starts.starts.len(), Aabb::EMPTY);
+    for ((body, (p, r, inertia, _), v, bv, collider, compound, _), asleep) in &bodies {
+        let rotation = Rotation::of(r);
+        let offset = rotation * inertia.map_or(Vec3::ZERO, |i| i.local_center_of_mass);
+        let Some(radius) = sweep_radius(p.0, bv, collider, compound) else {
+            continue;
+        };
+        let radius = radius + offset.length();
+        let center = p.0 + offset;
+        let fast = t.by_entity.binary_search_by_key(&body, |e| e.0);
+        let displacement = match fast {
+            Ok(k) => center - starts.starts[t.by_entity[k].1 as usize].from,
+            // A sleeper is held still; the others move by their last velocity.
+            Err(_) if asleep => Vec3::ZERO,
+            Err(_) => v.0 * dt,
+        };
+        if !displacement.is_finite() || !center.is_finite() {
+            continue;
+        }
+        let start = Isometry::new(p.0 - displacement, rotation);
+        let swept = Aabb::from_points([center - displacement, center]).expanded(radius);
+        match fast {
+            Ok(k) => {
+                let i = t.by_entity[k].1 as usize;
+                t.others[i].start = start;
+                t.others[i].displacement = displacement;
+                t.boxes[i] = swept;
+            }
+            Err(_) => {
+                t.others.push(Other {
+                    body,
+                    start,
+                    displacement,
+                    fast: false,
+                });
+                t.boxes.push(swept);
+            }
+        }
+    }
+    let fast = starts.starts.len();
+    pairs_with_a_fast_body(&t.boxes, fast, &mut t.pair_scratch, &mut t.pairs);
+    for &[i, j] in &t.pairs {
+        // `i < j`, and a pair holds a fast body, so `i` is one.
+        t.candidates.push((i, j));
+        if (j as usize) < fast {
+            t.candidates.push((j, i));
+        }
+    }
+    t.candidates.sort_unstable();
+}
+
+/// The first impact of fast body `start` (its sweep `sweep` over the whole substep) with a moving
+/// body: the fast body's place at that impact, the hit (point in the world at the impact), the
+/// other root and the collider of it that was hit.
+pub(super) struct MoverImpact {
+    /// The fraction of the substep's motion at the impact.
+    pub t: f32,
+    /// Where the fast body's swept centre ends the substep: at the impact, carried on by a slow
+    /// body it hit for the rest of the substep.
+    pub center: Vec3,
+    /// The hit, normal from the other body towards the fast one, point in the world at `t`.
+    pub hit: Toi,
+    pub other: Entity,
+    pub collider: Entity,
+    /// The speed at which the two approached along the normal.
+    pub approach: f32,
+}
+
+/// The earliest impact of fast body number `index` (sweep start `start`, its whole substep's
+/// `sweep`, its `layers` and convex `parts`) with the moving bodies it may meet, or `None`.
+pub(super) fn first_mover_impact(
+    index: usize,
+    (start, sweep): (&SweepStart, &SphereSweep),
+    (layers, parts): (CollisionLayers, LayeredParts),
+    (table, jointed, dt): (&MoverTable, Option<&JointedPairs>, f32),
+    (obstacles, locals): (
+        &Query<Obstacle, Without<Quarantined>>,
+        &Query<NodePose, With<ChildOf>>,
+    ),
+    stack: &mut Vec<(Entity, Isometry)>,
+    (query, contacts): (&mut QueryScratch, &mut ContactScratch),
+) -> Option<MoverImpact> {
+    let from = table.candidates.partition_point(|c| (c.0 as usize) < index);
+    let to = table
+        .candidates
+        .partition_point(|c| (c.0 as usize) <= index);
+    let mut best: Option<MoverImpact> = None;
+    for &(_, j) in &table.candidates[from..to] {
+        let other = table.others[j as usize];
+        if jointed.is_some_and(|p| p.contains(start.body, other.body)) {
+            continue;
+        }
+        let relative = sweep.displacement() - other.displacement;
+        let Ok(relative) = SphereSweep::new(sweep.center(), sweep.radius(), relative) else {
+            continue;
+        };
+        let relative = relative.with_initial_overlap(InitialOverlap::ApproachingOnly);
+        stack.clear();
+        stack.push((other.body, other.start));
+        while let Some((node, pose)) = stack.pop() {
+            let Ok((collider, _, _, children, _, node_layers, sensor)) = obstacles.get(node) else {
+                continue;
+            };
+            for child in children.into_iter().flat_map(|c| c.iter()) {
+                let (p, r) = locals.get(child).unwrap_or((None, None));
+                let local = Isometry::new(p.map_or(Vec3::ZERO, |p| p.0), Rotation::of(r));
+                stack.push((child, pose * local));
+            }
+            let Some(c) = collider.filter(|_| !sensor) else {
+                continue;
+            };
+            let Some(meeting) = meeting_parts(parts, layers, &layers_of(node_layers)) else {
+                continue;
+            };
+            let Some(mut hit) = toi_sphere_shape(&relative, &c.shape, &pose, query) else {
+                continue;
+            };
+            if best.as_ref().is_some_and(|b| b.t < hit.t) {
+                continue;
+            }
+            if !meeting.is_empty() {
+                match toi_parts_from(&relative, &meeting, hit, (&c.shape, &pose), contacts) {
+                    Some(own) => hit = own,
+                    None => continue,
+                }
+            }
+            // As against scenery: touching at the start counts only when the motion goes into
+            // the other body by more than rounding.
+            let into = -relative.displacement().dot(hit.normal);
+            let real = hit.t > 0.0 || into > TOUCHING_TOLERANCE * relative.radius();
+            let earlier = best
+                .as_ref()
+                .is_none_or(|b| hit.t < b.t || (hit.t == b.t && other.body < b.other));
+            if real && earlier {
+                // The hit was found in the other body's frame held at its start.
+                hit.point += other.displacement * hit.t;
+                let ride = if other.fast {
+                    Vec3::ZERO
+                } else {
+                    other.displacement * (1.0 - hit.t)
+                };
+                best = Some(MoverImpact {
+                    t: hit.t,
+                    center: sweep.position_at(hit.t) + ride,
+                    hit,
+                    other: other.body,
+                    collider: node,
+                    approach: (into / dt).max(0.0),
+                });
+            }
+        }
+    }
+    best
+}
