@@ -3,8 +3,9 @@
 //! The speculative contacts catch two moving bodies closing by up to their sizes in a step;
 //! past that (two 10 cm balls meeting head on at 10 m/s each, a bullet and a dynamic plank)
 //! they pass through each other, as the static sweep never looks at moving bodies. Here each
-//! fast body of the substep (those [`super::record_sweep_starts`] kept) is swept against the
-//! moving and sleeping bodies its swept box meets ([`pairs_with_a_fast_body`]) in their
+//! fast body of the substep (those [`super::record_sweep_starts`] kept that move more than a
+//! quarter of their radius in it) is swept against the moving and sleeping bodies its swept box
+//! meets ([`pairs_with_a_fast_body`]) in their
 //! *relative* motion: the other body held at its start pose, the fast one's sphere moving by the
 //! difference of the two displacements, refined to its own convex parts as against scenery.
 //!
@@ -54,7 +55,7 @@ struct Other {
 /// that has a fast body.
 #[derive(Resource, Default)]
 pub(super) struct MoverTable {
-    /// Index-aligned with the swept boxes: the fast bodies first, in the order of the sweep
+    /// Index-aligned with the swept boxes: the fast bodies first, in the order of their sweep
     /// starts, then the other moving roots.
     others: Vec<Other>,
     boxes: Vec<Aabb>,
@@ -62,7 +63,10 @@ pub(super) struct MoverTable {
     /// `(fast body, other)` in both directions where both are fast, sorted.
     candidates: Vec<(u32, u32)>,
     pair_scratch: MoverPairScratch,
-    by_entity: Vec<(Entity, u32)>,
+    /// Each sweep start's place among the fast bodies (`u32::MAX`: not one of them).
+    slot_of_start: Vec<u32>,
+    /// The fast bodies, sorted (to leave them out of the others).
+    fast_bodies: Vec<Entity>,
 }
 
 type AnyMovingRoot = (
@@ -72,7 +76,15 @@ type AnyMovingRoot = (
     Without<ChildOf>,
 );
 
-/// Fills the [`MoverTable`] for this substep's sweep starts (leaves it empty without any).
+/// A fast body joins the sweeps against moving bodies when it moves more than this share of
+/// its sweep's radius in the substep. Two bodies each moving less cannot pass through each other
+/// within one (their boxes, grown by their motion over the step, are paired by the broad phase
+/// and their speculative contacts look that far ahead); a body marked [`Ccd`] and resting on a
+/// pile is then no reason to gather every moving body.
+const MOVER_SWEEP_SHARE: f32 = 0.25;
+
+/// Fills the [`MoverTable`] for this substep's sweep starts (leaves it empty when none of them
+/// moves fast enough to need it).
 pub(super) fn gather_movers(
     bodies: Query<(Mover, Has<Sleeping>), AnyMovingRoot>,
     starts: Res<super::CcdScratch>,
@@ -83,66 +95,66 @@ pub(super) fn gather_movers(
     t.others.clear();
     t.boxes.clear();
     t.candidates.clear();
-    if starts.starts.is_empty() {
+    t.slot_of_start.clear();
+    t.slot_of_start.resize(starts.starts.len(), u32::MAX);
+    t.fast_bodies.clear();
+    // The fast bodies first: those of the sweep starts that move far enough in the substep.
+    for (i, start) in starts.starts.iter().enumerate() {
+        let Ok(((_, (p, r, _, _), ..), _)) = bodies.get(start.body) else {
+            continue;
+        };
+        let rotation = Rotation::of(r);
+        let center = p.0 + rotation * start.local_center;
+        let displacement = center - start.from;
+        let far = displacement.length() > MOVER_SWEEP_SHARE * start.radius;
+        if far && displacement.is_finite() {
+            t.slot_of_start[i] = t.others.len() as u32;
+            t.fast_bodies.push(start.body);
+            t.others.push(Other {
+                body: start.body,
+                start: Isometry::new(p.0 - displacement, rotation),
+                displacement,
+                fast: true,
+            });
+            t.boxes
+                .push(Aabb::from_points([start.from, center]).expanded(start.radius));
+        }
+    }
+    let fast = t.others.len();
+    if fast == 0 {
         return;
     }
     let dt = timestep.substep_dt();
-    t.by_entity.clear();
-    t.by_entity.extend(
-        starts
-            .starts
-            .iter()
-            .enumerate()
-            .map(|(i, s)| (s.body, i as u32)),
-    );
-    t.by_entity.sort_unstable();
-    // The fast bodies first, each with the box of its sweep (filled in below).
-    t.others.extend(starts.starts.iter().map(|s| Other {
-        body: s.body,
-        start: Isometry::IDENTITY,
-        displacement: Vec3::ZERO,
-        fast: true,
-    }));
-    t.boxes.resize(starts.starts.len(), Aabb::EMPTY);
+    t.fast_bodies.sort_unstable();
+    let reach = t.boxes.iter().fold(Aabb::EMPTY, |union, b| union.union(b));
     for ((body, (p, r, inertia, _), v, bv, collider, compound, _), asleep) in &bodies {
-        let rotation = Rotation::of(r);
-        let offset = rotation * inertia.map_or(Vec3::ZERO, |i| i.local_center_of_mass);
         let Some(radius) = sweep_radius(p.0, bv, collider, compound) else {
             continue;
         };
-        let radius = radius + offset.length();
-        let center = p.0 + offset;
-        let fast = t.by_entity.binary_search_by_key(&body, |e| e.0);
-        let displacement = match fast {
-            Ok(k) => center - starts.starts[t.by_entity[k].1 as usize].from,
-            // A sleeper is held still; the others move by their last velocity.
-            Err(_) if asleep => Vec3::ZERO,
-            Err(_) => v.0 * dt,
+        let local_center = inertia.map_or(Vec3::ZERO, |i| i.local_center_of_mass);
+        // Most bodies hold their centre of mass at their origin: no turn to apply.
+        let offset = if local_center == Vec3::ZERO {
+            Vec3::ZERO
+        } else {
+            Rotation::of(r) * local_center
         };
-        if !displacement.is_finite() || !center.is_finite() {
+        // A sleeper is held still; the others moved by their last velocity.
+        let displacement = if asleep { Vec3::ZERO } else { v.0 * dt };
+        let center = p.0 + offset;
+        let swept = Aabb::from_points([center - displacement, center]);
+        let swept = swept.expanded(radius + offset.length());
+        // Most bodies are far from every fast one (a box with a NaN meets nothing either).
+        if !swept.intersects(&reach) || t.fast_bodies.binary_search(&body).is_ok() {
             continue;
         }
-        let start = Isometry::new(p.0 - displacement, rotation);
-        let swept = Aabb::from_points([center - displacement, center]).expanded(radius);
-        match fast {
-            Ok(k) => {
-                let i = t.by_entity[k].1 as usize;
-                t.others[i].start = start;
-                t.others[i].displacement = displacement;
-                t.boxes[i] = swept;
-            }
-            Err(_) => {
-                t.others.push(Other {
-                    body,
-                    start,
-                    displacement,
-                    fast: false,
-                });
-                t.boxes.push(swept);
-            }
-        }
+        t.others.push(Other {
+            body,
+            start: Isometry::new(p.0 - displacement, Rotation::of(r)),
+            displacement,
+            fast: false,
+        });
+        t.boxes.push(swept);
     }
-    let fast = starts.starts.len();
     pairs_with_a_fast_body(&t.boxes, fast, &mut t.pair_scratch, &mut t.pairs);
     for &[i, j] in &t.pairs {
         // `i < j`, and a pair holds a fast body, so `i` is one.
@@ -185,10 +197,9 @@ pub(super) fn first_mover_impact(
     stack: &mut Vec<(Entity, Isometry)>,
     (query, contacts): (&mut QueryScratch, &mut ContactScratch),
 ) -> Option<MoverImpact> {
-    let from = table.candidates.partition_point(|c| (c.0 as usize) < index);
-    let to = table
-        .candidates
-        .partition_point(|c| (c.0 as usize) <= index);
+    let slot = *table.slot_of_start.get(index)?;
+    let from = table.candidates.partition_point(|c| c.0 < slot);
+    let to = table.candidates.partition_point(|c| c.0 <= slot);
     let mut best: Option<MoverImpact> = None;
     for &(_, j) in &table.candidates[from..to] {
         let other = table.others[j as usize];
