@@ -13,12 +13,14 @@
 //! contacts' business.
 
 use crate::bounding::Aabb;
+use crate::broad_phase::float_order_key;
 
 /// Reusable buffers of [`pairs_with_a_fast_body`].
 #[derive(Debug, Default, Clone)]
 pub struct MoverPairScratch {
-    order: Vec<u32>,
-    open: Vec<u32>,
+    order: Vec<u64>,
+    fast_open: Vec<u32>,
+    slow_open: Vec<u32>,
 }
 
 /// The pairs `[i, j]` (`i < j`) of `boxes` that overlap and of which at least one is fast:
@@ -39,31 +41,42 @@ pub fn pairs_with_a_fast_body(
     let reach = boxes[..fast]
         .iter()
         .fold(Aabb::EMPTY, |union, b| union.union(b));
+    // Sorted by the start along x (as integer keys, the box's index below), boxes that can
+    // meet no swept one and boxes with a NaN left out. Box indices fit in u32: callers index
+    // bodies by u32 (the broad phase's proxy ids).
     let order = &mut scratch.order;
     order.clear();
-    // Box indices fit in u32: callers index bodies by u32 (the broad phase's proxy ids).
-    order.extend((0..boxes.len() as u32).filter(|&i| {
+    order.extend((0..boxes.len() as u32).filter_map(|i| {
         let b = &boxes[i as usize];
-        (i as usize) < fast || b.intersects(&reach)
+        let kept = b.is_valid() && ((i as usize) < fast || b.intersects(&reach));
+        kept.then(|| u64::from(float_order_key(b.min.x)) << 32 | u64::from(i))
     }));
-    order.retain(|&i| boxes[i as usize].is_valid());
-    order.sort_unstable_by(|&i, &j| {
-        let (a, b) = (&boxes[i as usize], &boxes[j as usize]);
-        a.min.x.total_cmp(&b.min.x).then(i.cmp(&j))
-    });
-    let open = &mut scratch.open;
-    open.clear();
-    for &i in order.iter() {
+    order.sort_unstable();
+    // The boxes whose x interval is still open, fast and slow apart: a slow box is tested
+    // against the fast ones only, and the slow list is pruned and read only when a fast box
+    // comes (in a dense pile a slow box overlaps a hundred others along x).
+    let (fast_open, slow_open) = (&mut scratch.fast_open, &mut scratch.slow_open);
+    fast_open.clear();
+    slow_open.clear();
+    for &key in order.iter() {
+        let i = key as u32;
         let b = &boxes[i as usize];
-        // Boxes whose x interval ended before this one starts can meet nothing later.
-        open.retain(|&j| boxes[j as usize].max.x >= b.min.x);
-        for &j in open.iter() {
-            let one_fast = (i as usize) < fast || (j as usize) < fast;
-            if one_fast && b.intersects(&boxes[j as usize]) {
+        let mut meet = |j: u32| {
+            if b.intersects(&boxes[j as usize]) {
                 out.push([i.min(j), i.max(j)]);
             }
+        };
+        // Boxes whose x interval ended before this one starts can meet nothing later.
+        let open = |j: &u32| boxes[*j as usize].max.x >= b.min.x;
+        fast_open.retain(open);
+        fast_open.iter().for_each(|&j| meet(j));
+        if (i as usize) < fast {
+            slow_open.retain(open);
+            slow_open.iter().for_each(|&j| meet(j));
+            fast_open.push(i);
+        } else {
+            slow_open.push(i);
         }
-        open.push(i);
     }
     out.sort_unstable();
 }
