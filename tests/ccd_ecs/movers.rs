@@ -268,3 +268,44 @@ fn a_ball_kicked_by_1e30_n_s_never_passes_through_the_ball_beside_it_and_nothing
         assert!(at(&app, e).is_finite() && velocity(&app, e).is_finite());
     }
 }
+
+/// A kinematic paddle at 200 m/s (3.3 m a step, more than its size) follows the game's velocity
+/// exactly, through a static wall and a free ball in its way: the sweeps never stop or bounce
+/// a kinematic body (its velocity was reflected off the wall before), and the ball is hit.
+#[test]
+fn a_kinematic_paddle_at_200_m_s_keeps_its_velocity_through_a_wall_and_still_hits_a_ball() {
+    let mut app = weightless(1);
+    let paddle = app
+        .world_mut()
+        .spawn((
+            Collider::cuboid(0.05, 1.0, 1.0),
+            Position::new(0.0, 0.0, 0.0),
+            Velocity::new(200.0, 0.0, 0.0),
+            Mass::INFINITE,
+        ))
+        .id();
+    let wall = (
+        Collider::cuboid(0.05, 1.0, 1.0),
+        Position::new(5.0, 0.0, 0.5),
+        Static,
+    );
+    app.world_mut().spawn(wall);
+    let ball = (
+        Collider::sphere(0.1),
+        Position::new(10.5, 0.0, 0.0),
+        Velocity::default(),
+    );
+    let ball = app.world_mut().spawn(ball).id();
+    for step in 1..=8 {
+        urto::step(app.world_mut(), 1).unwrap();
+        let expected = 200.0 * step as f32 / 60.0;
+        assert!(
+            (at(&app, paddle).x - expected).abs() < 1e-4,
+            "{}",
+            at(&app, paddle)
+        );
+        assert_eq!(velocity(&app, paddle), Vec3::new(200.0, 0.0, 0.0));
+    }
+    assert!(velocity(&app, ball).x > 200.0, "{}", velocity(&app, ball));
+    assert!(at(&app, ball).x > at(&app, paddle).x);
+}
