@@ -431,11 +431,7 @@ fn parts_on_sweep<'q>(
         let Ok((collider, _, _, children, _, layers, sensor)) = obstacles.get(node) else {
             continue;
         };
-        for child in children.into_iter().flat_map(|c| c.iter()) {
-            let (p, r) = locals.get(child).unwrap_or((None, None));
-            let local = Isometry::new(p.map_or(Vec3::ZERO, |p| p.0), Rotation::of(r));
-            stack.push((child, in_body * local));
-        }
+        push_children(children, &in_body, locals, stack);
         let Some(c) = collider.filter(|_| !sensor) else {
             continue;
         };
@@ -458,6 +454,22 @@ fn parts_on_sweep<'q>(
     {
         parts.clear();
         part_layers.clear();
+    }
+}
+
+/// Pushes a node's `children` onto `stack`, each with its pose composed onto the node's `pose`
+/// (poses in the frame the walk started from, composed down from the root: no world pose's
+/// rounding far from the origin).
+fn push_children(
+    children: Option<&Children>,
+    pose: &Isometry,
+    locals: &Query<NodePose, With<ChildOf>>,
+    stack: &mut Vec<(Entity, Isometry)>,
+) {
+    for child in children.into_iter().flat_map(|c| c.iter()) {
+        let (p, r) = locals.get(child).unwrap_or((None, None));
+        let local = Isometry::new(p.map_or(Vec3::ZERO, |p| p.0), Rotation::of(r));
+        stack.push((child, *pose * local));
     }
 }
 

@@ -23,7 +23,7 @@
 
 use super::{
     LayeredParts, Mover, NodePose, Obstacle, SweepStart, TOUCHING_TOLERANCE, meeting_parts,
-    sweep_radius,
+    push_children, sweep_radius,
 };
 use crate::bounding::Aabb;
 use crate::bvh::QueryScratch;
@@ -217,11 +217,7 @@ pub(super) fn first_mover_impact(
             let Ok((collider, _, _, children, _, node_layers, sensor)) = obstacles.get(node) else {
                 continue;
             };
-            for child in children.into_iter().flat_map(|c| c.iter()) {
-                let (p, r) = locals.get(child).unwrap_or((None, None));
-                let local = Isometry::new(p.map_or(Vec3::ZERO, |p| p.0), Rotation::of(r));
-                stack.push((child, pose * local));
-            }
+            push_children(children, &pose, locals, stack);
             let Some(c) = collider.filter(|_| !sensor) else {
                 continue;
             };
