@@ -19,20 +19,19 @@
 //!
 //! Moving and sleeping bodies are swept against too, in the pair's relative motion, and a fast
 //! body that meets one first is clamped at that impact for the next step's contact to solve
-//! ([`movers`]). Sensors neither sweep nor stop a sweep, and colliders whose
+//! (`movers.rs`). Sensors neither sweep nor stop a sweep, and colliders whose
 //! [`CollisionLayers`] do not interact pass through each other here too, as do bodies a
 //! [`Joint`] keeps from colliding. A body already touching a surface
 //! at the start of its motion is the contact solver's business, not an impact.
 
 use crate::bvh::QueryScratch;
 use crate::ccd::{
-    InitialOverlap, MAX_REFINED_PARTS, MAX_REFINED_TURN, ShapeOnSweep, SphereSweep, Toi,
-    toi_parts_from, toi_sphere_shape,
+    InitialOverlap, MAX_REFINED_TURN, SphereSweep, Toi, toi_parts_from, toi_sphere_shape,
 };
 use crate::components::*;
 use crate::dynamics::response::reflect;
 use crate::geometry::contacts::ContactScratch;
-use crate::geometry::{ContactManifold, Isometry, Shape};
+use crate::geometry::{ContactManifold, Isometry};
 use crate::plugins::broad_phase::BroadPhaseIndex;
 use crate::plugins::integration::IntegrateBodies;
 use crate::plugins::joints::JointedPairs;
@@ -47,10 +46,11 @@ use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
 use movers::{MoverImpact, MoverTable, first_mover_impact, gather_movers};
-use std::borrow::Cow;
+use parts::{LayeredParts, NodePose, meeting_parts, parts_on_sweep};
 use std::time::Instant;
 
 mod movers;
+mod parts;
 
 /// Sweeps fast bodies against static scenery each substep.
 #[derive(Debug, Clone, Default)]
@@ -401,78 +401,6 @@ fn sweep_fast_bodies(
     stats.count_run("ccd");
 }
 
-/// A node's pose in its parent's frame.
-type NodePose<'a> = (Option<&'a Position>, Option<&'a Rotation>);
-
-/// The convex colliders of `body` (its own and its descendants', sensors left out) placed in
-/// its frame on its sweep turning by `rotations`, into `parts` (their layers into
-/// `part_layers`); left empty where refining cannot help: a body turning too fast for the slerp
-/// between its two orientations to be the way it turned (`rotations` is `None`), one that is
-/// one ball about its swept centre (its sweep is exact), or one with a part that has no finite
-/// convex gap (a mesh) or more than [`MAX_REFINED_PARTS`] parts. Each part's place in the body
-/// is composed from the nodes' local poses down from the root, not taken from world poses (whose
-/// f32 rounding far from the origin would move a part by millimetres).
-fn parts_on_sweep<'q>(
-    body: Entity,
-    (rotations, local_center): (Option<[Quat; 2]>, Vec3),
-    obstacles: &'q Query<Obstacle, Without<Quarantined>>,
-    locals: &Query<NodePose, With<ChildOf>>,
-    stack: &mut Vec<(Entity, Isometry)>,
-    (parts, part_layers): (&mut Vec<ShapeOnSweep<'q>>, &mut Vec<CollisionLayers>),
-) {
-    parts.clear();
-    part_layers.clear();
-    let Some(rotations) = rotations else {
-        return;
-    };
-    stack.clear();
-    stack.push((body, Isometry::IDENTITY));
-    while let Some((node, in_body)) = stack.pop() {
-        let Ok((collider, _, _, children, _, layers, sensor)) = obstacles.get(node) else {
-            continue;
-        };
-        push_children(children, &in_body, locals, stack);
-        let Some(c) = collider.filter(|_| !sensor) else {
-            continue;
-        };
-        if !ShapeOnSweep::has_convex_gap(&c.shape) || parts.len() == MAX_REFINED_PARTS {
-            parts.clear();
-            part_layers.clear();
-            return;
-        }
-        parts.push(ShapeOnSweep::part(
-            &c.shape,
-            &in_body,
-            rotations,
-            local_center,
-        ));
-        part_layers.push(layers_of(layers));
-    }
-    if let [only] = parts.as_slice()
-        && matches!(only.shape, Shape::Sphere(_))
-        && only.local_center == Vec3::ZERO
-    {
-        parts.clear();
-        part_layers.clear();
-    }
-}
-
-/// Pushes a node's `children` onto `stack`, each with its pose composed onto the node's `pose`
-/// (poses in the frame the walk started from, composed down from the root: no world pose's
-/// rounding far from the origin).
-fn push_children(
-    children: Option<&Children>,
-    pose: &Isometry,
-    locals: &Query<NodePose, With<ChildOf>>,
-    stack: &mut Vec<(Entity, Isometry)>,
-) {
-    for child in children.into_iter().flat_map(|c| c.iter()) {
-        let (p, r) = locals.get(child).unwrap_or((None, None));
-        let local = Isometry::new(p.map_or(Vec3::ZERO, |p| p.0), Rotation::of(r));
-        stack.push((child, *pose * local));
-    }
-}
-
 /// Motion into a surface already touched at the start of a sweep, as a fraction of the radius,
 /// below which it is rounding (a body sliding along its support), not an impact.
 const TOUCHING_TOLERANCE: f32 = 1e-4;
@@ -549,36 +477,6 @@ fn first_impact(
         }
     }
     best
-}
-
-/// A body's convex parts on its sweep and each one's collision layers.
-type LayeredParts<'p, 'q> = (&'p [ShapeOnSweep<'q>], &'p [CollisionLayers]);
-
-/// The parts that meet an obstacle in `obstacle` layers: all of them when each one's layers
-/// interact with it (the common case, borrowed), those that do when some do not, `None` when
-/// none does. Without parts (a body not refined), the body's own `layers` decide, and the
-/// answer is an empty list or `None`.
-fn meeting_parts<'p, 'q>(
-    (parts, part_layers): LayeredParts<'p, 'q>,
-    layers: CollisionLayers,
-    obstacle: &CollisionLayers,
-) -> Option<Cow<'p, [ShapeOnSweep<'q>]>> {
-    if parts.is_empty() {
-        return layers
-            .interacts_with(obstacle)
-            .then_some(Cow::Borrowed(parts));
-    }
-    let meets = |l: &CollisionLayers| l.interacts_with(obstacle);
-    if part_layers.iter().all(meets) {
-        return Some(Cow::Borrowed(parts));
-    }
-    let some: Vec<_> = parts
-        .iter()
-        .zip(part_layers)
-        .filter(|(_, l)| meets(l))
-        .map(|(p, _)| *p)
-        .collect();
-    (!some.is_empty()).then_some(Cow::Owned(some))
 }
 
 /// The substep's impacts join the narrow phase's contacts (once per pair), so the response and

@@ -21,10 +21,8 @@
 //! A substep with no fast body costs nothing here; otherwise one pass over the moving roots
 //! and a sort of those whose boxes meet the swept ones.
 
-use super::{
-    LayeredParts, Mover, NodePose, Obstacle, SweepStart, TOUCHING_TOLERANCE, meeting_parts,
-    push_children, sweep_radius,
-};
+use super::parts::{LayeredParts, NodePose, meeting_parts, push_children};
+use super::{Mover, Obstacle, SweepStart, TOUCHING_TOLERANCE, sweep_radius};
 use crate::bounding::Aabb;
 use crate::bvh::QueryScratch;
 use crate::ccd::{
