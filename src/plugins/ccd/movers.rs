@@ -164,6 +164,10 @@ pub(super) fn gather_movers(
     t.candidates.sort_unstable();
 }
 
+/// The colliders a sweep may meet, and the local poses of compound parts.
+type Obstacles<'w, 's, 'a> = Query<'w, 's, Obstacle<'a>, Without<Quarantined>>;
+type Locals<'w, 's, 'a> = Query<'w, 's, NodePose<'a>, With<ChildOf>>;
+
 /// The first impact of fast body `start` (its sweep `sweep` over the whole substep) with a moving
 /// body: the fast body's place at that impact, the hit (point in the world at the impact), the
 /// other root and the collider of it that was hit.
@@ -188,10 +192,7 @@ pub(super) fn first_mover_impact(
     (start, sweep): (&SweepStart, &SphereSweep),
     (layers, parts): (CollisionLayers, LayeredParts),
     (table, jointed, dt): (&MoverTable, Option<&JointedPairs>, f32),
-    (obstacles, locals): (
-        &Query<Obstacle, Without<Quarantined>>,
-        &Query<NodePose, With<ChildOf>>,
-    ),
+    (obstacles, locals): (&Obstacles, &Locals),
     stack: &mut Vec<(Entity, Isometry)>,
     (query, contacts): (&mut QueryScratch, &mut ContactScratch),
 ) -> Option<MoverImpact> {
