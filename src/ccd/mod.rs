@@ -72,6 +72,11 @@
 //! [`SphereSweep::position_at`]`(t)`, respond about `normal`, and sweep the rest of the step
 //! (`remaining × (1 − t)`) again, a bounded number of times. `tests/core/ccd_robustness.rs` runs this
 //! loop on the core alone.
+//!
+//! Against a moving obstacle, sweep in the pair's relative motion (the sphere's displacement
+//! minus the obstacle's, the obstacle held at its start); [`pairs_with_a_fast_body`] finds which
+//! fast bodies' swept boxes meet which moving bodies' boxes (the ECS clamps a fast body at its
+//! first such impact, `plugins/ccd/movers.rs`).
 
 mod advancement;
 mod mover_pairs;
