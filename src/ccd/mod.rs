@@ -106,7 +106,7 @@ pub(crate) use swept_point::segment_in_box;
 pub use toi::{MeshToi, Toi, toi_sphere_shape};
 pub use toi_shape::{
     MAX_REFINED_PARTS, MAX_REFINED_TURN, MAX_SHAPE_ADVANCEMENT_ITERATIONS, ShapeOnSweep,
-    toi_parts_from, toi_shape_from,
+    depth_at_start, toi_parts_from, toi_shape_from,
 };
 pub use toi_sphere_capsule::toi_sphere_capsule;
 pub use toi_sphere_convex::toi_sphere_convex;

@@ -208,6 +208,30 @@ fn kept_inside(
     })
 }
 
+/// How deep the body is inside `obstacle` at the sweep's start (0 when apart): its `parts` at
+/// their start poses, or, without parts, the sweep's sphere (the body itself when it is one
+/// ball about its centre). What a caller reads to tell a body touching the obstacle from one
+/// already deep inside it, whose overlap is the contact solver's to undo, not an impact.
+pub fn depth_at_start(
+    sweep: &SphereSweep,
+    parts: &[ShapeOnSweep<'_>],
+    (obstacle, obstacle_pose): (&Shape, &Isometry),
+    scratch: &mut ContactScratch,
+) -> f32 {
+    let mut depth = |shape: &Shape, pose: &Isometry| {
+        contact_with_scratch(shape, pose, obstacle, obstacle_pose, scratch)
+            .map_or(0.0, |m| m.max_depth().max(0.0))
+    };
+    if parts.is_empty() {
+        let pose = Isometry::new(sweep.center(), Quat::IDENTITY);
+        return depth(&Shape::sphere(sweep.radius()), &pose);
+    }
+    parts
+        .iter()
+        .map(|part| depth(part.shape, &part.pose_at(sweep, 0.0)))
+        .fold(0.0, f32::max)
+}
+
 /// Conservative advancement of one part from the sphere's impact on, for a body turning by
 /// `turn` over the sweep: its first contact with the obstacle (or the last time known safe, out
 /// of probes); `None` if it touches neither before the sweep's end nor before `until`.

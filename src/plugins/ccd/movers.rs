@@ -26,8 +26,8 @@ use super::{Mover, Obstacle, SweepStart, TOUCHING_TOLERANCE, sweep_radius};
 use crate::bounding::Aabb;
 use crate::bvh::QueryScratch;
 use crate::ccd::{
-    InitialOverlap, MoverPairScratch, SphereSweep, Toi, pairs_with_a_fast_body, toi_parts_from,
-    toi_sphere_shape,
+    InitialOverlap, MoverPairScratch, SphereSweep, Toi, depth_at_start, pairs_with_a_fast_body,
+    toi_parts_from, toi_sphere_shape,
 };
 use crate::components::*;
 use crate::geometry::Isometry;
@@ -36,6 +36,16 @@ use crate::plugins::joints::JointedPairs;
 use crate::settings::PhysicsTimestep;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
+
+/// How deep (a share of its sweep's radius) a fast body may start inside a moving one and still
+/// be stopped there when it moves deeper: a bullet clamped at a plank and pushed a hair into it
+/// is, a body spawned inside another is not.
+const DEEP_START: f32 = 0.1;
+
+/// Most moving bodies one fast body is swept against: one whose swept box meets more is in a
+/// heap (a thousand balls spawned on one point), where every pair is a contact already and
+/// sweeping each would cost seconds a step; it is left to the discrete step.
+const MAX_CANDIDATES: usize = 256;
 
 /// A moving root as the sweeps see it in this substep.
 #[derive(Clone, Copy, Debug)]
@@ -199,6 +209,9 @@ pub(super) fn first_mover_impact(
     let slot = *table.slot_of_start.get(index)?;
     let from = table.candidates.partition_point(|c| c.0 < slot);
     let to = table.candidates.partition_point(|c| c.0 <= slot);
+    if to - from > MAX_CANDIDATES {
+        return None;
+    }
     let mut best: Option<MoverImpact> = None;
     for &(_, j) in &table.candidates[from..to] {
         let other = table.others[j as usize];
@@ -236,9 +249,15 @@ pub(super) fn first_mover_impact(
                 }
             }
             // As against scenery: touching at the start counts only when the motion goes into
-            // the other body by more than rounding.
+            // the other body by more than rounding. Unlike scenery, a body already deep inside
+            // another moving one (spawned there, or pushed) is left to the contact solver to
+            // separate: stopping it there kept 1,000 balls spawned on one point from ever
+            // flying apart.
             let into = -relative.displacement().dot(hit.normal);
-            let real = hit.t > 0.0 || into > TOUCHING_TOLERANCE * relative.radius();
+            let real = hit.t > 0.0
+                || (into > TOUCHING_TOLERANCE * relative.radius()
+                    && depth_at_start(&relative, &meeting, (&c.shape, &pose), contacts)
+                        <= DEEP_START * relative.radius());
             let earlier = best
                 .as_ref()
                 .is_none_or(|b| hit.t < b.t || (hit.t == b.t && other.body < b.other));
