@@ -320,13 +320,11 @@ fn advance_to_contact(
 }
 
 /// How fast the gap of a probe `m` (normal from the body to the obstacle) can close, per unit
-/// of the sweep, at most: the separating-slab bound of conservative advancement (Mirtich 1996,
-/// §3; Zhang et al. 2006). Two convex shapes apart by `g` along a unit `n` stay apart until
-/// the slab between them closes, and it closes no faster than the body's displacement along
-/// `n` plus its turning (`θ r`): a body gliding past a surface, its motion nearly parallel to
-/// it, is advanced by its approach, not by its speed (which ran 32 probes out 5 cm from a box
-/// it flew past, and stopped it there). A triangle mesh is not convex, so another of its parts
-/// may come closer along another normal: against one, the full speed bound.
+/// of the sweep, at most: the separating-slab bound (Mirtich 1996, §3). Convex shapes apart by
+/// `g` along `n` stay apart until that slab closes, no faster than the body's motion along `n`
+/// plus its turning (`θ r`): a body gliding past a surface advances by its approach, not its
+/// speed (which ran 32 probes out 5 cm from a box a capsule flew past, and stopped it there).
+/// A triangle mesh is not convex (another part may come closer): against one, the speed bound.
 fn closing_speed(sweep: &SphereSweep, turn: f32, m: &ContactManifold, obstacle: &Shape) -> f32 {
     let spin = turn * sweep.radius();
     let full = sweep.displacement().length() + spin;
