@@ -336,7 +336,7 @@ fn sweep_fast_bodies(
             });
             // A moving body met before any scenery stops the sweep there (first pass only:
             // what the body meets after a bounce is the discrete step's).
-            let earlier = |m: &MoverImpact| found.as_ref().is_none_or(|(h, ..)| m.t <= h.t);
+            let earlier = |m: &MoverImpact| found.as_ref().is_none_or(|(h, ..)| m.hit.t <= h.t);
             if let Some(m) = mover.take().filter(earlier) {
                 at = from + (m.center - from) * free;
                 impacted = true;
@@ -405,6 +405,19 @@ fn sweep_fast_bodies(
 /// below which it is rounding (a body sliding along its support), not an impact.
 const TOUCHING_TOLERANCE: f32 = 1e-4;
 
+/// How far `sweep` moves into the surface of `hit` (along its normal), and whether that makes
+/// the hit an impact: any hit after the start does; a contact already there at t = 0 counts
+/// when the motion goes into it by more than rounding (left to the solver, which sees only the
+/// end of the substep, a body touching a thin wall would pass it). Motion along the surface is
+/// no impact.
+fn moves_into(sweep: &SphereSweep, hit: &Toi) -> (f32, bool) {
+    let into = -sweep.displacement().dot(hit.normal);
+    (
+        into,
+        hit.t > 0.0 || into > TOUCHING_TOLERANCE * sweep.radius(),
+    )
+}
+
 /// The earliest impact of `sweep` (`body`, with `layers`) with the static scenery its swept
 /// volume meets, its layers interact with and no joint keeps it from colliding with: the hit,
 /// the obstacle's root, the collider hit, and that collider's restitution. With `parts` (and
@@ -465,11 +478,7 @@ fn first_impact(
                     None => continue,
                 }
             }
-            // A contact already there at t = 0 counts when the motion goes into it by more than
-            // rounding: left to the solver, which sees only the end of the substep, a body
-            // touching a thin wall would pass it. Motion along the surface is no impact.
-            let into = -sweep.displacement().dot(hit.normal);
-            let real = hit.t > 0.0 || into > TOUCHING_TOLERANCE * sweep.radius();
+            let (_, real) = moves_into(sweep, &hit);
             let earlier = best.as_ref().is_none_or(|(b, ..)| hit.t < b.t);
             if real && earlier {
                 best = Some((hit, root, node, e.map(|r| r.0)));

@@ -22,7 +22,7 @@
 //! and a sort of those whose boxes meet the swept ones.
 
 use super::parts::{LayeredParts, NodePose, meeting_parts, push_children};
-use super::{Mover, Obstacle, SweepStart, TOUCHING_TOLERANCE, sweep_radius};
+use super::{Mover, Obstacle, SweepStart, moves_into, sweep_radius};
 use crate::bounding::Aabb;
 use crate::bvh::QueryScratch;
 use crate::ccd::{
@@ -55,8 +55,6 @@ struct Other {
     start: Isometry,
     /// How far it moves in the substep.
     displacement: Vec3,
-    /// Whether it is a fast body itself (stopped at its own impacts, so never ridden on).
-    fast: bool,
 }
 
 /// The moving bodies of the substep and which fast body may meet which, rebuilt each substep
@@ -64,7 +62,7 @@ struct Other {
 #[derive(Resource, Default)]
 pub(super) struct MoverTable {
     /// Index-aligned with the swept boxes: the fast bodies first, in the order of their sweep
-    /// starts, then the other moving roots.
+    /// starts (as many as `fast_bodies`), then the other moving roots.
     others: Vec<Other>,
     boxes: Vec<Aabb>,
     pairs: Vec<[u32; 2]>,
@@ -122,7 +120,6 @@ pub(super) fn gather_movers(
                 body: start.body,
                 start: Isometry::new(p.0 - displacement, rotation),
                 displacement,
-                fast: true,
             });
             t.boxes
                 .push(Aabb::from_points([start.from, center]).expanded(start.radius));
@@ -159,7 +156,6 @@ pub(super) fn gather_movers(
             body,
             start: Isometry::new(p.0 - displacement, Rotation::of(r)),
             displacement,
-            fast: false,
         });
         t.boxes.push(swept);
     }
@@ -182,12 +178,11 @@ type Locals<'w, 's, 'a> = Query<'w, 's, NodePose<'a>, With<ChildOf>>;
 /// body: the fast body's place at that impact, the hit (point in the world at the impact), the
 /// other root and the collider of it that was hit.
 pub(super) struct MoverImpact {
-    /// The fraction of the substep's motion at the impact.
-    pub t: f32,
     /// Where the fast body's swept centre ends the substep: at the impact, carried on by a slow
     /// body it hit for the rest of the substep.
     pub center: Vec3,
-    /// The hit, normal from the other body towards the fast one, point in the world at `t`.
+    /// The hit: the fraction `t` of the substep's motion at the impact, the normal from the
+    /// other body towards the fast one, the point in the world at `t`.
     pub hit: Toi,
     pub other: Entity,
     pub collider: Entity,
@@ -239,7 +234,7 @@ pub(super) fn first_mover_impact(
             let Some(mut hit) = toi_sphere_shape(&relative, &c.shape, &pose, query) else {
                 continue;
             };
-            if best.as_ref().is_some_and(|b| b.t < hit.t) {
+            if best.as_ref().is_some_and(|b| b.hit.t < hit.t) {
                 continue;
             }
             if !meeting.is_empty() {
@@ -248,29 +243,28 @@ pub(super) fn first_mover_impact(
                     None => continue,
                 }
             }
-            // As against scenery: touching at the start counts only when the motion goes into
-            // the other body by more than rounding. Unlike scenery, a body already deep inside
-            // another moving one (spawned there, or pushed) is left to the contact solver to
-            // separate: stopping it there kept 1,000 balls spawned on one point from ever
-            // flying apart.
-            let into = -relative.displacement().dot(hit.normal);
-            let real = hit.t > 0.0
-                || (into > TOUCHING_TOLERANCE * relative.radius()
-                    && depth_at_start(&relative, &meeting, (&c.shape, &pose), contacts)
+            // As against scenery; but a body already deep inside another moving one (spawned
+            // there, or pushed) is left to the contact solver to separate: stopping it there
+            // kept 1,000 balls spawned on one point from ever flying apart.
+            let (into, moving_in) = moves_into(&relative, &hit);
+            let real = moving_in
+                && (hit.t > 0.0
+                    || depth_at_start(&relative, &meeting, (&c.shape, &pose), contacts)
                         <= DEEP_START * relative.radius());
             let earlier = best
                 .as_ref()
-                .is_none_or(|b| hit.t < b.t || (hit.t == b.t && other.body < b.other));
+                .is_none_or(|b| hit.t < b.hit.t || (hit.t == b.hit.t && other.body < b.other));
             if real && earlier {
                 // The hit was found in the other body's frame held at its start.
                 hit.point += other.displacement * hit.t;
-                let ride = if other.fast {
+                // A fast body stops at its own impacts: it is never ridden on.
+                let fast = (j as usize) < table.fast_bodies.len();
+                let ride = if fast {
                     Vec3::ZERO
                 } else {
                     other.displacement * (1.0 - hit.t)
                 };
                 best = Some(MoverImpact {
-                    t: hit.t,
                     center: sweep.position_at(hit.t) + ride,
                     hit,
                     other: other.body,
