@@ -357,6 +357,7 @@ pub struct Sensor;
 /// assert!(ghost.interacts_with(&CollisionLayers::default()));
 /// ```
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[component(summary_tick)]
 pub struct CollisionLayers(pub Layers);
 
 impl CollisionLayers {

@@ -43,13 +43,14 @@ type SleeperColumns<'a> = (
 );
 
 /// What a body is made of and hangs from: any write to one of these wakes it (mass, density,
-/// gravity scale, locks, collider, inertia, drags, parent, children).
+/// gravity scale, locks, collider, layers, inertia, drags, parent, children).
 type MadeOf<'a> = (
     Option<Ref<'a, Mass>>,
     Option<Ref<'a, Density>>,
     Option<Ref<'a, GravityScale>>,
     Option<Ref<'a, LockedAxes>>,
     Option<Ref<'a, Collider>>,
+    Option<Ref<'a, CollisionLayers>>,
     Option<Ref<'a, Inertia>>,
     Option<Ref<'a, LinearDrag>>,
     Option<Ref<'a, AngularDrag>>,
@@ -98,6 +99,7 @@ pub(crate) fn wake_on_game_changes(
         RemovedComponents<Density>,
         RemovedComponents<GravityScale>,
         RemovedComponents<LockedAxes>,
+        RemovedComponents<CollisionLayers>,
     ),
     mut waker: Waker,
     mut scratch: Local<WakeScratch>,
@@ -109,11 +111,13 @@ pub(crate) fn wake_on_game_changes(
         return;
     }
     let scratch = &mut *scratch;
-    // A removed mass, density, gravity scale or lock changes what the body weighs or feels,
-    // or how it may move.
-    let (mass, density, scale, locks) = &mut unset;
+    // A removed mass, density, gravity scale, lock or layers changes what the body weighs or
+    // feels, how it may move or what it touches.
+    let (mass, density, scale, locks, layers) = &mut unset;
     let removed = mass.read().chain(density.read()).chain(scale.read());
-    scratch.woken.extend(removed.chain(locks.read()));
+    scratch
+        .woken
+        .extend(removed.chain(locks.read()).chain(layers.read()));
     // Every component of the query is stored in tables, so the query is dense and
     // `contiguous_iter` does not fail; were one made a sparse set, the error says so.
     let readable = sleepers.p0();
@@ -168,15 +172,27 @@ fn check_table(table: SleeperTable<'_, '_>, rows: &mut Vec<u8>, woken: &mut Vec<
 }
 
 /// The change ticks of the make-up columns some row of which was written.
-fn remade_ticks<'w>(made_of: MadeOfTable<'w, '_>) -> [Option<ContiguousComponentTicksRef<'w>>; 10] {
-    let (mass, density, scale, locks, collider, inertia, drag, angular_drag, parent, children) =
-        made_of;
+fn remade_ticks<'w>(made_of: MadeOfTable<'w, '_>) -> [Option<ContiguousComponentTicksRef<'w>>; 11] {
+    let (
+        mass,
+        density,
+        scale,
+        locks,
+        collider,
+        layers,
+        inertia,
+        drag,
+        angular_drag,
+        parent,
+        children,
+    ) = made_of;
     [
         written_ticks(mass),
         written_ticks(density),
         written_ticks(scale),
         written_ticks(locks),
         written_ticks(collider),
+        written_ticks(layers),
         written_ticks(inertia),
         written_ticks(drag),
         written_ticks(angular_drag),

@@ -109,6 +109,12 @@ impl Layers {
     pub const fn interacts_with(&self, other: &Self) -> bool {
         self.memberships.intersects(other.filters) && other.memberships.intersects(self.filters)
     }
+
+    /// Whether no layers at all interact with these (no membership, or no filter): a collider
+    /// with them touches nothing, so the broad phase need not keep it.
+    pub const fn interact_with_none(&self) -> bool {
+        self.memberships.0 == 0 || self.filters.0 == 0
+    }
 }
 
 #[cfg(test)]
@@ -129,6 +135,16 @@ mod tests {
                     }
                 }
             }
+        }
+    }
+
+    #[test]
+    fn layers_interact_with_none_iff_no_layers_of_3_bits_interact_with_them() {
+        let all =
+            || (0..8).flat_map(|m| (0..8).map(move |f| Layers::new(LayerMask(m), LayerMask(f))));
+        for a in all() {
+            let some = all().any(|b| a.interacts_with(&b));
+            assert_eq!(a.interact_with_none(), !some, "{a:?}");
         }
     }
 

@@ -334,7 +334,7 @@ type Write = fn(&mut EntityWorldMut);
 /// summary ticks, so this checks that no write goes unseen and that one write does not wake
 /// its table.
 #[test]
-fn each_of_17_writes_wakes_only_the_body_written_among_60_sleepers_in_three_tables() {
+fn each_of_19_writes_wakes_only_the_body_written_among_60_sleepers_in_three_tables() {
     let mut app = sleepy_app();
     let balls: Vec<Entity> = (0..60)
         .map(|i| {
@@ -347,7 +347,8 @@ fn each_of_17_writes_wakes_only_the_body_written_among_60_sleepers_in_three_tabl
                     e.insert(Tag);
                 }
                 _ => {
-                    e.insert((LinearDrag(0.1), Force(Vec3::ZERO), Mass(1.5)));
+                    let layers = CollisionLayers::default();
+                    e.insert((LinearDrag(0.1), Force(Vec3::ZERO), Mass(1.5), layers));
                 }
             }
             b
@@ -366,10 +367,11 @@ fn each_of_17_writes_wakes_only_the_body_written_among_60_sleepers_in_three_tabl
         urto::step(app.world_mut(), 1).unwrap();
         assert!(balls.iter().all(|&b| asleep(&app, b)), "unseen write {i}");
     }
-    // (ball, write): balls 20 to 35 and 50, rows of all three tables; a write to a component
-    // the ball has changes it in place (`Force`, `LinearDrag` and `Mass` on balls `i % 3 == 2`),
+    // (ball, write): balls 20 to 36, 50 and 53, rows of all three tables; a write to a component
+    // the ball has changes it in place (`Force`, `LinearDrag`, `Mass` and `CollisionLayers` on
+    // balls `i % 3 == 2`),
     // one it lacks is inserted (the ball moves to a table of its own).
-    let writes: [(usize, Write); 17] = [
+    let writes: [(usize, Write); 19] = [
         (20, |e| e.get_mut::<Position>().unwrap().0.x += 0.1),
         (21, |e| {
             e.get_mut::<Rotation>().unwrap().0 = Quat::from_rotation_z(0.3)
@@ -412,6 +414,12 @@ fn each_of_17_writes_wakes_only_the_body_written_among_60_sleepers_in_three_tabl
         }),
         (50, |e| {
             e.remove::<Mass>();
+        }),
+        (36, |e| {
+            e.insert(CollisionLayers::new(LayerMask::ALL, LayerMask::DEFAULT));
+        }),
+        (53, |e| {
+            e.remove::<CollisionLayers>();
         }),
     ];
     for (i, &(ball, write)) in writes.iter().enumerate() {

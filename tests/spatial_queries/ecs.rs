@@ -241,3 +241,72 @@ fn spatial_query_finds_the_nearest_collider_and_casts_a_box_with_a_filter() {
         (block, true, 0.0)
     );
 }
+
+/// Bodies whose layers interact with none are left out of the broad phase, and each way back
+/// in works within the step: layers written or removed, and a part below the root with layers
+/// of its own. Balls dropped from 2 m rest on the ground (centre at 0.5 m) or fall through it.
+#[test]
+fn bodies_whose_layers_interact_with_none_leave_the_broad_phase_and_come_back_within_1_step() {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    let none = CollisionLayers::new(LayerMask::NONE, LayerMask::NONE);
+    let unfiltered = CollisionLayers::new(LayerMask::ALL, LayerMask::NONE);
+    let world = app.world_mut();
+    world.spawn((Collider::half_space(Vec3::Z), Static));
+    let mut ball = |x: f32, layers: Option<CollisionLayers>| {
+        let mut e = world.spawn((
+            Collider::sphere(0.5),
+            Position::new(x, 0.0, 2.0),
+            Velocity::default(),
+        ));
+        if let Some(l) = layers {
+            e.insert(l);
+        }
+        e.id()
+    };
+    let ghost = ball(0.0, Some(none));
+    let given = ball(3.0, Some(unfiltered));
+    let unset = ball(6.0, Some(none));
+    let solid = ball(9.0, None);
+    let sleeper = ball(12.0, None);
+    let compound = ball(15.0, Some(none));
+    world.spawn((
+        Collider::sphere(0.5),
+        Position(Vec3::ZERO),
+        ChildOf(compound),
+    ));
+    let moving = |app: &App| {
+        let stats = app.world().resource::<PhysicsStats>();
+        stats.counter("broad_phase/moving_bodies").unwrap_or(-1.0)
+    };
+    urto::step(app.world_mut(), 5).unwrap();
+    assert_eq!(
+        moving(&app),
+        3.0,
+        "the solid ball, the sleeper, the compound"
+    );
+    app.world_mut()
+        .entity_mut(given)
+        .insert(CollisionLayers::default());
+    app.world_mut()
+        .entity_mut(unset)
+        .remove::<CollisionLayers>();
+    urto::step(app.world_mut(), 1).unwrap();
+    assert_eq!(moving(&app), 5.0);
+    urto::step(app.world_mut(), 150).unwrap();
+    let z = |app: &App, e| app.world().get::<Position>(e).unwrap().0.z;
+    for e in [given, unset, solid, sleeper, compound] {
+        assert!(
+            (z(&app, e) - 0.5).abs() < 0.01,
+            "{e:?} rests: {}",
+            z(&app, e)
+        );
+    }
+    assert!(z(&app, ghost) < -1.0, "{}", z(&app, ghost));
+    assert!(app.world().get::<Sleeping>(sleeper).is_some(), "asleep");
+    // A sleeper made a ghost wakes, leaves the broad phase and falls through the ground.
+    app.world_mut().entity_mut(sleeper).insert(none);
+    urto::step(app.world_mut(), 60).unwrap();
+    assert!(z(&app, sleeper) < -1.0, "{}", z(&app, sleeper));
+    assert_eq!(moving(&app), 4.0);
+}
