@@ -13,7 +13,9 @@
 //! started after `STEPS` steps, the pyramid's sag (its top box's drop), and bodies asleep.
 //!
 //! Run (from `peers/`): `cargo bench --bench pyramid 2> pyramid_sanity.txt`;
-//! `PEERS_PYRAMID_ROWS=40` for a larger one.
+//! `PEERS_PYRAMID_ROWS=40` for a larger one; `PEERS_PYRAMID_LAYERS=14` for the 3D
+//! pyramid instead (a square pyramid of 14 layers, 14 × 14 boxes at the bottom and one at the
+//! top: 1,015 boxes, 1 cm apart both ways).
 
 use bevy_app::App;
 use criterion::{
@@ -59,6 +61,34 @@ fn rows() -> u32 {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(20)
+}
+
+/// The scene's name and where each box starts: the 3D pyramid of `PEERS_PYRAMID_LAYERS`
+/// layers if set, else the 2D one of [`rows`] rows.
+fn scene() -> (String, Vec<Vec3>) {
+    let layers = std::env::var("PEERS_PYRAMID_LAYERS")
+        .ok()
+        .and_then(|s| s.parse().ok());
+    match layers {
+        Some(layers) => (format!("pyramid3d_{layers}_layers"), boxes_3d(layers)),
+        None => (format!("pyramid_{}_rows", rows()), boxes(rows())),
+    }
+}
+
+/// A square pyramid of `layers` layers, each box 1 cm from its neighbours both ways; the top
+/// box last (the sag is read from it).
+fn boxes_3d(layers: u32) -> Vec<Vec3> {
+    let mut out = Vec::new();
+    for layer in 0..layers {
+        let count = layers - layer;
+        let at = |k: u32| (k as f32 - (count - 1) as f32 * 0.5) * 2.0 * HALF * 1.01;
+        for i in 0..count {
+            for k in 0..count {
+                out.push(Vec3::new(at(i), at(k), HALF + 2.0 * HALF * layer as f32));
+            }
+        }
+    }
+    out
 }
 
 /// Where each box starts.
@@ -251,8 +281,7 @@ fn step_or_never(step: Option<u32>) -> String {
 }
 
 fn bench_pyramid(c: &mut Criterion) {
-    let rows = rows();
-    let start = boxes(rows);
+    let (name, start) = scene();
     let n = start.len();
 
     let mut default_run = None;
@@ -274,7 +303,7 @@ fn bench_pyramid(c: &mut Criterion) {
                 .count()
         };
         eprintln!(
-            "[sanity] pyramid {rows} rows ({n} boxes) {label} after {STEPS} steps: largest drift {:.1} mm, top sag {:.1} mm, boxes turned > 0.01 rad {turned}, asleep {}, all asleep from step {}",
+            "[sanity] {name} ({n} boxes) {label} after {STEPS} steps: largest drift {:.1} mm, top sag {:.1} mm, boxes turned > 0.01 rad {turned}, asleep {}, all asleep from step {}",
             drift * 1e3,
             sag * 1e3,
             v.asleep(),
@@ -288,7 +317,7 @@ fn bench_pyramid(c: &mut Criterion) {
         let all_asleep_at = run_watching_sleep(&mut r, |r| r.step(1), Rapier::asleep, n);
         let (drift, sag) = quality(&start, &r.positions());
         eprintln!(
-            "[sanity] pyramid {rows} rows ({n} boxes) {label} after {STEPS} steps: largest drift {:.1} mm, top sag {:.1} mm, asleep {}, all asleep from step {}",
+            "[sanity] {name} ({n} boxes) {label} after {STEPS} steps: largest drift {:.1} mm, top sag {:.1} mm, asleep {}, all asleep from step {}",
             drift * 1e3,
             sag * 1e3,
             r.asleep(),
@@ -298,7 +327,7 @@ fn bench_pyramid(c: &mut Criterion) {
     let stages = u.app.world().resource::<PhysicsStats>();
     eprintln!("[urto stages] last step: {}", stages_line(stages));
 
-    let mut group = c.benchmark_group(format!("pyramid_{rows}_rows_{STEPS}_steps"));
+    let mut group = c.benchmark_group(format!("{name}_{STEPS}_steps"));
     group
         .sample_size(10)
         .sampling_mode(SamplingMode::Flat)
