@@ -310,3 +310,52 @@ fn bodies_whose_layers_interact_with_none_leave_the_broad_phase_and_come_back_wi
     assert!(z(&app, sleeper) < -1.0, "{}", z(&app, sleeper));
     assert_eq!(moving(&app), 4.0);
 }
+
+/// Churn: 300 balls flying in zero gravity, a random third of them switched between layers
+/// that interact with none, layers that do and no layers at all every step, some while they
+/// sleep: the broad phase holds exactly the balls that can touch something after every step,
+/// and no ball's state turns NaN.
+#[test]
+fn layers_switched_every_step_for_200_steps_leave_the_broad_phase_exact_and_no_nan() {
+    let mut app = common::app();
+    let mut rng = Rng::new(23);
+    let none = CollisionLayers::new(LayerMask::NONE, LayerMask::ALL);
+    let world = app.world_mut();
+    let balls: Vec<Entity> = (0..300)
+        .map(|_| {
+            world
+                .spawn((
+                    Collider::sphere(0.3),
+                    Position(rng.vec3(-10.0, 10.0)),
+                    Velocity(rng.vec3(-3.0, 3.0) * (rng.below(2) as f32)),
+                ))
+                .id()
+        })
+        .collect();
+    for step in 0..200 {
+        for _ in 0..100 {
+            let mut e = app.world_mut().entity_mut(balls[rng.below(balls.len())]);
+            match rng.below(3) {
+                0 => e.insert(none),
+                1 => e.insert(CollisionLayers::default()),
+                _ => e.remove::<CollisionLayers>(),
+            };
+        }
+        urto::step(app.world_mut(), 1).unwrap();
+        let world = app.world();
+        let touching = balls
+            .iter()
+            .filter(|&&b| world.get::<CollisionLayers>(b).is_none_or(|l| *l != none))
+            .count();
+        let indexed = world
+            .resource::<PhysicsStats>()
+            .counter("broad_phase/moving_bodies");
+        assert_eq!(indexed, Some(touching as f64), "step {step}");
+        let finite = balls.iter().all(|&b| {
+            let p = world.get::<Position>(b).unwrap().0;
+            let v = world.get::<Velocity>(b).unwrap().0;
+            p.is_finite() && v.is_finite()
+        });
+        assert!(finite, "step {step}");
+    }
+}
