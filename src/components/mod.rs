@@ -344,7 +344,9 @@ pub struct Sensor;
 /// [`crate::spatial::layers`]): two colliders touch only when each is a member of a layer the
 /// other filters, and a [`SpatialQuery`](crate::plugins::SpatialQuery) sees colliders whose
 /// memberships meet its mask. Without it a collider is in the first layer and interacts with
-/// every layer (Avian's default).
+/// every layer (Avian's default). A body without parts whose layers interact with none (no
+/// membership or no filter) is kept out of the broad phase, at no cost there; writing its
+/// layers wakes it if it sleeps.
 ///
 /// ```
 /// # use urto::prelude::*;
