@@ -89,3 +89,30 @@ fn a_20_row_pyramid_of_210_boxes_stands_3_s_with_drift_under_1_cm_per_patch() {
     eprintln!("pyramid, per patch: drift {drift} m");
     assert!(drift < 0.01, "drift {drift} m");
 }
+
+/// A unit cube sliding on the ground slows at `μ g` (Coulomb) until it stops: its speed after
+/// `t` is `v₀ − μ g t`, per point and per patch, also where its points slide 8–33 cm a step.
+#[test]
+fn a_box_sliding_at_5_to_20_m_s_slows_at_mu_g_within_0_1_percent_per_point_and_per_patch() {
+    for model in [FrictionModel::PerPoint, PATCH] {
+        for (mu, v0) in [(0.5f32, 5.0f32), (0.2, 10.0), (0.5, 20.0)] {
+            let mut scene = Scene::default();
+            scene.solver.settings.friction = model;
+            let ground = scene.ground(Vec3::Z);
+            let cube = Shape::cuboid(Vec3::splat(0.5));
+            let b = scene.add(cube, Vec3::new(0.0, 0.0, 0.5), Quat::IDENTITY, 1.0);
+            for body in [ground, b] {
+                scene.bodies[body].friction = mu;
+            }
+            scene.run(0.5);
+            scene.bodies[b].v = Vec3::new(v0, 0.0, 0.0);
+            let t = 0.5;
+            scene.run(t);
+            let (v, expected) = (scene.bodies[b].v, v0 - mu * 9.81 * t);
+            assert!(
+                (v.x / expected - 1.0).abs() < 1e-3 && v.y.abs() < 1e-3,
+                "{model:?}, mu {mu}, from {v0} m/s: {v} after {t} s, Coulomb predicts {expected}"
+            );
+        }
+    }
+}
