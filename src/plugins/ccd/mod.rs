@@ -158,13 +158,15 @@ type Mover<'a> = (
     Has<Children>,
     Has<Ccd>,
 );
-type MovingRoot = (
+/// A root that may move: asleep or not ([`movers`] meets sleepers too).
+type AnyMovingRoot = (
     Without<Static>,
     Without<Sensor>,
     Without<Quarantined>,
     Without<ChildOf>,
-    Without<Sleeping>,
 );
+/// A root that moves in this substep.
+type MovingRoot = (AnyMovingRoot, Without<Sleeping>);
 
 /// Radius of the sphere swept for a body at `p`: its collider's bounding radius (exact for a
 /// ball); for a compound body, the sphere about `p` holding its whole volume (parts included).
@@ -185,6 +187,21 @@ fn sweep_radius(
         .filter(|r| r.is_finite())
 }
 
+/// The sphere swept for a body at `p` turned by `rotation`: about its centre of mass, holding
+/// the whole body (the [`sweep_radius`] sphere about `p`, grown by the centre's offset). Its
+/// centre, its radius and the body's local centre of mass; `None` as for [`sweep_radius`].
+fn centred_sphere(
+    (p, rotation, inertia): (Vec3, Quat, Option<&Inertia>),
+    bv: &BoundingVolume,
+    collider: Option<&Collider>,
+    compound: bool,
+) -> Option<(Vec3, f32, Vec3)> {
+    let radius = sweep_radius(p, bv, collider, compound)?;
+    let local_center = inertia.map_or(Vec3::ZERO, |i| i.local_center_of_mass);
+    let offset = rotation * local_center;
+    Some((p + offset, radius + offset.length(), local_center))
+}
+
 fn record_sweep_starts(
     bodies: Query<(Mover, Option<&ComputedMass>), MovingRoot>,
     settings: Res<CcdSettings>,
@@ -200,21 +217,19 @@ fn record_sweep_starts(
         if mass.is_some_and(|m| m.inverse() == 0.0) {
             continue;
         }
-        let Some(radius) = sweep_radius(p.0, bv, collider, compound) else {
+        let rotation = Rotation::of(r);
+        let Some((from, radius, local_center)) =
+            centred_sphere((p.0, rotation, inertia), bv, collider, compound)
+        else {
             continue;
         };
-        let local_center = inertia.map_or(Vec3::ZERO, |i| i.local_center_of_mass);
-        let rotation = Rotation::of(r);
-        let offset = rotation * local_center;
-        // The sphere about the origin holding the body, grown to be about the centre of mass.
-        let radius = radius + offset.length();
         let fast = settings
             .auto_speed_ratio
             .is_some_and(|k| v.0.length() * dt > k * radius);
         if marked || fast {
             scratch.starts.push(SweepStart {
                 body,
-                from: p.0 + offset,
+                from,
                 radius,
                 local_center,
                 rotation,

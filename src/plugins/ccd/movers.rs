@@ -22,7 +22,7 @@
 //! and a sort of those whose boxes meet the swept ones.
 
 use super::parts::{LayeredParts, NodePose, meeting_parts, push_children};
-use super::{Mover, Obstacle, SweepStart, moves_into, sweep_radius};
+use super::{AnyMovingRoot, Mover, Obstacle, SweepStart, centred_sphere, moves_into};
 use crate::bounding::Aabb;
 use crate::bvh::QueryScratch;
 use crate::ccd::{
@@ -75,13 +75,6 @@ pub(super) struct MoverTable {
     fast_bodies: Vec<Entity>,
 }
 
-type AnyMovingRoot = (
-    Without<Static>,
-    Without<Sensor>,
-    Without<Quarantined>,
-    Without<ChildOf>,
-);
-
 /// A fast body joins the sweeps against moving bodies when it moves more than this share of
 /// its sweep's radius in the substep. Two bodies each moving less cannot pass through each other
 /// within one (their boxes, grown by their motion over the step, are paired by the broad phase
@@ -133,28 +126,22 @@ pub(super) fn gather_movers(
     t.fast_bodies.sort_unstable();
     let reach = t.boxes.iter().fold(Aabb::EMPTY, |union, b| union.union(b));
     for ((body, (p, r, inertia, _), v, bv, collider, compound, _), asleep) in &bodies {
-        let Some(radius) = sweep_radius(p.0, bv, collider, compound) else {
+        let rotation = Rotation::of(r);
+        let Some((center, radius, _)) =
+            centred_sphere((p.0, rotation, inertia), bv, collider, compound)
+        else {
             continue;
-        };
-        let local_center = inertia.map_or(Vec3::ZERO, |i| i.local_center_of_mass);
-        // Most bodies hold their centre of mass at their origin: no turn to apply.
-        let offset = if local_center == Vec3::ZERO {
-            Vec3::ZERO
-        } else {
-            Rotation::of(r) * local_center
         };
         // A sleeper is held still; the others moved by their last velocity.
         let displacement = if asleep { Vec3::ZERO } else { v.0 * dt };
-        let center = p.0 + offset;
-        let swept = Aabb::from_points([center - displacement, center]);
-        let swept = swept.expanded(radius + offset.length());
+        let swept = Aabb::from_points([center - displacement, center]).expanded(radius);
         // Most bodies are far from every fast one (a box with a NaN meets nothing either).
         if !swept.intersects(&reach) || t.fast_bodies.binary_search(&body).is_ok() {
             continue;
         }
         t.others.push(Other {
             body,
-            start: Isometry::new(p.0 - displacement, Rotation::of(r)),
+            start: Isometry::new(p.0 - displacement, rotation),
             displacement,
         });
         t.boxes.push(swept);
