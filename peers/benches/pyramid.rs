@@ -60,15 +60,18 @@ fn rows() -> u32 {
     std::env::var("PEERS_PYRAMID_ROWS")
         .ok()
         .and_then(|s| s.parse().ok())
+        .filter(|&n: &u32| n > 0)
         .unwrap_or(20)
 }
 
 /// The scene's name and where each box starts: the 3D pyramid of `PEERS_PYRAMID_LAYERS`
-/// layers if set, else the 2D one of [`rows`] rows.
+/// layers if set (to a positive number), else the 2D one of [`rows`] rows (a count of 0 or one
+/// that is not a number is ignored: an empty pyramid has no top to read the sag from).
 fn scene() -> (String, Vec<Vec3>) {
     let layers = std::env::var("PEERS_PYRAMID_LAYERS")
         .ok()
-        .and_then(|s| s.parse().ok());
+        .and_then(|s| s.parse().ok())
+        .filter(|&n: &u32| n > 0);
     match layers {
         Some(layers) => (format!("pyramid3d_{layers}_layers"), boxes_3d(layers)),
         None => (format!("pyramid_{}_rows", rows()), boxes(rows())),
