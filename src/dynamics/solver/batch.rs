@@ -40,14 +40,36 @@ impl RowX4 {
     }
 }
 
+/// A point's row as a batch keeps it: [`RowX4`] without the lever arms `r × d`, which each pass
+/// takes from the point's anchors ([`PointX4::row`]: the arithmetic of [`RowPart::new`], so the
+/// same bits). A third less to read per point and pass: the passes stream every batch from
+/// memory several times a substep, and once a scene's batches outgrow the processor's cache
+/// that traffic, not the arithmetic, sets the pace (a 3D pyramid of 1,015 boxes: 1.13× rapier's
+/// time at 204 boxes, 1.37× at 1,015, with 1.11× its instructions in both).
+#[derive(Clone, Copy, Debug, Default)]
+struct PointRowX4 {
+    turn: [Vec3x4; 2],
+    mass: Lanes,
+}
+
+impl PointRowX4 {
+    fn gather(rows: [&RowPart; LANES]) -> Self {
+        let side = |part: fn(&RowPart) -> Vec3| Vec3x4::gather(rows.map(part));
+        Self {
+            turn: [side(|r| r.turn[0]), side(|r| r.turn[1])],
+            mass: Lanes::new(rows.map(|r| r.mass)),
+        }
+    }
+}
+
 /// The `k`-th point of four contacts ([`ConstraintPoint`] per lane).
 #[derive(Clone, Copy, Debug, Default)]
 struct PointX4 {
     anchor_a: Vec3x4,
     anchor_b: Vec3x4,
     base_separation: Lanes,
-    normal_row: RowX4,
-    tangent_rows: [RowX4; 2],
+    normal_row: PointRowX4,
+    tangent_rows: [PointRowX4; 2],
     normal_impulse: Lanes,
     tangent_impulse: [Lanes; 2],
     max_normal_impulse: Lanes,
@@ -61,10 +83,10 @@ impl PointX4 {
             anchor_a: Vec3x4::gather(points.map(|p| p.anchor_a)),
             anchor_b: Vec3x4::gather(points.map(|p| p.anchor_b)),
             base_separation: each(|p| p.base_separation),
-            normal_row: RowX4::gather(points.map(|p| &p.normal_row)),
+            normal_row: PointRowX4::gather(points.map(|p| &p.normal_row)),
             tangent_rows: [
-                RowX4::gather(points.map(|p| &p.tangent_rows[0])),
-                RowX4::gather(points.map(|p| &p.tangent_rows[1])),
+                PointRowX4::gather(points.map(|p| &p.tangent_rows[0])),
+                PointRowX4::gather(points.map(|p| &p.tangent_rows[1])),
             ],
             normal_impulse: each(|p| p.normal_impulse),
             tangent_impulse: [
@@ -73,6 +95,16 @@ impl PointX4 {
             ],
             max_normal_impulse: each(|p| p.max_normal_impulse),
             relative_velocity: each(|p| p.relative_velocity),
+        }
+    }
+
+    /// `row` (along `dir`) with its lever arms `r_a × d`, `r_b × d`.
+    #[inline(always)]
+    fn row(&self, row: &PointRowX4, dir: Vec3x4) -> RowX4 {
+        RowX4 {
+            arm: [self.anchor_a.cross(dir), self.anchor_b.cross(dir)],
+            turn: row.turn,
+            mass: row.mass,
         }
     }
 
@@ -245,15 +277,12 @@ impl ContactBatch {
             self.warm_start_patch(&mut pair);
         } else {
             for p in &self.points[..self.count] {
-                pair.push(
-                    self.inverse_mass,
-                    self.normal,
-                    &p.normal_row,
-                    p.normal_impulse,
-                );
+                let row = p.row(&p.normal_row, self.normal);
+                pair.push(self.inverse_mass, self.normal, &row, p.normal_impulse);
                 for k in 0..2 {
-                    let (t, row) = (self.tangents[k], &p.tangent_rows[k]);
-                    pair.push(self.inverse_mass, t, row, p.tangent_impulse[k]);
+                    let t = self.tangents[k];
+                    let row = p.row(&p.tangent_rows[k], t);
+                    pair.push(self.inverse_mass, t, &row, p.tangent_impulse[k]);
                 }
             }
         }
@@ -265,8 +294,8 @@ impl ContactBatch {
     #[inline(never)]
     fn warm_start_patch(&self, pair: &mut PairVelocities) {
         for p in &self.points[..self.count] {
-            let row = &p.normal_row;
-            pair.push(self.inverse_mass, self.normal, row, p.normal_impulse);
+            let row = p.row(&p.normal_row, self.normal);
+            pair.push(self.inverse_mass, self.normal, &row, p.normal_impulse);
         }
         let patch = &self.patch;
         for k in 0..2 {
@@ -338,7 +367,7 @@ impl ContactBatch {
             let bias = apart.select(s * inv_h, push_out);
             let mass_scale = apart.select(one, soft_mass);
             let impulse_scale = apart.select(zero, soft_impulse);
-            let row = &p.normal_row;
+            let row = &p.row(&p.normal_row, n);
             let vn = pair.along(n, row);
             let impulse = -row.mass * (mass_scale * vn + bias) - impulse_scale * p.normal_impulse;
             let total = (p.normal_impulse + impulse).max(zero);
@@ -363,9 +392,9 @@ impl ContactBatch {
                 continue;
             }
             let limit = self.friction * p.normal_impulse;
-            let rows = &p.tangent_rows;
+            let rows = [0, 1].map(|k| p.row(&p.tangent_rows[k], self.tangents[k]));
             p.tangent_impulse = pair.solve_disc(
-                rows,
+                &rows,
                 self.tangents,
                 p.tangent_impulse,
                 (limit, self.inverse_mass),

@@ -67,11 +67,13 @@ impl Vec3x4 {
     }
 
     /// Per-lane dot product.
+    #[inline]
     pub fn dot(self, o: Self) -> Lanes {
         self.x * o.x + self.y * o.y + self.z * o.z
     }
 
     /// Per-lane cross product.
+    #[inline]
     pub fn cross(self, o: Self) -> Self {
         Self {
             x: self.y * o.z - o.y * self.z,
