@@ -9,157 +9,28 @@
 //! batch's largest, and the padding lanes of a short batch, hold zero rows: their impulses come
 //! out zero and change nothing, so no lane needs a mask.
 //!
-//! The batch is packed from the prepared constraints once per step and its impulses unpacked
-//! into them after the substeps, so restitution, warm-start storage and contact reports read
-//! the constraints as before.
+//! [`ContactBatches`] keeps a step's batches densely, in the order the passes read them: the
+//! batches' shared rows, then their points one after another (as many as each batch has, not
+//! room for the most), their friction rows per point in a list of their own (only the relax
+//! passes read them), or their friction per patch. What a lane holds, and why a point keeps no
+//! lever arms, is in [`batch_rows`](super::batch_rows).
+//!
+//! The batches are packed from the prepared constraints once per step and their impulses
+//! unpacked into them after the substeps, so restitution, warm-start storage and contact
+//! reports read the constraints as before.
 
+use super::batch_rows::{FrictionX4, PatchX4, PointX4};
 use super::body::BodyState;
-use super::contact::{ConstraintPoint, ContactConstraint, RowPart};
+use super::contact::{ConstraintPoint, ContactConstraint};
 use super::lanes::{LANES, Lanes, PairVelocities, Quatx4, Vec3x4, lanes_of};
 use super::patch_friction::PatchFriction;
 use crate::geometry::MAX_MANIFOLD_POINTS;
 use glam::Vec3;
 
-/// One row of four contacts' points ([`RowPart`] per lane).
-#[derive(Clone, Copy, Debug, Default)]
-struct RowX4 {
-    arm: [Vec3x4; 2],
-    turn: [Vec3x4; 2],
-    mass: Lanes,
-}
-
-impl RowX4 {
-    // Written out, not `[0, 1].map(..)`: the array map's drain stayed out of line.
-    fn gather(rows: [&RowPart; LANES]) -> Self {
-        let side = |part: fn(&RowPart) -> Vec3| Vec3x4::gather(rows.map(part));
-        Self {
-            arm: [side(|r| r.arm[0]), side(|r| r.arm[1])],
-            turn: [side(|r| r.turn[0]), side(|r| r.turn[1])],
-            mass: Lanes::new(rows.map(|r| r.mass)),
-        }
-    }
-}
-
-/// A point's row as a batch keeps it: [`RowX4`] without the lever arms `r × d`, which each pass
-/// takes from the point's anchors ([`PointX4::row`]: the arithmetic of [`RowPart::new`], so the
-/// same bits). A third less to read per point and pass: the passes stream every batch from
-/// memory several times a substep, and once a scene's batches outgrow the processor's cache
-/// that traffic, not the arithmetic, sets the pace (a 3D pyramid of 1,015 boxes: 1.13× rapier's
-/// time at 204 boxes, 1.37× at 1,015, with 1.11× its instructions in both).
-#[derive(Clone, Copy, Debug, Default)]
-struct PointRowX4 {
-    turn: [Vec3x4; 2],
-    mass: Lanes,
-}
-
-impl PointRowX4 {
-    fn gather(rows: [&RowPart; LANES]) -> Self {
-        let side = |part: fn(&RowPart) -> Vec3| Vec3x4::gather(rows.map(part));
-        Self {
-            turn: [side(|r| r.turn[0]), side(|r| r.turn[1])],
-            mass: Lanes::new(rows.map(|r| r.mass)),
-        }
-    }
-}
-
-/// The `k`-th point of four contacts ([`ConstraintPoint`] per lane).
-#[derive(Clone, Copy, Debug, Default)]
-struct PointX4 {
-    anchor_a: Vec3x4,
-    anchor_b: Vec3x4,
-    base_separation: Lanes,
-    normal_row: PointRowX4,
-    tangent_rows: [PointRowX4; 2],
-    normal_impulse: Lanes,
-    tangent_impulse: [Lanes; 2],
-    max_normal_impulse: Lanes,
-    relative_velocity: Lanes,
-}
-
-impl PointX4 {
-    fn gather(points: [&ConstraintPoint; LANES]) -> Self {
-        let each = |f: fn(&ConstraintPoint) -> f32| Lanes::new(points.map(f));
-        Self {
-            anchor_a: Vec3x4::gather(points.map(|p| p.anchor_a)),
-            anchor_b: Vec3x4::gather(points.map(|p| p.anchor_b)),
-            base_separation: each(|p| p.base_separation),
-            normal_row: PointRowX4::gather(points.map(|p| &p.normal_row)),
-            tangent_rows: [
-                PointRowX4::gather(points.map(|p| &p.tangent_rows[0])),
-                PointRowX4::gather(points.map(|p| &p.tangent_rows[1])),
-            ],
-            normal_impulse: each(|p| p.normal_impulse),
-            tangent_impulse: [
-                each(|p| p.tangent_impulse[0]),
-                each(|p| p.tangent_impulse[1]),
-            ],
-            max_normal_impulse: each(|p| p.max_normal_impulse),
-            relative_velocity: each(|p| p.relative_velocity),
-        }
-    }
-
-    /// `row` (along `dir`) with its lever arms `r_a × d`, `r_b × d`.
-    #[inline(always)]
-    fn row(&self, row: &PointRowX4, dir: Vec3x4) -> RowX4 {
-        RowX4 {
-            arm: [self.anchor_a.cross(dir), self.anchor_b.cross(dir)],
-            turn: row.turn,
-            mass: row.mass,
-        }
-    }
-
-    /// Writes lane `lane`'s impulses and approach speed into `point`.
-    fn scatter(&self, lane: usize, point: &mut ConstraintPoint) {
-        let at = |v: &Lanes| v.as_array()[lane];
-        point.normal_impulse = at(&self.normal_impulse);
-        point.tangent_impulse = self.tangent_impulse.each_ref().map(at);
-        point.max_normal_impulse = at(&self.max_normal_impulse);
-        point.relative_velocity = at(&self.relative_velocity);
-    }
-}
-
-/// Four contacts' [`PatchFriction`] (zero rows in lanes without one).
-#[derive(Clone, Copy, Debug, Default)]
-struct PatchX4 {
-    tangent_rows: [RowX4; 2],
-    twist_turn: [Vec3x4; 2],
-    twist_mass: Lanes,
-    arms: [Lanes; MAX_MANIFOLD_POINTS],
-    tangent_impulse: [Lanes; 2],
-    twist_impulse: Lanes,
-}
-
-impl PatchX4 {
-    fn gather(patches: [&PatchFriction; LANES]) -> Self {
-        let each = |f: fn(&PatchFriction) -> f32| Lanes::new(patches.map(f));
-        let side = |f: fn(&PatchFriction) -> Vec3| Vec3x4::gather(patches.map(f));
-        Self {
-            tangent_rows: [
-                RowX4::gather(patches.map(|p| &p.tangent_rows[0])),
-                RowX4::gather(patches.map(|p| &p.tangent_rows[1])),
-            ],
-            twist_turn: [side(|p| p.twist_turn[0]), side(|p| p.twist_turn[1])],
-            twist_mass: each(|p| p.twist_mass),
-            arms: std::array::from_fn(|k| Lanes::new(patches.map(|p| p.arms[k]))),
-            tangent_impulse: [
-                each(|p| p.tangent_impulse[0]),
-                each(|p| p.tangent_impulse[1]),
-            ],
-            twist_impulse: each(|p| p.twist_impulse),
-        }
-    }
-
-    /// Writes lane `lane`'s impulses into `patch`.
-    fn scatter(&self, lane: usize, patch: &mut PatchFriction) {
-        let at = |v: &Lanes| v.as_array()[lane];
-        patch.tangent_impulse = self.tangent_impulse.each_ref().map(at);
-        patch.twist_impulse = at(&self.twist_impulse);
-    }
-}
-
-/// Up to four contacts that move no common body, solved side by side.
+/// What the lanes of one batch share in every pass: their contacts, bodies, directions and
+/// softness, and where the batch's points lie in [`ContactBatches`].
 #[derive(Clone, Debug, Default)]
-pub struct ContactBatch {
+struct ContactBatch {
     /// Which constraint each lane holds (`None`: padding).
     constraints: [Option<u32>; LANES],
     /// Body slots of A and B per lane (padding lanes repeat lane 0's).
@@ -173,140 +44,139 @@ pub struct ContactBatch {
     /// `mass_scale · bias_rate`, `mass_scale`, `impulse_scale` of each lane's softness.
     softness: [Lanes; 3],
     closing_acceleration: Lanes,
-    points: [PointX4; MAX_MANIFOLD_POINTS],
-    /// The most points any lane has.
+    /// The batch's first point in [`ContactBatches::points`].
+    first: usize,
+    /// The most points any lane has: the batch's points in that list.
     count: usize,
+    /// Where the batch's friction rows are: its points' first in
+    /// [`ContactBatches::frictions`] (friction per point), or its entry in
+    /// [`ContactBatches::patches`] (friction per patch).
+    rows: FrictionRows,
     /// Whether any lane has friction.
     rubs: bool,
-    /// The lanes' friction per patch (zero where a lane has none).
-    patch: PatchX4,
-    /// Whether the lanes carry friction per patch, not per point (the solver's one
-    /// [`FrictionModel`](super::FrictionModel) for every contact).
-    patched: bool,
 }
 
-impl ContactBatch {
-    /// Packs `indices` (1 to [`LANES`] constraints moving no common body) of `constraints`;
-    /// `None` for no index, more than [`LANES`] or an index out of range.
-    pub fn pack(indices: &[u32], constraints: &[ContactConstraint]) -> Option<Self> {
-        let mut batch = Self::default();
-        batch.repack(indices, constraints).then_some(batch)
+/// Where a batch's friction rows are ([`ContactBatch::rows`]).
+#[derive(Clone, Copy, Debug, Default)]
+enum FrictionRows {
+    /// Per point, from this index of [`ContactBatches::frictions`] on.
+    PerPoint(usize),
+    /// Per patch, at this index of [`ContactBatches::patches`].
+    Patch(usize),
+    /// None yet (a batch not packed).
+    #[default]
+    Unpacked,
+}
+
+/// A step's contact batches, in solving order, stored densely (module docs).
+#[derive(Clone, Debug, Default)]
+pub struct ContactBatches {
+    batches: Vec<ContactBatch>,
+    points: Vec<PointX4>,
+    /// Friction per point: the rows of the points of the batches that have them.
+    frictions: Vec<FrictionX4>,
+    /// Friction per patch: the batches' that have it.
+    patches: Vec<PatchX4>,
+}
+
+impl ContactBatches {
+    /// Packs each group of `indices` (1 to [`LANES`] constraints moving no common body) of
+    /// `constraints` as one batch, in order, in place of what was held (the solver refills
+    /// last step's lists: building each batch anew and moving it in copied it twice). False
+    /// for a group with no index, more than [`LANES`] or an index out of range: the batches
+    /// then hold the groups before it.
+    pub fn pack<'a>(
+        &mut self,
+        groups: impl IntoIterator<Item = &'a [u32]>,
+        constraints: &[ContactConstraint],
+    ) -> bool {
+        let mut filled = Filled::default();
+        let mut packed = true;
+        for indices in groups {
+            if !self.push(&mut filled, indices, constraints) {
+                packed = false;
+                break;
+            }
+        }
+        self.batches.truncate(filled.batches);
+        self.points.truncate(filled.points);
+        self.frictions.truncate(filled.frictions);
+        self.patches.truncate(filled.patches);
+        packed
     }
 
-    /// [`Self::pack`] into this batch, in place (the solver refills last step's batches: a
-    /// batch is a few kilobytes, and building one to move it into the list copied it twice);
-    /// false, the batch left as it was, where `pack` gives `None`. Only the points some lane
-    /// has are gathered: the passes never read past the batch's point count.
-    pub fn repack(&mut self, indices: &[u32], constraints: &[ContactConstraint]) -> bool {
-        let Some((lanes, first)) = lanes_of(indices, constraints) else {
-            return false;
-        };
-        let real = |l: usize| lanes[l].unwrap_or(first);
-        let each = |f: fn(&ContactConstraint) -> f32| {
-            Lanes::new(std::array::from_fn(|l| lanes[l].map_or(0.0, f)))
-        };
-        let vectors = |f: fn(&ContactConstraint) -> Vec3| {
-            Vec3x4::gather(std::array::from_fn(|l| lanes[l].map_or(Vec3::ZERO, f)))
-        };
-        self.constraints = std::array::from_fn(|l| indices.get(l).copied());
-        self.bodies = [
-            std::array::from_fn(|l| real(l).a as usize),
-            std::array::from_fn(|l| real(l).b as usize),
-        ];
-        self.writes =
-            [0, 1].map(|k| std::array::from_fn(|l| lanes[l].is_some_and(|c| c.dynamic[k])));
-        self.normal = vectors(|c| c.normal);
-        self.tangents = [vectors(|c| c.tangents[0]), vectors(|c| c.tangents[1])];
-        self.friction = each(|c| c.friction);
-        debug_assert!(
-            lanes.iter().flatten().all(|c| !c.translation_locked),
-            "contacts of a body locked along some translation axes are solved one at a time"
-        );
-        self.inverse_mass = [each(|c| c.inverse_mass[0].x), each(|c| c.inverse_mass[1].x)];
-        self.softness = [
-            each(|c| c.softness.mass_scale * c.softness.bias_rate),
-            each(|c| c.softness.mass_scale),
-            each(|c| c.softness.impulse_scale),
-        ];
-        self.closing_acceleration = each(|c| c.closing_acceleration);
-        self.count = lanes
-            .iter()
-            .flatten()
-            .map(|c| c.count as usize)
-            .max()
-            .unwrap_or(0);
-        debug_assert!(
-            self.count <= MAX_MANIFOLD_POINTS,
-            "prepare caps a contact's points"
-        );
-        let zero = ConstraintPoint::default();
-        for (k, point) in self.points[..self.count].iter_mut().enumerate() {
-            *point = PointX4::gather(std::array::from_fn(|l| match lanes[l] {
-                Some(c) if k < c.count as usize => &c.points[k],
-                _ => &zero,
-            }));
-        }
-        self.rubs = lanes.iter().flatten().any(|c| c.friction > 0.0);
-        self.patched = lanes.iter().flatten().any(|c| c.patch.is_some());
-        if self.patched {
-            let none = PatchFriction::default();
-            self.patch =
-                PatchX4::gather(lanes.map(|c| c.and_then(|c| c.patch.as_ref()).unwrap_or(&none)));
-        }
-        true
+    /// How many batches are held.
+    pub fn len(&self) -> usize {
+        self.batches.len()
+    }
+
+    /// True when no batch is held.
+    pub fn is_empty(&self) -> bool {
+        self.batches.is_empty()
     }
 
     /// Writes the impulses and approach speeds back into the constraints the lanes came from.
     pub fn unpack(&self, constraints: &mut [ContactConstraint]) {
-        for (lane, index) in self.constraints.iter().enumerate() {
-            let Some(index) = index else { continue };
-            let c = &mut constraints[*index as usize];
-            for (point, wide) in c.points[..c.count as usize].iter_mut().zip(&self.points) {
-                wide.scatter(lane, point);
-            }
-            if let Some(patch) = &mut c.patch {
-                self.patch.scatter(lane, patch);
+        for batch in &self.batches {
+            for (lane, index) in batch.constraints.iter().enumerate() {
+                let Some(index) = index else { continue };
+                let c = &mut constraints[*index as usize];
+                let mine = &mut c.points[..c.count as usize];
+                for (point, wide) in mine.iter_mut().zip(self.points_of(batch)) {
+                    wide.scatter(lane, point);
+                }
+                match batch.rows {
+                    FrictionRows::PerPoint(from) => {
+                        let frictions = &self.frictions[from..from + batch.count];
+                        for (point, wide) in mine.iter_mut().zip(frictions) {
+                            wide.scatter(lane, point);
+                        }
+                    }
+                    FrictionRows::Patch(at) => {
+                        if let Some(patch) = &mut c.patch {
+                            self.patches[at].scatter(lane, patch);
+                        }
+                    }
+                    FrictionRows::Unpacked => {}
+                }
             }
         }
     }
 
     /// Applies the accumulated impulses ([`ContactConstraint::warm_start`] per lane).
     pub fn warm_start(&self, states: &mut [BodyState]) {
-        let mut pair = PairVelocities::load(&self.bodies, states);
-        if self.patched {
-            self.warm_start_patch(&mut pair);
-        } else {
-            for p in &self.points[..self.count] {
-                let row = p.row(&p.normal_row, self.normal);
-                pair.push(self.inverse_mass, self.normal, &row, p.normal_impulse);
-                for k in 0..2 {
-                    let t = self.tangents[k];
-                    let row = p.row(&p.tangent_rows[k], t);
-                    pair.push(self.inverse_mass, t, &row, p.tangent_impulse[k]);
+        for batch in &self.batches {
+            let points = self.points_of(batch);
+            let mut pair = PairVelocities::load(&batch.bodies, states);
+            let normal = |pair: &mut PairVelocities, p: &PointX4| {
+                let row = p.row(&p.normal_row, batch.normal);
+                pair.push(batch.inverse_mass, batch.normal, &row, p.normal_impulse);
+            };
+            match batch.rows {
+                // Each point's normal, then its friction rows (the scalar rows' order).
+                FrictionRows::PerPoint(from) => {
+                    let frictions = &self.frictions[from..from + batch.count];
+                    for (p, f) in points.iter().zip(frictions) {
+                        normal(&mut pair, p);
+                        for k in 0..2 {
+                            let t = batch.tangents[k];
+                            let row = p.row(&f.rows[k], t);
+                            pair.push(batch.inverse_mass, t, &row, f.impulse[k]);
+                        }
+                    }
                 }
+                FrictionRows::Patch(at) => {
+                    points.iter().for_each(|p| normal(&mut pair, p));
+                    warm_start_patch(batch, &self.patches[at], &mut pair);
+                }
+                FrictionRows::Unpacked => points.iter().for_each(|p| normal(&mut pair, p)),
             }
+            pair.store(&batch.bodies, &batch.writes, states);
         }
-        pair.store(&self.bodies, &self.writes, states);
     }
 
-    /// The warm start of the normal rows and of a patch's friction (out of line, as
-    /// [`Self::solve_patch`]).
-    #[inline(never)]
-    fn warm_start_patch(&self, pair: &mut PairVelocities) {
-        for p in &self.points[..self.count] {
-            let row = p.row(&p.normal_row, self.normal);
-            pair.push(self.inverse_mass, self.normal, &row, p.normal_impulse);
-        }
-        let patch = &self.patch;
-        for k in 0..2 {
-            let (t, row) = (self.tangents[k], &patch.tangent_rows[k]);
-            pair.push(self.inverse_mass, t, row, patch.tangent_impulse[k]);
-        }
-        pair.twist(patch, patch.twist_impulse);
-    }
-
-    /// One pass over the rows ([`ContactConstraint::solve`] per lane; `flip` visits the points
-    /// backwards).
+    /// One pass over the batches ([`ContactConstraint::solve`] per lane; `flip` visits the
+    /// points backwards): biased (push-out, normal rows only) or relaxing (no bias, friction).
     pub fn solve(
         &mut self,
         states: &mut [BodyState],
@@ -315,125 +185,292 @@ impl ContactBatch {
         use_bias: bool,
         flip: bool,
     ) {
-        let mut pair = PairVelocities::load(&self.bodies, states);
-        self.solve_normals(&mut pair, states, inv_h, max_push_out, use_bias, flip);
-        if !use_bias && self.rubs {
-            if self.patched {
-                self.solve_patch(&mut pair);
-            } else {
-                self.solve_friction(&mut pair);
-            }
-        }
-        pair.store(&self.bodies, &self.writes, states);
-    }
-
-    /// The normal rows: speculative points close their gap, penetrating ones are pushed out
-    /// softly when `use_bias`.
-    fn solve_normals(
-        &mut self,
-        pair: &mut PairVelocities,
-        states: &[BodyState],
-        inv_h: f32,
-        max_push_out: f32,
-        use_bias: bool,
-        flip: bool,
-    ) {
-        let [slots_a, slots_b] = self.bodies;
-        let moved = Vec3x4::gather(slots_b.map(|i| states[i].delta_position))
-            - Vec3x4::gather(slots_a.map(|i| states[i].delta_position));
-        let dqa = Quatx4::gather(slots_a.map(|i| states[i].delta_rotation));
-        let dqb = Quatx4::gather(slots_b.map(|i| states[i].delta_rotation));
-        let (zero, one) = (Lanes::ZERO, Lanes::ONE);
-        let [bias_rate, soft_mass, soft_impulse] = if use_bias {
-            self.softness
-        } else {
-            [zero, one, zero]
+        let pass = Pass {
+            inv_h,
+            max_push_out,
+            use_bias,
+            flip,
         };
-        let (inv_h, most_push) = (Lanes::splat(inv_h), Lanes::splat(-max_push_out));
-        let n = self.normal;
-        // The normal in each body's rotation since the step's start, once for all points (see
-        // `ContactConstraint::solve`).
-        let (moved, na, nb) = (moved.dot(n), dqa.inverse_rotate(n), dqb.inverse_rotate(n));
-        for k in 0..self.count {
-            let i = if flip { self.count - 1 - k } else { k };
-            let p = &mut self.points[i];
-            let s = p.base_separation + moved + p.anchor_b.dot(nb) - p.anchor_a.dot(na);
-            let apart = s.simd_gt(zero);
-            let push_out = if use_bias {
-                (bias_rate * s).max(most_push)
-            } else {
-                zero
-            };
-            let bias = apart.select(s * inv_h, push_out);
-            let mass_scale = apart.select(one, soft_mass);
-            let impulse_scale = apart.select(zero, soft_impulse);
-            let row = &p.row(&p.normal_row, n);
-            let vn = pair.along(n, row);
-            let impulse = -row.mass * (mass_scale * vn + bias) - impulse_scale * p.normal_impulse;
-            let total = (p.normal_impulse + impulse).max(zero);
-            pair.push(self.inverse_mass, n, row, total - p.normal_impulse);
-            let first = p.max_normal_impulse.simd_eq(zero) & total.simd_gt(zero);
-            if first.any() {
-                let speed = impact_speed(vn, s, self.closing_acceleration);
-                p.relative_velocity = first.select(speed, p.relative_velocity);
+        for batch in &self.batches {
+            let points = &mut self.points[batch.first..batch.first + batch.count];
+            let mut pair = PairVelocities::load(&batch.bodies, states);
+            solve_normals(batch, points, &mut pair, states, &pass);
+            if !use_bias && batch.rubs {
+                match batch.rows {
+                    FrictionRows::PerPoint(from) => {
+                        let frictions = &mut self.frictions[from..from + batch.count];
+                        solve_friction(batch, points, frictions, &mut pair);
+                    }
+                    FrictionRows::Patch(at) => {
+                        solve_patch(batch, points, &mut self.patches[at], &mut pair);
+                    }
+                    FrictionRows::Unpacked => {}
+                }
             }
-            p.normal_impulse = total;
-            p.max_normal_impulse = p.max_normal_impulse.max(total);
+            pair.store(&batch.bodies, &batch.writes, states);
         }
     }
 
-    /// Coulomb friction at each point: both tangent rows clamped together to the disc `μ λ_n`.
-    fn solve_friction(&mut self, pair: &mut PairVelocities) {
-        let zero = Lanes::ZERO;
-        for p in &mut self.points[..self.count] {
-            let [old0, old1] = p.tangent_impulse;
-            let idle = p.normal_impulse.simd_eq(zero) & old0.simd_eq(zero) & old1.simd_eq(zero);
-            if idle.all() {
-                continue;
-            }
-            let limit = self.friction * p.normal_impulse;
-            let rows = [0, 1].map(|k| p.row(&p.tangent_rows[k], self.tangents[k]));
-            p.tangent_impulse = pair.solve_disc(
-                &rows,
-                self.tangents,
-                p.tangent_impulse,
-                (limit, self.inverse_mass),
-            );
-        }
+    /// The points of `batch`.
+    fn points_of(&self, batch: &ContactBatch) -> &[PointX4] {
+        &self.points[batch.first..batch.first + batch.count]
     }
 
-    /// Friction per patch ([`PatchFriction`]): the twist, then the tangent disc at the centre,
-    /// within `μ Σλ_i d_i` and `μ Σλ_i`. Kept out of line: inlined, it changed how the
-    /// per-point passes were compiled (+4 % instructions on a pyramid).
-    #[inline(never)]
-    fn solve_patch(&mut self, pair: &mut PairVelocities) {
-        let zero = Lanes::ZERO;
-        let patch = &mut self.patch;
-        let (mut sum, mut moment) = (zero, zero);
-        for (p, arm) in self.points[..self.count].iter().zip(patch.arms) {
-            sum += p.normal_impulse;
-            moment += p.normal_impulse * arm;
+    /// Packs `indices` as the next batch at the lists' `filled` ends, overwriting what lies
+    /// there (module docs).
+    fn push(
+        &mut self,
+        filled: &mut Filled,
+        indices: &[u32],
+        constraints: &[ContactConstraint],
+    ) -> bool {
+        let Some((lanes, first)) = lanes_of(indices, constraints) else {
+            return false;
+        };
+        let count = lanes
+            .iter()
+            .flatten()
+            .map(|c| c.count as usize)
+            .max()
+            .unwrap_or(0);
+        debug_assert!(
+            count <= MAX_MANIFOLD_POINTS,
+            "prepare caps a contact's points"
+        );
+        let patched = lanes.iter().flatten().any(|c| c.patch.is_some());
+        let rows = if patched {
+            FrictionRows::Patch(filled.patches)
+        } else {
+            FrictionRows::PerPoint(filled.frictions)
+        };
+        let header = ContactBatch::packed(indices, lanes, first, (filled.points, count), rows);
+        put(&mut self.batches, filled.batches, header);
+        filled.batches += 1;
+        let zero = ConstraintPoint::default();
+        let lane_points = |k: usize| {
+            std::array::from_fn(|l| match lanes[l] {
+                Some(c) if k < c.count as usize => &c.points[k],
+                _ => &zero,
+            })
+        };
+        for k in 0..count {
+            let points = lane_points(k);
+            put(&mut self.points, filled.points + k, PointX4::gather(points));
+            if !patched {
+                put(
+                    &mut self.frictions,
+                    filled.frictions + k,
+                    FrictionX4::gather(points),
+                );
+            }
         }
-        let (limit, twist_limit) = (self.friction * sum, self.friction * moment);
-        let old = patch.twist_impulse;
-        let [old0, old1] = patch.tangent_impulse;
-        let idle =
-            limit.simd_eq(zero) & old.simd_eq(zero) & old0.simd_eq(zero) & old1.simd_eq(zero);
-        if idle.all() {
-            return;
+        filled.points += count;
+        if patched {
+            let none = PatchFriction::default();
+            let patches = lanes.map(|c| c.and_then(|c| c.patch.as_ref()).unwrap_or(&none));
+            put(&mut self.patches, filled.patches, PatchX4::gather(patches));
+            filled.patches += 1;
+        } else {
+            filled.frictions += count;
         }
-        let wanted = old - patch.twist_mass * self.normal.dot(pair.wb - pair.wa);
-        let twist = wanted.max(-twist_limit).min(twist_limit);
-        pair.twist(patch, twist - old);
-        patch.twist_impulse = twist;
-        let rows = &patch.tangent_rows;
-        patch.tangent_impulse = pair.solve_disc(
+        true
+    }
+}
+
+/// How far [`ContactBatches::pack`] has filled each list.
+#[derive(Default)]
+struct Filled {
+    batches: usize,
+    points: usize,
+    frictions: usize,
+    patches: usize,
+}
+
+/// Writes `value` at `at` (overwriting, or appending at the end).
+fn put<T>(list: &mut Vec<T>, at: usize, value: T) {
+    match list.get_mut(at) {
+        Some(slot) => *slot = value,
+        None => list.push(value),
+    }
+}
+
+/// What a pass over the batches is.
+struct Pass {
+    inv_h: f32,
+    max_push_out: f32,
+    use_bias: bool,
+    flip: bool,
+}
+
+impl ContactBatch {
+    /// The shared rows of the constraints `lanes` (`indices` of them; `first` is lane 0's),
+    /// their `count` points from `first_point` on, their friction `rows`.
+    fn packed(
+        indices: &[u32],
+        lanes: [Option<&ContactConstraint>; LANES],
+        first: &ContactConstraint,
+        (first_point, count): (usize, usize),
+        rows: FrictionRows,
+    ) -> Self {
+        let real = |l: usize| lanes[l].unwrap_or(first);
+        let each = |f: fn(&ContactConstraint) -> f32| {
+            Lanes::new(std::array::from_fn(|l| lanes[l].map_or(0.0, f)))
+        };
+        let vectors = |f: fn(&ContactConstraint) -> Vec3| {
+            Vec3x4::gather(std::array::from_fn(|l| lanes[l].map_or(Vec3::ZERO, f)))
+        };
+        debug_assert!(
+            lanes.iter().flatten().all(|c| !c.translation_locked),
+            "contacts of a body locked along some translation axes are solved one at a time"
+        );
+        Self {
+            constraints: std::array::from_fn(|l| indices.get(l).copied()),
+            bodies: [
+                std::array::from_fn(|l| real(l).a as usize),
+                std::array::from_fn(|l| real(l).b as usize),
+            ],
+            writes: [0, 1].map(|k| std::array::from_fn(|l| lanes[l].is_some_and(|c| c.dynamic[k]))),
+            normal: vectors(|c| c.normal),
+            tangents: [vectors(|c| c.tangents[0]), vectors(|c| c.tangents[1])],
+            friction: each(|c| c.friction),
+            inverse_mass: [each(|c| c.inverse_mass[0].x), each(|c| c.inverse_mass[1].x)],
+            softness: [
+                each(|c| c.softness.mass_scale * c.softness.bias_rate),
+                each(|c| c.softness.mass_scale),
+                each(|c| c.softness.impulse_scale),
+            ],
+            closing_acceleration: each(|c| c.closing_acceleration),
+            first: first_point,
+            count,
             rows,
-            self.tangents,
-            patch.tangent_impulse,
-            (limit, self.inverse_mass),
+            rubs: lanes.iter().flatten().any(|c| c.friction > 0.0),
+        }
+    }
+}
+
+/// The warm start of a patch's friction (out of line, as [`solve_patch`]).
+#[inline(never)]
+fn warm_start_patch(batch: &ContactBatch, patch: &PatchX4, pair: &mut PairVelocities) {
+    for k in 0..2 {
+        let (t, row) = (batch.tangents[k], &patch.tangent_rows[k]);
+        pair.push(batch.inverse_mass, t, row, patch.tangent_impulse[k]);
+    }
+    pair.twist(patch, patch.twist_impulse);
+}
+
+/// The normal rows: speculative points close their gap, penetrating ones are pushed out
+/// softly when the pass is biased.
+fn solve_normals(
+    batch: &ContactBatch,
+    points: &mut [PointX4],
+    pair: &mut PairVelocities,
+    states: &[BodyState],
+    pass: &Pass,
+) {
+    let [slots_a, slots_b] = batch.bodies;
+    let moved = Vec3x4::gather(slots_b.map(|i| states[i].delta_position))
+        - Vec3x4::gather(slots_a.map(|i| states[i].delta_position));
+    let dqa = Quatx4::gather(slots_a.map(|i| states[i].delta_rotation));
+    let dqb = Quatx4::gather(slots_b.map(|i| states[i].delta_rotation));
+    let (zero, one) = (Lanes::ZERO, Lanes::ONE);
+    let [bias_rate, soft_mass, soft_impulse] = if pass.use_bias {
+        batch.softness
+    } else {
+        [zero, one, zero]
+    };
+    let (inv_h, most_push) = (Lanes::splat(pass.inv_h), Lanes::splat(-pass.max_push_out));
+    let n = batch.normal;
+    // The normal in each body's rotation since the step's start, once for all points (see
+    // `ContactConstraint::solve`).
+    let (moved, na, nb) = (moved.dot(n), dqa.inverse_rotate(n), dqb.inverse_rotate(n));
+    let count = points.len();
+    for k in 0..count {
+        let i = if pass.flip { count - 1 - k } else { k };
+        let p = &mut points[i];
+        let s = p.base_separation + moved + p.anchor_b.dot(nb) - p.anchor_a.dot(na);
+        let apart = s.simd_gt(zero);
+        let push_out = if pass.use_bias {
+            (bias_rate * s).max(most_push)
+        } else {
+            zero
+        };
+        let bias = apart.select(s * inv_h, push_out);
+        let mass_scale = apart.select(one, soft_mass);
+        let impulse_scale = apart.select(zero, soft_impulse);
+        let row = &p.row(&p.normal_row, n);
+        let vn = pair.along(n, row);
+        let impulse = -row.mass * (mass_scale * vn + bias) - impulse_scale * p.normal_impulse;
+        let total = (p.normal_impulse + impulse).max(zero);
+        pair.push(batch.inverse_mass, n, row, total - p.normal_impulse);
+        let first = p.max_normal_impulse.simd_eq(zero) & total.simd_gt(zero);
+        if first.any() {
+            let speed = impact_speed(vn, s, batch.closing_acceleration);
+            p.relative_velocity = first.select(speed, p.relative_velocity);
+        }
+        p.normal_impulse = total;
+        p.max_normal_impulse = p.max_normal_impulse.max(total);
+    }
+}
+
+/// Coulomb friction at each point: both tangent rows clamped together to the disc `μ λ_n`.
+fn solve_friction(
+    batch: &ContactBatch,
+    points: &[PointX4],
+    frictions: &mut [FrictionX4],
+    pair: &mut PairVelocities,
+) {
+    let zero = Lanes::ZERO;
+    for (p, f) in points.iter().zip(frictions) {
+        let [old0, old1] = f.impulse;
+        let idle = p.normal_impulse.simd_eq(zero) & old0.simd_eq(zero) & old1.simd_eq(zero);
+        if idle.all() {
+            continue;
+        }
+        let limit = batch.friction * p.normal_impulse;
+        let rows = [0, 1].map(|k| p.row(&f.rows[k], batch.tangents[k]));
+        f.impulse = pair.solve_disc(
+            &rows,
+            batch.tangents,
+            f.impulse,
+            (limit, batch.inverse_mass),
         );
     }
+}
+
+/// Friction per patch ([`PatchFriction`]): the twist, then the tangent disc at the centre,
+/// within `μ Σλ_i d_i` and `μ Σλ_i`. Kept out of line: inlined, it changed how the per-point
+/// passes were compiled (+4 % instructions on a pyramid).
+#[inline(never)]
+fn solve_patch(
+    batch: &ContactBatch,
+    points: &[PointX4],
+    patch: &mut PatchX4,
+    pair: &mut PairVelocities,
+) {
+    let zero = Lanes::ZERO;
+    let (mut sum, mut moment) = (zero, zero);
+    for (p, arm) in points.iter().zip(patch.arms) {
+        sum += p.normal_impulse;
+        moment += p.normal_impulse * arm;
+    }
+    let (limit, twist_limit) = (batch.friction * sum, batch.friction * moment);
+    let old = patch.twist_impulse;
+    let [old0, old1] = patch.tangent_impulse;
+    let idle = limit.simd_eq(zero) & old.simd_eq(zero) & old0.simd_eq(zero) & old1.simd_eq(zero);
+    if idle.all() {
+        return;
+    }
+    let wanted = old - patch.twist_mass * batch.normal.dot(pair.wb - pair.wa);
+    let twist = wanted.max(-twist_limit).min(twist_limit);
+    pair.twist(patch, twist - old);
+    patch.twist_impulse = twist;
+    let rows = patch.tangent_rows;
+    patch.tangent_impulse = pair.solve_disc(
+        &rows,
+        batch.tangents,
+        patch.tangent_impulse,
+        (limit, batch.inverse_mass),
+    );
 }
 
 /// [`contact`](super::contact)'s `impact_speed` per lane: a speculative point approaching at
@@ -444,50 +481,6 @@ fn impact_speed(vn: Lanes, s: Lanes, closing: Lanes) -> Lanes {
     let faster =
         s.simd_gt(zero) & vn.simd_lt(zero) & squared.is_finite() & squared.simd_gt(vn * vn);
     faster.select(-squared.sqrt(), vn)
-}
-
-/// What a contact row reads of its bodies' velocities and adds to them.
-impl PairVelocities {
-    /// The rate of a row: `d·(v_b − v_a) + (r_b × d)·ω_b − (r_a × d)·ω_a`.
-    fn along(&self, dir: Vec3x4, row: &RowX4) -> Lanes {
-        dir.dot(self.vb - self.va) + row.arm[1].dot(self.wb) - row.arm[0].dot(self.wa)
-    }
-
-    /// An impulse `λ d` on B at its anchor, `−λ d` on A.
-    fn push(&mut self, inverse_mass: [Lanes; 2], dir: Vec3x4, row: &RowX4, lambda: Lanes) {
-        self.va = self.va - dir * (lambda * inverse_mass[0]);
-        self.wa = self.wa - row.turn[0] * lambda;
-        self.vb = self.vb + dir * (lambda * inverse_mass[1]);
-        self.wb = self.wb + row.turn[1] * lambda;
-    }
-
-    /// An angular impulse `λ n` on B, `−λ n` on A (a patch's twist row).
-    fn twist(&mut self, patch: &PatchX4, lambda: Lanes) {
-        self.wa = self.wa - patch.twist_turn[0] * lambda;
-        self.wb = self.wb + patch.twist_turn[1] * lambda;
-    }
-
-    /// Two tangent rows clamped together to the disc `|λ| ≤ limit`, as the scalar rows: the new
-    /// accumulated impulses from the `old` ones.
-    #[inline(always)]
-    fn solve_disc(
-        &mut self,
-        [r0, r1]: &[RowX4; 2],
-        [t0, t1]: [Vec3x4; 2],
-        [old0, old1]: [Lanes; 2],
-        (limit, inverse_mass): (Lanes, [Lanes; 2]),
-    ) -> [Lanes; 2] {
-        let (zero, one) = (Lanes::ZERO, Lanes::ONE);
-        let w0 = old0 - r0.mass * self.along(t0, r0);
-        let w1 = old1 - r1.mass * self.along(t1, r1);
-        let length = (w0 * w0 + w1 * w1).sqrt();
-        let clamped = length.simd_gt(limit) & length.simd_gt(zero);
-        let scale = clamped.select(limit / length, one);
-        let (new0, new1) = (w0 * scale, w1 * scale);
-        self.push(inverse_mass, t0, r0, new0 - old0);
-        self.push(inverse_mass, t1, r1, new1 - old1);
-        [new0, new1]
-    }
 }
 
 #[cfg(test)]

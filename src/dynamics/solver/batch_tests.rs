@@ -91,10 +91,10 @@ fn batch_against_scalar(model: FrictionModel) {
     }
     let mut batch_states = bodies.states.clone();
     let mut batched = constraints.clone();
-    let mut batch = ContactBatch::pack(&[0, 1, 2], &constraints).unwrap();
-    assert!(ContactBatch::pack(&[], &constraints).is_none());
-    assert!(ContactBatch::pack(&[0, 1, 2, 0, 1], &constraints).is_none());
-    assert!(ContactBatch::pack(&[0, 7], &constraints).is_none());
+    let mut batch = packed(&[&[0, 1, 2]], &constraints);
+    for refused in [&[][..], &[0, 1, 2, 0, 1], &[0, 7]] {
+        assert!(!ContactBatches::default().pack([refused], &constraints));
+    }
     batch.warm_start(&mut batch_states);
     batch.solve(&mut batch_states, 1.0 / h, push, true, true);
     batch.solve(&mut batch_states, 1.0 / h, push, false, true);
@@ -150,29 +150,45 @@ fn a_batch_repacked_over_a_fuller_one_solves_bit_for_bit_as_a_fresh_pack() {
     // The solver refills last step's batches in place: a batch whose lane 0 held four
     // points, refilled with contacts of two and one, must leave no trace of the old ones.
     let (bodies, constraints) = scene(FrictionModel::PerPoint);
-    let solve = |batch: &mut ContactBatch| {
+    let solve = |batch: &mut ContactBatches| {
         let mut states = bodies.states.clone();
         batch.warm_start(&mut states);
         batch.solve(&mut states, 240.0, 3.0, true, false);
         batch.solve(&mut states, 240.0, 3.0, false, true);
         states
     };
-    let mut reused = ContactBatch::pack(&[0], &constraints).unwrap();
-    assert!(reused.repack(&[1, 2], &constraints));
-    let mut fresh = ContactBatch::pack(&[1, 2], &constraints).unwrap();
+    let mut reused = packed(&[&[0]], &constraints);
+    assert!(reused.pack([&[1, 2][..]], &constraints));
+    let mut fresh = packed(&[&[1, 2]], &constraints);
     assert_eq!(solve(&mut reused), solve(&mut fresh));
-    let unpacked = |batch: &ContactBatch| {
+    let unpacked = |batch: &ContactBatches| {
         let mut out = constraints.clone();
         batch.unpack(&mut out);
         out
     };
     assert_eq!(unpacked(&reused), unpacked(&fresh));
     // Three lanes down to one: the lanes left over hold nothing of before.
-    let mut shrunk = ContactBatch::pack(&[0, 1, 2], &constraints).unwrap();
-    assert!(shrunk.repack(&[2], &constraints));
-    let mut single = ContactBatch::pack(&[2], &constraints).unwrap();
+    let mut shrunk = packed(&[&[0, 1, 2]], &constraints);
+    assert!(shrunk.pack([&[2][..]], &constraints));
+    let mut single = packed(&[&[2]], &constraints);
     assert_eq!(solve(&mut shrunk), solve(&mut single));
     assert_eq!(unpacked(&shrunk), unpacked(&single));
-    // A refused repack says so.
-    assert!(!reused.repack(&[9], &constraints));
+    // Two batches refilled over one, and one over two.
+    let mut grown = packed(&[&[0, 1]], &constraints);
+    assert!(grown.pack([&[2][..], &[0, 1]], &constraints));
+    let mut two = packed(&[&[2], &[0, 1]], &constraints);
+    assert_eq!(solve(&mut grown), solve(&mut two));
+    assert_eq!(unpacked(&grown), unpacked(&two));
+    assert!(two.pack([&[1][..]], &constraints));
+    assert_eq!(solve(&mut two), solve(&mut packed(&[&[1]], &constraints)));
+    // A refused pack says so, and keeps the groups before the refused one.
+    assert!(!reused.pack([&[2][..], &[9]], &constraints));
+    assert_eq!(reused.len(), 1);
+}
+
+/// The groups packed into fresh batches.
+fn packed(groups: &[&[u32]], constraints: &[ContactConstraint]) -> ContactBatches {
+    let mut batches = ContactBatches::default();
+    assert!(batches.pack(groups.iter().copied(), constraints));
+    batches
 }

@@ -7,7 +7,7 @@
 //!
 //! 1. **prepare** — contact rows with lever arms ([`ContactConstraint::prepare`]), seeded with
 //!    last step's impulses ([`WarmStartCache`]), then packed up to four at a time into
-//!    [`ContactBatch`]es of contacts that share no moving body ([`ordered_batches`]); joints
+//!    batches ([`ContactBatches`]) of contacts that share no moving body ([`ordered_batches`]); joints
 //!    seeded with theirs, held to what the speed and spin bounds allow
 //!    (`joint_list.rs`, `JointList::bound_impulses`), the free ball joints packed four at a
 //!    time the same way (`joint_batch.rs`);
@@ -62,6 +62,7 @@
 //! archetype or thread order).
 
 pub mod batch;
+mod batch_rows;
 pub mod body;
 pub mod contact;
 mod integrate;
@@ -81,7 +82,7 @@ pub mod warm_start;
 #[cfg(test)]
 mod scenarios;
 
-pub use batch::ContactBatch;
+pub use batch::ContactBatches;
 pub use body::{BodyInput, BodyParams, BodyState, SolverBodies};
 pub use contact::{ConstraintPoint, ContactConstraint, ContactInput, ContactPointInput};
 pub use joint::{
@@ -241,7 +242,7 @@ pub struct Solver {
     /// The constraints in batches that keep the key order's result.
     batching: OrderedBatches,
     /// The batched constraints, [`lanes::LANES`] at a time.
-    batches: Vec<ContactBatch>,
+    batches: ContactBatches,
     cache: WarmStartCache,
     /// Centres and velocities of the substep, for the springs.
     spring_state: (Vec<Vec3>, Vec<Vec3>),
@@ -340,9 +341,7 @@ impl Solver {
             }
         }
         self.joints.store();
-        for batch in &self.batches {
-            batch.unpack(&mut self.constraints);
-        }
+        self.batches.unpack(&mut self.constraints);
         for c in &mut self.constraints {
             c.restitute(&mut bodies.states, s.restitution_threshold);
         }
@@ -461,9 +460,7 @@ impl Solver {
 
     /// Applies every contact's accumulated impulses: the batches, then the rest.
     fn warm_start(&mut self, bodies: &mut SolverBodies, flip: bool) {
-        for batch in &self.batches {
-            batch.warm_start(&mut bodies.states);
-        }
+        self.batches.warm_start(&mut bodies.states);
         for &i in self.batching.one_by_one() {
             let c = &mut self.constraints[i as usize];
             c.flip = flip;
@@ -482,9 +479,8 @@ impl Solver {
         flip: bool,
     ) {
         let push = self.settings.max_push_out;
-        for batch in &mut self.batches {
-            batch.solve(&mut bodies.states, inv_h, push, use_bias, flip);
-        }
+        self.batches
+            .solve(&mut bodies.states, inv_h, push, use_bias, flip);
         for &i in self.batching.one_by_one() {
             self.constraints[i as usize].solve(&mut bodies.states, inv_h, push, use_bias);
         }
@@ -526,9 +522,8 @@ impl Solver {
         );
         self.batching.pack(&self.constraints, bodies.len());
         let constraints = &self.constraints;
-        self.batching.refill(&mut self.batches, |b, indices| {
-            b.repack(indices, constraints)
-        });
+        let packed = self.batches.pack(self.batching.batches(), constraints);
+        debug_assert!(packed, "the packing hands out 1 to 4 valid indices");
     }
 }
 

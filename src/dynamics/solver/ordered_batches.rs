@@ -264,15 +264,11 @@ mod tests {
             }
             let mut packing = OrderedBatches::default();
             packing.pack(&cs, 10);
-            let mut batches: Vec<_> = packing
-                .batches()
-                .filter_map(|b| crate::dynamics::solver::ContactBatch::pack(b, &cs))
-                .collect();
+            let mut batches = crate::dynamics::solver::ContactBatches::default();
+            assert!(batches.pack(packing.batches(), &cs));
             let mut states = bodies.states.clone();
             for use_bias in [true, false, false] {
-                for b in &mut batches {
-                    b.solve(&mut states, 1.0 / h, push, use_bias, false);
-                }
+                batches.solve(&mut states, 1.0 / h, push, use_bias, false);
             }
             for (s, b) in scalar_states.iter().zip(&states) {
                 assert!(
