@@ -11,7 +11,7 @@
 //! the pace (a 3D pyramid of boxes, awake: 1.13× rapier's time at 204 boxes but 1.37× at
 //! 1,015, with 1.11× its instructions in both, when a point took 816 bytes in one piece).
 
-use super::contact::{ConstraintPoint, RowPart};
+use super::contact::{ConstraintPoint, PointRow, RowPart};
 use super::lanes::{LANES, Lanes, PairVelocities, Vec3x4};
 use super::patch_friction::PatchFriction;
 use crate::geometry::MAX_MANIFOLD_POINTS;
@@ -46,8 +46,8 @@ pub(super) struct PointRowX4 {
 }
 
 impl PointRowX4 {
-    fn gather(rows: [&RowPart; LANES]) -> Self {
-        let side = |part: fn(&RowPart) -> Vec3| Vec3x4::gather(rows.map(part));
+    fn gather(rows: [&PointRow; LANES]) -> Self {
+        let side = |part: fn(&PointRow) -> Vec3| Vec3x4::gather(rows.map(part));
         Self {
             turn: [side(|r| r.turn[0]), side(|r| r.turn[1])],
             mass: Lanes::new(rows.map(|r| r.mass)),

@@ -35,6 +35,7 @@
 use super::body::{BodyParams, BodyState, same_on_every_axis};
 use super::patch_friction::{FrictionModel, PatchFriction};
 use super::rolling::RollingRows;
+pub use super::row::{PointRow, RowPart};
 use super::softness::Softness;
 use crate::geometry::MAX_MANIFOLD_POINTS;
 use glam::Vec3;
@@ -82,10 +83,10 @@ pub struct ConstraintPoint {
     pub anchor_b: Vec3,
     /// `s₀ − (r_b − r_a)·n` (see the module doc).
     pub base_separation: f32,
-    /// The normal row.
-    pub normal_row: RowPart,
+    /// The normal row (its lever arms from the anchors: [`Self::row`]).
+    pub normal_row: PointRow,
     /// The two friction rows.
-    pub tangent_rows: [RowPart; 2],
+    pub tangent_rows: [PointRow; 2],
     /// Accumulated normal impulse of the current substep (N·s).
     pub normal_impulse: f32,
     /// Accumulated friction impulses along the two tangents.
@@ -98,6 +99,15 @@ pub struct ConstraintPoint {
     /// impact, not the step's start, so a bounce does not lose the speed gravity added during
     /// the step before it.
     pub relative_velocity: f32,
+}
+
+impl ConstraintPoint {
+    /// `row` (along `dir`) with its lever arms `r_a × d`, `r_b × d`, taken from the anchors
+    /// (the bits [`RowPart::new`] stored: a point keeps no arms, see [`PointRow`]).
+    #[inline(always)]
+    pub fn row(&self, row: &PointRow, dir: Vec3) -> RowPart {
+        row.with_arms(self.anchor_a, self.anchor_b, dir)
+    }
 }
 
 /// A prepared contact: its rows and accumulated impulses.
@@ -144,44 +154,6 @@ pub struct ContactConstraint {
     /// `(a_b − a_a)·n` (m/s²), to carry a speculative point's approach speed on to the moment
     /// it touches.
     pub closing_acceleration: f32,
-}
-
-/// What one row of one point needs in the passes (Jolt's `AxisConstraintPart`, Box2D's
-/// per-point masses): for a direction `d` and anchors `r_a`, `r_b`, the lever arms `r × d`, the
-/// angular velocity changes per unit impulse `I⁻¹ (r × d)`, and `1/K`. Precomputed once per
-/// step, so a pass does no matrix product.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct RowPart {
-    /// `r_a × d`, `r_b × d`.
-    pub arm: [Vec3; 2],
-    /// `I_a⁻¹ (r_a × d)`, `I_b⁻¹ (r_b × d)`.
-    pub turn: [Vec3; 2],
-    /// `1/K`, `K = d·W_a d + d·W_b d + (r_a×d)·I_a⁻¹(r_a×d) + (r_b×d)·I_b⁻¹(r_b×d)` with
-    /// `W = diag(1/m per axis)` (`1/m_a + 1/m_b` for unit `d` without locks; 0 if immovable).
-    pub mass: f32,
-}
-
-impl RowPart {
-    /// The row along `dir` at anchors `ra`, `rb`; `linear` is its translational part
-    /// `d·W_a d + d·W_b d` (the same for every point of a contact, so computed once).
-    #[inline]
-    pub(super) fn new(
-        pa: &BodyParams,
-        pb: &BodyParams,
-        ra: Vec3,
-        rb: Vec3,
-        (dir, linear): (Vec3, f32),
-    ) -> Self {
-        let arm = [ra.cross(dir), rb.cross(dir)];
-        let turn = [pa.inverse_inertia * arm[0], pb.inverse_inertia * arm[1]];
-        let k = linear + arm[0].dot(turn[0]) + arm[1].dot(turn[1]);
-        let mass = if k > 0.0 && k.is_finite() {
-            1.0 / k
-        } else {
-            0.0
-        };
-        Self { arm, turn, mass }
-    }
 }
 
 /// Restitution within `0..=1`; a non-finite value (which would fling both bodies to infinity)
@@ -286,11 +258,11 @@ impl ContactConstraint {
                 anchor_a: ra,
                 anchor_b: rb,
                 base_separation: p.separation - (rb - ra).dot(n),
-                normal_row: RowPart::new(pa, pb, ra, rb, normal),
+                normal_row: PointRow::new(pa, pb, ra, rb, normal),
                 tangent_rows: if per_point {
-                    sides.map(|t| RowPart::new(pa, pb, ra, rb, t))
+                    sides.map(|t| PointRow::new(pa, pb, ra, rb, t))
                 } else {
-                    [RowPart::default(); 2]
+                    [PointRow::default(); 2]
                 },
                 relative_velocity: relative.dot(n),
                 ..Default::default()
@@ -338,15 +310,13 @@ impl ContactConstraint {
     pub fn warm_start(&self, states: &mut [BodyState]) {
         let mut pair = Pair::load(self, states);
         for cp in self.points() {
-            pair.push(self, self.normal, &cp.normal_row, cp.normal_impulse);
+            let normal = cp.row(&cp.normal_row, self.normal);
+            pair.push(self, self.normal, &normal, cp.normal_impulse);
             if self.patch.is_none() {
                 for k in 0..2 {
-                    pair.push(
-                        self,
-                        self.tangents[k],
-                        &cp.tangent_rows[k],
-                        cp.tangent_impulse[k],
-                    );
+                    let t = self.tangents[k];
+                    let row = cp.row(&cp.tangent_rows[k], t);
+                    pair.push(self, t, &row, cp.tangent_impulse[k]);
                 }
             }
         }
@@ -402,7 +372,7 @@ impl ContactConstraint {
             } else {
                 (0.0, 1.0, 0.0)
             };
-            let row = &cp.normal_row;
+            let row = &cp.row(&cp.normal_row, n);
             let vn = pair.along(n, row);
             let impulse = -row.mass * (mass_scale * vn + bias) - impulse_scale * cp.normal_impulse;
             let total = (cp.normal_impulse + impulse).max(0.0);
@@ -443,8 +413,9 @@ impl ContactConstraint {
                 continue;
             }
             let limit = self.friction * cp.normal_impulse;
+            let rows = [0, 1].map(|k| cp.row(&cp.tangent_rows[k], self.tangents[k]));
             cp.tangent_impulse = pair.solve_disc(
-                &cp.tangent_rows,
+                &rows,
                 self.tangents,
                 cp.tangent_impulse,
                 (limit, self.inverse_mass),
@@ -465,7 +436,7 @@ impl ContactConstraint {
             if cp.relative_velocity > -threshold || cp.max_normal_impulse == 0.0 {
                 continue;
             }
-            let row = &cp.normal_row;
+            let row = &cp.row(&cp.normal_row, n);
             let vn = pair.along(n, row);
             let impulse = -row.mass * (vn + e * cp.relative_velocity);
             let total = (cp.normal_impulse + impulse).max(0.0);

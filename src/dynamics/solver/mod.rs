@@ -76,6 +76,7 @@ pub mod lanes;
 pub mod ordered_batches;
 pub mod patch_friction;
 pub mod rolling;
+pub mod row;
 pub mod softness;
 pub mod warm_start;
 
