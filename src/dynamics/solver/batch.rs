@@ -22,19 +22,18 @@
 use super::batch_rows::{FrictionX4, PatchX4, PointX4};
 use super::body::BodyState;
 use super::contact::{ConstraintPoint, ContactConstraint};
-use super::lanes::{LANES, Lanes, PairVelocities, Quatx4, Vec3x4, lanes_of};
+use super::lanes::{LANES, Lanes, PairVelocities, Quatx4, Slots, Vec3x4, lanes_of};
 use super::patch_friction::PatchFriction;
 use crate::geometry::MAX_MANIFOLD_POINTS;
 use glam::Vec3;
 
-/// What the lanes of one batch share in every pass: their contacts, bodies, directions and
-/// softness, and where the batch's points lie in [`ContactBatches`].
+/// What the lanes of one batch share in every pass: their bodies, directions and softness, and
+/// where the batch's points lie in [`ContactBatches`] (which constraint each lane holds is kept
+/// apart, in [`ContactBatches::members`]: only unpacking reads it).
 #[derive(Clone, Debug, Default)]
 struct ContactBatch {
-    /// Which constraint each lane holds (`None`: padding).
-    constraints: [Option<u32>; LANES],
     /// Body slots of A and B per lane (padding lanes repeat lane 0's).
-    bodies: [[usize; LANES]; 2],
+    bodies: Slots,
     /// Whether the lane writes A's and B's velocities back (dynamic bodies of real lanes).
     writes: [[bool; LANES]; 2],
     normal: Vec3x4,
@@ -45,9 +44,9 @@ struct ContactBatch {
     softness: [Lanes; 3],
     closing_acceleration: Lanes,
     /// The batch's first point in [`ContactBatches::points`].
-    first: usize,
+    first: u32,
     /// The most points any lane has: the batch's points in that list.
-    count: usize,
+    count: u32,
     /// Where the batch's friction rows are: its points' first in
     /// [`ContactBatches::frictions`] (friction per point), or its entry in
     /// [`ContactBatches::patches`] (friction per patch).
@@ -60,9 +59,9 @@ struct ContactBatch {
 #[derive(Clone, Copy, Debug, Default)]
 enum FrictionRows {
     /// Per point, from this index of [`ContactBatches::frictions`] on.
-    PerPoint(usize),
+    PerPoint(u32),
     /// Per patch, at this index of [`ContactBatches::patches`].
-    Patch(usize),
+    Patch(u32),
     /// None yet (a batch not packed).
     #[default]
     Unpacked,
@@ -72,6 +71,8 @@ enum FrictionRows {
 #[derive(Clone, Debug, Default)]
 pub struct ContactBatches {
     batches: Vec<ContactBatch>,
+    /// Which constraint each lane of each batch holds (`None`: padding).
+    members: Vec<[Option<u32>; LANES]>,
     points: Vec<PointX4>,
     /// Friction per point: the rows of the points of the batches that have them.
     frictions: Vec<FrictionX4>,
@@ -99,6 +100,7 @@ impl ContactBatches {
             }
         }
         self.batches.truncate(filled.batches);
+        self.members.truncate(filled.batches);
         self.points.truncate(filled.points);
         self.frictions.truncate(filled.frictions);
         self.patches.truncate(filled.patches);
@@ -117,8 +119,8 @@ impl ContactBatches {
 
     /// Writes the impulses and approach speeds back into the constraints the lanes came from.
     pub fn unpack(&self, constraints: &mut [ContactConstraint]) {
-        for batch in &self.batches {
-            for (lane, index) in batch.constraints.iter().enumerate() {
+        for (batch, members) in self.batches.iter().zip(&self.members) {
+            for (lane, index) in members.iter().enumerate() {
                 let Some(index) = index else { continue };
                 let c = &mut constraints[*index as usize];
                 let mine = &mut c.points[..c.count as usize];
@@ -127,14 +129,14 @@ impl ContactBatches {
                 }
                 match batch.rows {
                     FrictionRows::PerPoint(from) => {
-                        let frictions = &self.frictions[from..from + batch.count];
+                        let frictions = &self.frictions[batch.range(from)];
                         for (point, wide) in mine.iter_mut().zip(frictions) {
                             wide.scatter(lane, point);
                         }
                     }
                     FrictionRows::Patch(at) => {
                         if let Some(patch) = &mut c.patch {
-                            self.patches[at].scatter(lane, patch);
+                            self.patches[at as usize].scatter(lane, patch);
                         }
                     }
                     FrictionRows::Unpacked => {}
@@ -155,7 +157,7 @@ impl ContactBatches {
             match batch.rows {
                 // Each point's normal, then its friction rows (the scalar rows' order).
                 FrictionRows::PerPoint(from) => {
-                    let frictions = &self.frictions[from..from + batch.count];
+                    let frictions = &self.frictions[batch.range(from)];
                     for (p, f) in points.iter().zip(frictions) {
                         normal(&mut pair, p);
                         for k in 0..2 {
@@ -167,7 +169,7 @@ impl ContactBatches {
                 }
                 FrictionRows::Patch(at) => {
                     points.iter().for_each(|p| normal(&mut pair, p));
-                    warm_start_patch(batch, &self.patches[at], &mut pair);
+                    warm_start_patch(batch, &self.patches[at as usize], &mut pair);
                 }
                 FrictionRows::Unpacked => points.iter().for_each(|p| normal(&mut pair, p)),
             }
@@ -192,17 +194,17 @@ impl ContactBatches {
             flip,
         };
         for batch in &self.batches {
-            let points = &mut self.points[batch.first..batch.first + batch.count];
+            let points = &mut self.points[batch.range(batch.first)];
             let mut pair = PairVelocities::load(&batch.bodies, states);
             solve_normals(batch, points, &mut pair, states, &pass);
             if !use_bias && batch.rubs {
                 match batch.rows {
                     FrictionRows::PerPoint(from) => {
-                        let frictions = &mut self.frictions[from..from + batch.count];
+                        let frictions = &mut self.frictions[batch.range(from)];
                         solve_friction(batch, points, frictions, &mut pair);
                     }
                     FrictionRows::Patch(at) => {
-                        solve_patch(batch, points, &mut self.patches[at], &mut pair);
+                        solve_patch(batch, points, &mut self.patches[at as usize], &mut pair);
                     }
                     FrictionRows::Unpacked => {}
                 }
@@ -213,7 +215,7 @@ impl ContactBatches {
 
     /// The points of `batch`.
     fn points_of(&self, batch: &ContactBatch) -> &[PointX4] {
-        &self.points[batch.first..batch.first + batch.count]
+        &self.points[batch.range(batch.first)]
     }
 
     /// Packs `indices` as the next batch at the lists' `filled` ends, overwriting what lies
@@ -239,12 +241,17 @@ impl ContactBatches {
         );
         let patched = lanes.iter().flatten().any(|c| c.patch.is_some());
         let rows = if patched {
-            FrictionRows::Patch(filled.patches)
+            FrictionRows::Patch(filled.patches as u32)
         } else {
-            FrictionRows::PerPoint(filled.frictions)
+            FrictionRows::PerPoint(filled.frictions as u32)
         };
-        let header = ContactBatch::packed(indices, lanes, first, (filled.points, count), rows);
+        let header = ContactBatch::packed(lanes, first, (filled.points as u32, count as u32), rows);
         put(&mut self.batches, filled.batches, header);
+        put(
+            &mut self.members,
+            filled.batches,
+            std::array::from_fn(|l| indices.get(l).copied()),
+        );
         filled.batches += 1;
         let zero = ConstraintPoint::default();
         let lane_points = |k: usize| {
@@ -303,13 +310,18 @@ struct Pass {
 }
 
 impl ContactBatch {
-    /// The shared rows of the constraints `lanes` (`indices` of them; `first` is lane 0's),
+    /// The batch's `count` entries of a list from index `from` on (its points, or its points'
+    /// friction rows).
+    fn range(&self, from: u32) -> std::ops::Range<usize> {
+        from as usize..(from + self.count) as usize
+    }
+
+    /// The shared rows of the constraints `lanes` (`first` is lane 0's),
     /// their `count` points from `first_point` on, their friction `rows`.
     fn packed(
-        indices: &[u32],
         lanes: [Option<&ContactConstraint>; LANES],
         first: &ContactConstraint,
-        (first_point, count): (usize, usize),
+        (first_point, count): (u32, u32),
         rows: FrictionRows,
     ) -> Self {
         let real = |l: usize| lanes[l].unwrap_or(first);
@@ -324,10 +336,9 @@ impl ContactBatch {
             "contacts of a body locked along some translation axes are solved one at a time"
         );
         Self {
-            constraints: std::array::from_fn(|l| indices.get(l).copied()),
             bodies: [
-                std::array::from_fn(|l| real(l).a as usize),
-                std::array::from_fn(|l| real(l).b as usize),
+                std::array::from_fn(|l| real(l).a),
+                std::array::from_fn(|l| real(l).b),
             ],
             writes: [0, 1].map(|k| std::array::from_fn(|l| lanes[l].is_some_and(|c| c.dynamic[k]))),
             normal: vectors(|c| c.normal),
@@ -368,10 +379,11 @@ fn solve_normals(
     pass: &Pass,
 ) {
     let [slots_a, slots_b] = batch.bodies;
-    let moved = Vec3x4::gather(slots_b.map(|i| states[i].delta_position))
-        - Vec3x4::gather(slots_a.map(|i| states[i].delta_position));
-    let dqa = Quatx4::gather(slots_a.map(|i| states[i].delta_rotation));
-    let dqb = Quatx4::gather(slots_b.map(|i| states[i].delta_rotation));
+    let state = |i: u32| &states[i as usize];
+    let moved = Vec3x4::gather(slots_b.map(|i| state(i).delta_position))
+        - Vec3x4::gather(slots_a.map(|i| state(i).delta_position));
+    let dqa = Quatx4::gather(slots_a.map(|i| state(i).delta_rotation));
+    let dqb = Quatx4::gather(slots_b.map(|i| state(i).delta_rotation));
     let (zero, one) = (Lanes::ZERO, Lanes::ONE);
     let [bias_rate, soft_mass, soft_impulse] = if pass.use_bias {
         batch.softness

@@ -13,7 +13,7 @@
 
 use super::body::BodyState;
 use super::joint::JointConstraint;
-use super::lanes::{LANES, Lanes, Mat3x4, PairVelocities, Quatx4, Vec3x4, lanes_of};
+use super::lanes::{LANES, Lanes, Mat3x4, PairVelocities, Quatx4, Slots, Vec3x4, lanes_of};
 use super::softness::Softness;
 use glam::{Mat3, Vec3};
 
@@ -23,7 +23,7 @@ pub(super) struct JointBatch {
     /// Which joint each lane holds (`None`: padding).
     joints: [Option<u32>; LANES],
     /// Body slots of A and B per lane (padding lanes repeat lane 0's).
-    bodies: [[usize; LANES]; 2],
+    bodies: Slots,
     /// Whether the lane writes A's and B's velocities back (dynamic bodies of real lanes).
     writes: [[bool; LANES]; 2],
     /// `1/m` per world axis of A and B.
@@ -52,7 +52,11 @@ impl JointBatch {
         let Some((lanes, first)) = lanes_of(indices, joints) else {
             return false;
         };
-        let real = |l: usize| lanes[l].unwrap_or(first).slots();
+        // Slots are u32 (`SolverBodies::push`).
+        let real = |l: usize| {
+            let (a, b) = lanes[l].unwrap_or(first).slots();
+            (a as u32, b as u32)
+        };
         self.joints = std::array::from_fn(|l| indices.get(l).copied());
         self.bodies = [
             std::array::from_fn(|l| real(l).0),
@@ -125,8 +129,9 @@ impl JointBatch {
     /// [`JointConstraint::refresh`] per lane).
     pub(super) fn refresh(&mut self, states: &[BodyState]) {
         let [a, b] = self.bodies;
-        let turn = |slots: [usize; LANES]| Quatx4::gather(slots.map(|i| states[i].delta_rotation));
-        let moved = |slots: [usize; LANES]| Vec3x4::gather(slots.map(|i| states[i].delta_position));
+        let state = |i: u32| &states[i as usize];
+        let turn = |slots: [u32; LANES]| Quatx4::gather(slots.map(|i| state(i).delta_rotation));
+        let moved = |slots: [u32; LANES]| Vec3x4::gather(slots.map(|i| state(i).delta_position));
         let r_a = turn(a).rotate(self.anchors[0]);
         let r_b = turn(b).rotate(self.anchors[1]);
         self.arms = [r_a, r_b];

@@ -180,6 +180,10 @@ pub fn lanes_of<'a, T>(indices: &[u32], items: &'a [T]) -> Option<([Option<&'a T
     Some((lanes, lanes[0]?))
 }
 
+/// The body slots of A and B per lane of a batch (u32, as the solver numbers its slots: half
+/// the bytes of `usize` in a header every pass reads).
+pub type Slots = [[u32; LANES]; 2];
+
 /// The velocities of a batch's two bodies per lane (a contact's or a joint's A and B), gathered
 /// from the solver's states and scattered back to the slots a lane may write.
 #[derive(Clone, Copy, Debug)]
@@ -196,33 +200,29 @@ pub struct PairVelocities {
 
 impl PairVelocities {
     /// The velocities of slots `[a, b]` per lane.
-    pub fn load([a, b]: &[[usize; LANES]; 2], states: &[BodyState]) -> Self {
+    pub fn load([a, b]: &Slots, states: &[BodyState]) -> Self {
+        let state = |i: u32| &states[i as usize];
         Self {
-            va: Vec3x4::gather(a.map(|i| states[i].linear_velocity)),
-            wa: Vec3x4::gather(a.map(|i| states[i].angular_velocity)),
-            vb: Vec3x4::gather(b.map(|i| states[i].linear_velocity)),
-            wb: Vec3x4::gather(b.map(|i| states[i].angular_velocity)),
+            va: Vec3x4::gather(a.map(|i| state(i).linear_velocity)),
+            wa: Vec3x4::gather(a.map(|i| state(i).angular_velocity)),
+            vb: Vec3x4::gather(b.map(|i| state(i).linear_velocity)),
+            wb: Vec3x4::gather(b.map(|i| state(i).angular_velocity)),
         }
     }
 
     /// Writes the velocities back to slots `bodies`, where `writes` allows (the dynamic bodies
     /// of real lanes: padding lanes repeat lane 0's slots, and static bodies keep theirs).
-    pub fn store(
-        self,
-        bodies: &[[usize; LANES]; 2],
-        writes: &[[bool; LANES]; 2],
-        states: &mut [BodyState],
-    ) {
+    pub fn store(self, bodies: &Slots, writes: &[[bool; LANES]; 2], states: &mut [BodyState]) {
         let (va, wa) = (self.va.to_vecs(), self.wa.to_vecs());
         let (vb, wb) = (self.vb.to_vecs(), self.wb.to_vecs());
         for lane in 0..LANES {
             if writes[0][lane] {
-                let s = &mut states[bodies[0][lane]];
+                let s = &mut states[bodies[0][lane] as usize];
                 s.linear_velocity = va[lane];
                 s.angular_velocity = wa[lane];
             }
             if writes[1][lane] {
-                let s = &mut states[bodies[1][lane]];
+                let s = &mut states[bodies[1][lane] as usize];
                 s.linear_velocity = vb[lane];
                 s.angular_velocity = wb[lane];
             }
