@@ -258,9 +258,9 @@ impl ContactConstraint {
                 anchor_a: ra,
                 anchor_b: rb,
                 base_separation: p.separation - (rb - ra).dot(n),
-                normal_row: PointRow::new(pa, pb, ra, rb, normal),
+                normal_row: RowPart::new(pa, pb, ra, rb, normal).into(),
                 tangent_rows: if per_point {
-                    sides.map(|t| PointRow::new(pa, pb, ra, rb, t))
+                    sides.map(|t| RowPart::new(pa, pb, ra, rb, t).into())
                 } else {
                     [PointRow::default(); 2]
                 },

@@ -49,8 +49,8 @@ impl RowPart {
     }
 }
 
-/// A point's row as a contact keeps it: [`RowPart`] without the lever arms, which
-/// [`Self::with_arms`] takes from the point's anchors (the same arithmetic as
+/// A point's row as a contact keeps it: [`RowPart`] without the lever arms (`From<RowPart>`),
+/// which [`Self::with_arms`] takes from the point's anchors (the same arithmetic as
 /// [`RowPart::new`], so the same bits).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PointRow {
@@ -60,20 +60,15 @@ pub struct PointRow {
     pub mass: f32,
 }
 
-impl PointRow {
-    /// The row along `dir` at anchors `ra`, `rb` ([`RowPart::new`] less the arms).
+impl From<RowPart> for PointRow {
+    /// The row less its lever arms.
     #[inline]
-    pub(super) fn new(
-        pa: &BodyParams,
-        pb: &BodyParams,
-        ra: Vec3,
-        rb: Vec3,
-        (dir, linear): (Vec3, f32),
-    ) -> Self {
-        let RowPart { turn, mass, .. } = RowPart::new(pa, pb, ra, rb, (dir, linear));
+    fn from(RowPart { turn, mass, .. }: RowPart) -> Self {
         Self { turn, mass }
     }
+}
 
+impl PointRow {
     /// The whole row along `dir` for anchors `ra`, `rb`.
     #[inline(always)]
     pub fn with_arms(&self, ra: Vec3, rb: Vec3, dir: Vec3) -> RowPart {
