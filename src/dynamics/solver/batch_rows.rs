@@ -9,7 +9,7 @@
 //! so the same bits). The passes stream every batch from memory several times a substep, and
 //! once a scene's batches outgrow the processor's cache that traffic, not the arithmetic, sets
 //! the pace (a 3D pyramid of boxes, awake: 1.13× rapier's time at 204 boxes but 1.37× at
-//! 1,015, with 1.11× its instructions in both, when a point took 816 bytes in one piece).
+//! 1,015, where it ran 1.11× rapier's instructions, when a point took 816 bytes in one piece).
 
 use super::contact::{ConstraintPoint, PointRow, RowPart};
 use super::lanes::{LANES, Lanes, PairVelocities, Vec3x4};
