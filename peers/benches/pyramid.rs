@@ -57,22 +57,22 @@ fn stages_line(stats: &PhysicsStats) -> String {
 }
 
 fn rows() -> u32 {
-    std::env::var("PEERS_PYRAMID_ROWS")
+    positive_env("PEERS_PYRAMID_ROWS").unwrap_or(20)
+}
+
+/// The positive count in environment variable `name` (none for 0 or a value that is not a
+/// number: an empty pyramid has no top to read the sag from).
+fn positive_env(name: &str) -> Option<u32> {
+    std::env::var(name)
         .ok()
         .and_then(|s| s.parse().ok())
         .filter(|&n: &u32| n > 0)
-        .unwrap_or(20)
 }
 
 /// The scene's name and where each box starts: the 3D pyramid of `PEERS_PYRAMID_LAYERS`
-/// layers if set (to a positive number), else the 2D one of [`rows`] rows (a count of 0 or one
-/// that is not a number is ignored: an empty pyramid has no top to read the sag from).
+/// layers if set (to a positive number), else the 2D one of [`rows`] rows.
 fn scene() -> (String, Vec<Vec3>) {
-    let layers = std::env::var("PEERS_PYRAMID_LAYERS")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .filter(|&n: &u32| n > 0);
-    match layers {
+    match positive_env("PEERS_PYRAMID_LAYERS") {
         Some(layers) => (format!("pyramid3d_{layers}_layers"), boxes_3d(layers)),
         None => (format!("pyramid_{}_rows", rows()), boxes(rows())),
     }

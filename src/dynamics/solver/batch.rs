@@ -30,7 +30,7 @@ use glam::Vec3;
 /// What the lanes of one batch share in every pass: their bodies, directions and softness, and
 /// where the batch's points lie in [`ContactBatches`] (which constraint each lane holds is kept
 /// apart, in [`ContactBatches::members`]: only unpacking reads it).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 struct ContactBatch {
     /// Body slots of A and B per lane (padding lanes repeat lane 0's).
     bodies: Slots,
@@ -56,15 +56,12 @@ struct ContactBatch {
 }
 
 /// Where a batch's friction rows are ([`ContactBatch::rows`]).
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug)]
 enum FrictionRows {
     /// Per point, from this index of [`ContactBatches::frictions`] on.
     PerPoint(u32),
     /// Per patch, at this index of [`ContactBatches::patches`].
     Patch(u32),
-    /// None yet (a batch not packed).
-    #[default]
-    Unpacked,
 }
 
 /// A step's contact batches, in solving order, stored densely (module docs).
@@ -139,7 +136,6 @@ impl ContactBatches {
                             self.patches[at as usize].scatter(lane, patch);
                         }
                     }
-                    FrictionRows::Unpacked => {}
                 }
             }
         }
@@ -151,8 +147,8 @@ impl ContactBatches {
             let points = self.points_of(batch);
             let mut pair = PairVelocities::load(&batch.bodies, states);
             let normal = |pair: &mut PairVelocities, p: &PointX4| {
-                let row = p.row(&p.normal_row, batch.normal);
-                pair.push(batch.inverse_mass, batch.normal, &row, p.normal_impulse);
+                let turn = &p.normal_row.turn;
+                pair.push(batch.inverse_mass, batch.normal, turn, p.normal_impulse);
             };
             match batch.rows {
                 // Each point's normal, then its friction rows (the scalar rows' order).
@@ -161,9 +157,8 @@ impl ContactBatches {
                     for (p, f) in points.iter().zip(frictions) {
                         normal(&mut pair, p);
                         for k in 0..2 {
-                            let t = batch.tangents[k];
-                            let row = p.row(&f.rows[k], t);
-                            pair.push(batch.inverse_mass, t, &row, f.impulse[k]);
+                            let (t, turn) = (batch.tangents[k], &f.rows[k].turn);
+                            pair.push(batch.inverse_mass, t, turn, f.impulse[k]);
                         }
                     }
                 }
@@ -171,7 +166,6 @@ impl ContactBatches {
                     points.iter().for_each(|p| normal(&mut pair, p));
                     warm_start_patch(batch, &self.patches[at as usize], &mut pair);
                 }
-                FrictionRows::Unpacked => points.iter().for_each(|p| normal(&mut pair, p)),
             }
             pair.store(&batch.bodies, &batch.writes, states);
         }
@@ -206,7 +200,6 @@ impl ContactBatches {
                     FrictionRows::Patch(at) => {
                         solve_patch(batch, points, &mut self.patches[at as usize], &mut pair);
                     }
-                    FrictionRows::Unpacked => {}
                 }
             }
             pair.store(&batch.bodies, &batch.writes, states);
@@ -364,7 +357,7 @@ impl ContactBatch {
 fn warm_start_patch(batch: &ContactBatch, patch: &PatchX4, pair: &mut PairVelocities) {
     for k in 0..2 {
         let (t, row) = (batch.tangents[k], &patch.tangent_rows[k]);
-        pair.push(batch.inverse_mass, t, row, patch.tangent_impulse[k]);
+        pair.push(batch.inverse_mass, t, &row.turn, patch.tangent_impulse[k]);
     }
     pair.twist(patch, patch.twist_impulse);
 }
@@ -413,7 +406,7 @@ fn solve_normals(
         let vn = pair.along(n, row);
         let impulse = -row.mass * (mass_scale * vn + bias) - impulse_scale * p.normal_impulse;
         let total = (p.normal_impulse + impulse).max(zero);
-        pair.push(batch.inverse_mass, n, row, total - p.normal_impulse);
+        pair.push(batch.inverse_mass, n, &row.turn, total - p.normal_impulse);
         let first = p.max_normal_impulse.simd_eq(zero) & total.simd_gt(zero);
         if first.any() {
             let speed = impact_speed(vn, s, batch.closing_acceleration);

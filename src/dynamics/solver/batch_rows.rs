@@ -22,7 +22,7 @@ use glam::Vec3;
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct RowX4 {
     arm: [Vec3x4; 2],
-    turn: [Vec3x4; 2],
+    pub turn: [Vec3x4; 2],
     pub mass: Lanes,
 }
 
@@ -41,7 +41,7 @@ impl RowX4 {
 /// A point's row as a batch keeps it: [`RowX4`] without the lever arms.
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct PointRowX4 {
-    turn: [Vec3x4; 2],
+    pub turn: [Vec3x4; 2],
     mass: Lanes,
 }
 
@@ -176,18 +176,19 @@ impl PairVelocities {
         dir.dot(self.vb - self.va) + row.arm[1].dot(self.wb) - row.arm[0].dot(self.wa)
     }
 
-    /// An impulse `λ d` on B at its anchor, `−λ d` on A.
+    /// An impulse `λ d` on B at its anchor, `−λ d` on A, through the row's angular velocity
+    /// changes per unit impulse `turn` (the lever arms are not needed).
     pub(super) fn push(
         &mut self,
         inverse_mass: [Lanes; 2],
         dir: Vec3x4,
-        row: &RowX4,
+        turn: &[Vec3x4; 2],
         lambda: Lanes,
     ) {
         self.va = self.va - dir * (lambda * inverse_mass[0]);
-        self.wa = self.wa - row.turn[0] * lambda;
+        self.wa = self.wa - turn[0] * lambda;
         self.vb = self.vb + dir * (lambda * inverse_mass[1]);
-        self.wb = self.wb + row.turn[1] * lambda;
+        self.wb = self.wb + turn[1] * lambda;
     }
 
     /// An angular impulse `λ n` on B, `−λ n` on A (a patch's twist row).
@@ -213,8 +214,8 @@ impl PairVelocities {
         let clamped = length.simd_gt(limit) & length.simd_gt(zero);
         let scale = clamped.select(limit / length, one);
         let (new0, new1) = (w0 * scale, w1 * scale);
-        self.push(inverse_mass, t0, r0, new0 - old0);
-        self.push(inverse_mass, t1, r1, new1 - old1);
+        self.push(inverse_mass, t0, &r0.turn, new0 - old0);
+        self.push(inverse_mass, t1, &r1.turn, new1 - old1);
         [new0, new1]
     }
 }

@@ -310,20 +310,18 @@ impl ContactConstraint {
     pub fn warm_start(&self, states: &mut [BodyState]) {
         let mut pair = Pair::load(self, states);
         for cp in self.points() {
-            let normal = cp.row(&cp.normal_row, self.normal);
-            pair.push(self, self.normal, &normal, cp.normal_impulse);
+            pair.push(self, self.normal, &cp.normal_row.turn, cp.normal_impulse);
             if self.patch.is_none() {
                 for k in 0..2 {
-                    let t = self.tangents[k];
-                    let row = cp.row(&cp.tangent_rows[k], t);
-                    pair.push(self, t, &row, cp.tangent_impulse[k]);
+                    let turn = &cp.tangent_rows[k].turn;
+                    pair.push(self, self.tangents[k], turn, cp.tangent_impulse[k]);
                 }
             }
         }
         if let Some(patch) = &self.patch {
             for k in 0..2 {
                 let (t, row) = (self.tangents[k], &patch.tangent_rows[k]);
-                pair.push(self, t, row, patch.tangent_impulse[k]);
+                pair.push(self, t, &row.turn, patch.tangent_impulse[k]);
             }
             pair.twist(patch, patch.twist_impulse);
         }
@@ -377,7 +375,7 @@ impl ContactConstraint {
             let impulse = -row.mass * (mass_scale * vn + bias) - impulse_scale * cp.normal_impulse;
             let total = (cp.normal_impulse + impulse).max(0.0);
             let applied = total - cp.normal_impulse;
-            pair.push_with(inverse_mass, n, row, applied);
+            pair.push_with(inverse_mass, n, &row.turn, applied);
             if cp.max_normal_impulse == 0.0 && total > 0.0 {
                 cp.relative_velocity = impact_speed(vn, s, closing);
             }
@@ -440,7 +438,7 @@ impl ContactConstraint {
             let vn = pair.along(n, row);
             let impulse = -row.mass * (vn + e * cp.relative_velocity);
             let total = (cp.normal_impulse + impulse).max(0.0);
-            pair.push(self, n, row, total - cp.normal_impulse);
+            pair.push(self, n, &row.turn, total - cp.normal_impulse);
             self.points[i].normal_impulse = total;
         }
         pair.store(self, states);
@@ -472,18 +470,19 @@ impl Pair {
         dir.dot(self.vb - self.va) + row.arm[1].dot(self.wb) - row.arm[0].dot(self.wa)
     }
 
-    /// An impulse `λ d` on B at its anchor, `−λ d` on A.
-    fn push(&mut self, c: &ContactConstraint, dir: Vec3, row: &RowPart, lambda: f32) {
-        self.push_with(c.inverse_mass, dir, row, lambda);
+    /// An impulse `λ d` on B at its anchor, `−λ d` on A, through the row's angular velocity
+    /// changes per unit impulse `turn` (`I⁻¹ (r × d)`; the lever arms are not needed).
+    fn push(&mut self, c: &ContactConstraint, dir: Vec3, turn: &[Vec3; 2], lambda: f32) {
+        self.push_with(c.inverse_mass, dir, turn, lambda);
     }
 
     /// [`Self::push`] with the two per-axis inverse masses given.
-    fn push_with(&mut self, inverse_mass: [Vec3; 2], dir: Vec3, row: &RowPart, lambda: f32) {
+    fn push_with(&mut self, inverse_mass: [Vec3; 2], dir: Vec3, turn: &[Vec3; 2], lambda: f32) {
         // `d (W λ)` per component: with one `1/m` per body exactly the old `d (λ/m)`.
         self.va -= dir * (inverse_mass[0] * lambda);
-        self.wa -= row.turn[0] * lambda;
+        self.wa -= turn[0] * lambda;
         self.vb += dir * (inverse_mass[1] * lambda);
-        self.wb += row.turn[1] * lambda;
+        self.wb += turn[1] * lambda;
     }
 
     /// Two tangent rows clamped together to the disc `|λ| ≤ limit` (Coulomb friction, at a
@@ -506,8 +505,8 @@ impl Pair {
             1.0
         };
         let (new0, new1) = (w0 * scale, w1 * scale);
-        self.push_with(inverse_mass, t0, r0, new0 - old0);
-        self.push_with(inverse_mass, t1, r1, new1 - old1);
+        self.push_with(inverse_mass, t0, &r0.turn, new0 - old0);
+        self.push_with(inverse_mass, t1, &r1.turn, new1 - old1);
         [new0, new1]
     }
 

@@ -198,7 +198,13 @@ fn centred_sphere(
 ) -> Option<(Vec3, f32, Vec3)> {
     let radius = sweep_radius(p, bv, collider, compound)?;
     let local_center = inertia.map_or(Vec3::ZERO, |i| i.local_center_of_mass);
-    let offset = rotation * local_center;
+    // Most bodies hold their centre of mass at their origin: no turn to apply (this runs for
+    // every moving body of every substep with a fast one).
+    let offset = if local_center == Vec3::ZERO {
+        Vec3::ZERO
+    } else {
+        rotation * local_center
+    };
     Some((p + offset, radius + offset.length(), local_center))
 }
 
