@@ -46,7 +46,7 @@ mod sort_sweep;
 
 pub use adaptive::AdaptiveSweep;
 pub use brute_force::BruteForce;
-pub use grid::{GridError, GridQueryStats, StaticGrid, StaticGridConfig};
+pub use grid::{GridError, GridQueryCache, GridQueryStats, StaticGrid, StaticGridConfig};
 pub use pair_tracking::{AxisBits, AxisTests, PairTracking};
 pub use regions::RegionSweep;
 pub use sap::IncrementalSap;

@@ -6,7 +6,10 @@
 //!   its segmented form, a sweep per cell of a grid), fed only the bodies whose volume
 //!   changed, so bodies at rest cost nothing.
 //! - Bounded static scenery is in a hashed uniform grid (the slides' "object vs static scene"):
-//!   indexed once, queried with each moving body's volume; statics never enter the sort.
+//!   indexed once, queried with each moving body's volume; statics never enter the sort. A
+//!   query keeps the statics met by a fattened volume ([`GridQueryCache`], Box2D's fat AABBs),
+//!   so a body still inside it next step filters that short list and hashes no cell: same
+//!   answer, a resting pile's grid queries for a fraction of the cost.
 //! - Unbounded scenery (grounds, walls) is paired with every moving body whose volume reaches
 //!   it: a half-space only with the bodies whose grown volume has a corner below its plane (a
 //!   ball in the middle of a box of six planes is paired with none), anything else unbounded
@@ -33,10 +36,10 @@
 
 use crate::bounding::Aabb;
 use crate::broad_phase::{
-    AdaptiveSweep, BodyKind, BroadPhase, ProxyId, StaticGrid, StaticGridConfig,
+    AdaptiveSweep, BodyKind, BroadPhase, GridQueryCache, GridQueryStats, ProxyId, StaticGrid,
+    StaticGridConfig,
 };
 use crate::components::*;
-use crate::geometry::{Isometry, Shape};
 use crate::plugins::core::PrepareIndex;
 use crate::plugins::hierarchy::HierarchyInstalled;
 use crate::plugins::proxy_table::{Proxy, ProxyTable};
@@ -50,8 +53,10 @@ use bevy_app::prelude::*;
 use bevy_ecs::change_detection::{CheckChangeTicks, Tick};
 use bevy_ecs::prelude::*;
 use bevy_ecs::system::SystemChangeTick;
-use glam::Vec3;
 use std::time::Instant;
+use world_plane::WorldPlane;
+
+mod world_plane;
 
 /// Makes a fresh moving-body broad phase.
 pub type BroadPhaseFactory = fn() -> Box<dyn BroadPhase + Send + Sync>;
@@ -89,36 +94,6 @@ pub struct BroadPhasePairs {
     pub pairs: Vec<(Entity, Entity)>,
 }
 
-/// An unbounded static half-space (a ground, a wall) in world space: the points `x` with
-/// `normal·x <= offset` are inside it.
-#[derive(Clone, Copy, Debug)]
-struct WorldPlane {
-    normal: Vec3,
-    offset: f32,
-}
-
-impl WorldPlane {
-    /// The plane of a half-space collider at `pose`; `None` for any other shape.
-    fn of(shape: &Shape, pose: &Isometry) -> Option<Self> {
-        let Shape::HalfSpace(h) = shape else {
-            return None;
-        };
-        let normal = pose.rotation * h.normal;
-        Some(Self {
-            normal,
-            offset: normal.dot(pose.translation),
-        })
-    }
-
-    /// Whether some point of `aabb` lies inside the half-space (its lowest corner along the
-    /// normal is at or below the plane). A NaN plane or box reaches (the pair is left to the
-    /// narrow phase, as before).
-    fn reaches(&self, aabb: &Aabb) -> bool {
-        let lowest = self.normal.dot(aabb.center()) - self.normal.abs().dot(aabb.half_extents());
-        lowest.partial_cmp(&self.offset) != Some(std::cmp::Ordering::Greater)
-    }
-}
-
 /// Whether a node among `children` or below them has a collider (`stack`: scratch; a deep
 /// `ChildOf` chain is walked without recursion).
 fn has_collider_below(
@@ -148,6 +123,9 @@ pub struct BroadPhaseIndex {
     static_batch: Vec<(ProxyId, Aabb)>,
     moving_batch: Vec<(ProxyId, Aabb, BodyKind)>,
     hits: Vec<u32>,
+    /// The statics each moving body's last grid query met, reused while it stays inside the
+    /// box they were found for (resting bodies query no cell).
+    grid_queries: GridQueryCache,
     /// The world planes of the unbounded statics that are half-spaces (in their order),
     /// taken each substep.
     planes: Vec<Option<WorldPlane>>,
@@ -178,6 +156,7 @@ impl BroadPhaseIndex {
             static_batch: Vec::new(),
             moving_batch: Vec::new(),
             hits: Vec::new(),
+            grid_queries: GridQueryCache::default(),
             planes: Vec::new(),
             fresh: true,
             grown_with: None,
@@ -561,7 +540,8 @@ fn find_candidate_pairs(
             .map(|p| (proxies.entity(p.a), proxies.entity(p.b))),
     );
     let moving_pairs = out.pairs.len();
-    let mut cells = 0usize;
+    let mut grid_work = GridQueryStats::default();
+    index.grid_queries.begin_round(&index.grid);
     if !index.grid.is_empty() || !proxies.unbounded().is_empty() {
         // Sleeping bodies are not paired with scenery: nothing moved.
         for id in proxies.awake_moving_ids() {
@@ -569,9 +549,10 @@ fn find_candidate_pairs(
                 continue;
             };
             if !index.grid.is_empty()
-                && let Ok(q) = index.grid.query(&aabb, &mut index.hits)
+                && let Ok(q) =
+                    (index.grid_queries).query(&mut index.grid, id, &aabb, &mut index.hits)
             {
-                cells += q.cells_visited;
+                grid_work += q;
                 out.pairs
                     .extend(index.hits.iter().map(|&s| (e, proxies.entity(s))));
             }
@@ -590,7 +571,14 @@ fn find_candidate_pairs(
         "broad_phase/static_pairs",
         (out.pairs.len() - moving_pairs) as f64,
     );
-    stats.set_counter("broad_phase/grid_cells_visited", cells as f64);
+    stats.set_counter(
+        "broad_phase/grid_cells_visited",
+        grid_work.cells_visited as f64,
+    );
+    stats.set_counter(
+        "broad_phase/grid_queries_reused",
+        grid_work.reused_queries as f64,
+    );
     stats.add_time(Stage::BroadPhase, start.elapsed());
     stats.count_run("broad_phase");
 }

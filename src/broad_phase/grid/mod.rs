@@ -10,6 +10,7 @@ mod cells;
 mod config;
 mod error;
 mod query;
+mod query_cache;
 mod stats;
 mod storage;
 
@@ -21,5 +22,6 @@ pub use config::{
     StaticGridConfig,
 };
 pub use error::GridError;
+pub use query_cache::{FAT_FRACTION, GridQueryCache};
 pub use stats::GridQueryStats;
 pub use storage::StaticGrid;

@@ -100,21 +100,52 @@ impl StaticGrid {
     ) -> Result<GridQueryStats, GridError> {
         check_aabb(query, None)?;
         out.clear();
+        let stats = self.collect_with(query, filter, |_, id| out.push(id));
+        out.sort_unstable();
+        Ok(stats)
+    }
+
+    /// Writes to `out` (cleared first) the slots of the objects whose AABB intersects `query`
+    /// (a box already checked), in ascending id order: what [`super::GridQueryCache`] keeps.
+    pub(super) fn intersecting_slots(
+        &mut self,
+        query: &Aabb,
+        out: &mut Vec<u32>,
+        scratch: &mut Vec<u64>,
+    ) -> GridQueryStats {
+        scratch.clear();
+        let stats = self.collect_with(query, Filter::Intersecting, |slot, id| {
+            scratch.push(u64::from(id) << 32 | u64::from(slot))
+        });
+        // Ids are distinct, so sorting the packed words sorts by id.
+        scratch.sort_unstable();
+        out.clear();
+        out.extend(scratch.iter().map(|&packed| packed as u32));
+        stats
+    }
+
+    /// Hands every object `filter` keeps to `emit` (its slot, then its id), once each, in no
+    /// particular order.
+    fn collect_with(
+        &mut self,
+        query: &Aabb,
+        filter: Filter,
+        mut emit: impl FnMut(u32, u32),
+    ) -> GridQueryStats {
         let mut stats = GridQueryStats::default();
-        self.collect_oversize(query, filter, out, &mut stats);
+        self.collect_oversize(query, filter, &mut emit, &mut stats);
         let touched = CellRange::of_aabb(query, self.inv_cell_size);
         if let Some(range) = self
             .occupied
             .and_then(|occupied| occupied.intersection(&touched))
         {
             if range.cell_count() > self.gridded_count as u128 {
-                self.scan_gridded(query, &range, filter, out, &mut stats);
+                self.scan_gridded(query, &range, filter, &mut emit, &mut stats);
             } else {
-                self.visit_cells(query, &range, filter, out, &mut stats);
+                self.visit_cells(query, &range, filter, &mut emit, &mut stats);
             }
         }
-        out.sort_unstable();
-        Ok(stats)
+        stats
     }
 
     /// Oversize objects are in no cell: every query reads them all.
@@ -122,7 +153,7 @@ impl StaticGrid {
         &self,
         query: &Aabb,
         filter: Filter,
-        out: &mut Vec<u32>,
+        emit: &mut impl FnMut(u32, u32),
         stats: &mut GridQueryStats,
     ) {
         stats.candidates_listed += self.oversize.len();
@@ -134,7 +165,7 @@ impl StaticGrid {
                     continue;
                 }
             }
-            out.push(object.id);
+            emit(slot, object.id);
         }
     }
 
@@ -144,7 +175,7 @@ impl StaticGrid {
         query: &Aabb,
         range: &CellRange,
         filter: Filter,
-        out: &mut Vec<u32>,
+        emit: &mut impl FnMut(u32, u32),
         stats: &mut GridQueryStats,
     ) {
         let generation = self.next_generation();
@@ -167,7 +198,7 @@ impl StaticGrid {
                         continue;
                     }
                 }
-                out.push(object.id);
+                emit(slot, object.id);
             }
         }
     }
@@ -180,7 +211,7 @@ impl StaticGrid {
         query: &Aabb,
         range: &CellRange,
         filter: Filter,
-        out: &mut Vec<u32>,
+        emit: &mut impl FnMut(u32, u32),
         stats: &mut GridQueryStats,
     ) {
         stats.object_scans += 1;
@@ -197,7 +228,8 @@ impl StaticGrid {
                 Filter::Candidates => cells.overlaps(range),
             };
             if keep {
-                out.push(self.objects[slot].id);
+                // Slots are numbered in u32 (see `insert_checked`).
+                emit(slot as u32, self.objects[slot].id);
             }
         }
     }

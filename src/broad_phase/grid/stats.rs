@@ -17,6 +17,8 @@ pub struct GridQueryStats {
     /// Queries that scanned every object instead of visiting cells, because they touched more
     /// cells than the grid holds objects.
     pub object_scans: usize,
+    /// Queries answered from a [`super::GridQueryCache`]'s kept list, without visiting cells.
+    pub reused_queries: usize,
 }
 
 impl AddAssign for GridQueryStats {
@@ -25,6 +27,7 @@ impl AddAssign for GridQueryStats {
         self.candidates_listed += other.candidates_listed;
         self.exact_tests += other.exact_tests;
         self.object_scans += other.object_scans;
+        self.reused_queries += other.reused_queries;
     }
 }
 
@@ -48,18 +51,21 @@ mod tests {
             candidates_listed: 2,
             exact_tests: 3,
             object_scans: 0,
+            reused_queries: 2,
         };
         let b = GridQueryStats {
             cells_visited: 10,
             candidates_listed: 20,
             exact_tests: 30,
             object_scans: 1,
+            reused_queries: 20,
         };
         let expected = GridQueryStats {
             cells_visited: 11,
             candidates_listed: 22,
             exact_tests: 33,
             object_scans: 1,
+            reused_queries: 22,
         };
         assert_eq!(a + b, expected);
         let mut c = a;

@@ -20,7 +20,7 @@
 //!   only by edits, is kept apart.
 //!   Removed slots are recycled, so removing or moving an object touches only its cells.
 //!
-//! Queries live in `grid_query.rs`.
+//! Queries live in `query.rs`, kept answers in `query_cache.rs`.
 
 use super::cell_hasher::CellHashBuilder;
 use super::cell_list::CellList;
@@ -34,6 +34,7 @@ use crate::bounding::Aabb;
 use glam::Vec3;
 use std::collections::HashMap;
 use std::mem::size_of;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Where a slot's object is indexed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -54,7 +55,7 @@ pub(super) struct SlotObject {
     pub(super) aabb: Aabb,
     /// The caller's id.
     pub(super) id: u32,
-    /// The last query generation that met this object (see `grid_query.rs`).
+    /// The last query generation that met this object (see `query.rs`).
     pub(super) stamp: u32,
 }
 
@@ -85,8 +86,18 @@ pub struct StaticGrid {
     /// object is left in cells), so queries skip the part of their range that cannot hold
     /// anything.
     pub(super) occupied: Option<CellRange>,
-    /// Stamp of the current query; see `grid_query.rs`.
+    /// Stamp of the current query; see `query.rs`.
     pub(super) generation: u32,
+    /// Names this grid's contents: see [`StaticGrid::revision`].
+    revision: u64,
+}
+
+/// The next revision any grid takes: one counter for all grids, so two grids (or one grid before
+/// and after an edit) never share a revision unless one is a clone of the other, unchanged.
+static NEXT_REVISION: AtomicU64 = AtomicU64::new(1);
+
+fn new_revision() -> u64 {
+    NEXT_REVISION.fetch_add(1, Ordering::Relaxed)
 }
 
 impl StaticGrid {
@@ -113,6 +124,7 @@ impl StaticGrid {
             gridded_count: 0,
             occupied: None,
             generation: 0,
+            revision: new_revision(),
         }
     }
 
@@ -172,6 +184,7 @@ impl StaticGrid {
         self.unplace(slot);
         self.placements[slot as usize] = Placement::Vacant;
         self.free_slots.push(slot);
+        self.revision = new_revision();
         Ok(self.objects[slot as usize].aabb)
     }
 
@@ -182,6 +195,7 @@ impl StaticGrid {
         let slot = *self.slot_of_id.get(&id).ok_or(GridError::UnknownId(id))?;
         let old = self.placements[slot as usize];
         self.objects[slot as usize].aabb = aabb;
+        self.revision = new_revision();
         let same_place = match (old, self.cell_range_if_gridded(&aabb)) {
             (Placement::Cells(before), Some(after)) => before == after,
             (Placement::Oversize { .. }, None) => true,
@@ -224,6 +238,13 @@ impl StaticGrid {
             self.placements[slot as usize],
             Placement::Oversize { .. }
         ))
+    }
+
+    /// A number naming the grid's contents: every edit (insert, update, remove) gives the grid
+    /// a new one, never used before by any grid, so whoever keeps an answer of this grid can
+    /// tell whether it still holds ([`super::GridQueryCache`]).
+    pub fn revision(&self) -> u64 {
+        self.revision
     }
 
     /// Size of a cell along x, y, z.
@@ -298,6 +319,7 @@ impl StaticGrid {
         };
         self.slot_of_id.insert(id, slot);
         self.place(slot);
+        self.revision = new_revision();
     }
 
     /// Lists the slot's object in its cells, or on the oversize list.
