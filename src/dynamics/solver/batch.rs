@@ -36,6 +36,10 @@ struct ContactBatch {
     bodies: Slots,
     /// Whether the lane writes A's and B's velocities back (dynamic bodies of real lanes).
     writes: [[bool; LANES]; 2],
+    /// Whether every lane's A (B) is still ([`ContactConstraint::still`]): its state is then
+    /// the rest state's constants, not gathered (a ground under resting bodies: the passes
+    /// load and store one body per lane, as rapier's one-body contact constraints do).
+    still: [bool; 2],
     normal: Vec3x4,
     tangents: [Vec3x4; 2],
     friction: Lanes,
@@ -145,7 +149,7 @@ impl ContactBatches {
     pub fn warm_start(&self, states: &mut [BodyState]) {
         for batch in &self.batches {
             let points = self.points_of(batch);
-            let mut pair = PairVelocities::load(&batch.bodies, states);
+            let mut pair = PairVelocities::load(&batch.bodies, batch.still, states);
             let normal = |pair: &mut PairVelocities, p: &PointX4| {
                 let turn = &p.normal_row.turn;
                 pair.push(batch.inverse_mass, batch.normal, turn, p.normal_impulse);
@@ -167,7 +171,7 @@ impl ContactBatches {
                     warm_start_patch(batch, &self.patches[at as usize], &mut pair);
                 }
             }
-            pair.store(&batch.bodies, &batch.writes, states);
+            pair.store(&batch.bodies, (batch.still, &batch.writes), states);
         }
     }
 
@@ -189,7 +193,7 @@ impl ContactBatches {
         };
         for batch in &self.batches {
             let points = &mut self.points[batch.range(batch.first)];
-            let mut pair = PairVelocities::load(&batch.bodies, states);
+            let mut pair = PairVelocities::load(&batch.bodies, batch.still, states);
             solve_normals(batch, points, &mut pair, states, &pass);
             if !use_bias && batch.rubs {
                 match batch.rows {
@@ -202,7 +206,7 @@ impl ContactBatches {
                     }
                 }
             }
-            pair.store(&batch.bodies, &batch.writes, states);
+            pair.store(&batch.bodies, (batch.still, &batch.writes), states);
         }
     }
 
@@ -334,6 +338,7 @@ impl ContactBatch {
                 std::array::from_fn(|l| real(l).b),
             ],
             writes: [0, 1].map(|k| std::array::from_fn(|l| lanes[l].is_some_and(|c| c.dynamic[k]))),
+            still: [0, 1].map(|k| lanes.iter().flatten().all(|c| c.still[k])),
             normal: vectors(|c| c.normal),
             tangents: [vectors(|c| c.tangents[0]), vectors(|c| c.tangents[1])],
             friction: each(|c| c.friction),
@@ -371,12 +376,20 @@ fn solve_normals(
     states: &[BodyState],
     pass: &Pass,
 ) {
-    let [slots_a, slots_b] = batch.bodies;
     let state = |i: u32| &states[i as usize];
-    let moved = Vec3x4::gather(slots_b.map(|i| state(i).delta_position))
-        - Vec3x4::gather(slots_a.map(|i| state(i).delta_position));
-    let dqa = Quatx4::gather(slots_a.map(|i| state(i).delta_rotation));
-    let dqb = Quatx4::gather(slots_b.map(|i| state(i).delta_rotation));
+    // A still side has not moved: the rest state's constants (the same bits as its states).
+    let motion = |k: usize| {
+        if batch.still[k] {
+            return (Vec3x4::ZERO, Quatx4::IDENTITY);
+        }
+        let slots = batch.bodies[k];
+        (
+            Vec3x4::gather(slots.map(|i| state(i).delta_position)),
+            Quatx4::gather(slots.map(|i| state(i).delta_rotation)),
+        )
+    };
+    let ((moved_a, dqa), (moved_b, dqb)) = (motion(0), motion(1));
+    let moved = moved_b - moved_a;
     let (zero, one) = (Lanes::ZERO, Lanes::ONE);
     let [bias_rate, soft_mass, soft_impulse] = if pass.use_bias {
         batch.softness

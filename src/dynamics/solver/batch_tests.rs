@@ -10,20 +10,47 @@ use glam::Quat;
 /// points, some apart (speculative) and some penetrating, carrying impulses from a warm
 /// start, with friction rows as `model` says.
 fn scene(model: FrictionModel) -> (SolverBodies, Vec<ContactConstraint>) {
+    scene_with(model, false)
+}
+
+/// [`scene`]; with `grounds`, bodies 1 and 3 (B of the first two contacts) are static and at
+/// rest, and body 5 is kinematic (immovable, moving).
+fn scene_with(model: FrictionModel, grounds: bool) -> (SolverBodies, Vec<ContactConstraint>) {
     let mut bodies = SolverBodies::default();
+    let ground = |i: usize| grounds && i % 2 == 1;
     for i in 0..6 {
         let f = i as f32;
-        bodies.push(BodyInput {
+        let dynamic = BodyInput {
             center: Vec3::new(f, 0.3 * f, 0.0),
             orientation: Quat::from_rotation_y(0.2 * f),
-            linear_velocity: Vec3::new(0.5 - f * 0.2, 0.1 * f, -1.0 + 0.3 * f),
+            // Towards the grounds (along the normals), or as the scene always was.
+            linear_velocity: Vec3::new(
+                0.5 - f * 0.2,
+                0.1 * f,
+                if grounds { 1.0 } else { -1.0 + 0.3 * f },
+            ),
             angular_velocity: Vec3::new(0.7, -0.2 * f, 0.4),
             inverse_mass: 1.0 / (1.0 + f),
             inverse_principal_inertia: Vec3::new(2.0, 3.0, 1.0 + f),
             ..Default::default()
+        };
+        bodies.push(match (ground(i), i) {
+            (true, 5) => BodyInput {
+                inverse_mass: 0.0,
+                inverse_principal_inertia: Vec3::ZERO,
+                ..dynamic
+            },
+            (true, _) => BodyInput {
+                center: dynamic.center,
+                ..Default::default()
+            },
+            _ => dynamic,
         });
     }
     for (i, s) in bodies.states.iter_mut().enumerate() {
+        if ground(i) && i != 5 {
+            continue;
+        }
         s.delta_position = Vec3::new(0.01, -0.02, 0.003 * i as f32);
         s.delta_rotation = Quat::from_rotation_z(0.01 * i as f32);
     }
@@ -184,6 +211,56 @@ fn a_batch_repacked_over_a_fuller_one_solves_bit_for_bit_as_a_fresh_pack() {
     // A refused pack says so, and keeps the groups before the refused one.
     assert!(!reused.pack([&[2][..], &[9]], &constraints));
     assert_eq!(reused.len(), 1);
+}
+
+#[test]
+fn a_still_ground_read_as_constants_gives_the_bits_of_gathering_it() {
+    for model in [FrictionModel::PerPoint, FrictionModel::Patch] {
+        let (bodies, constraints) = scene_with(model, true);
+        let still: Vec<_> = constraints.iter().map(|c| c.still).collect();
+        // Static at rest: still; kinematic and moving (body 5), or dynamic: not.
+        assert_eq!(still, [[false, true], [false, true], [false, false]]);
+        let gathered: Vec<_> = constraints
+            .iter()
+            .map(|c| ContactConstraint {
+                still: [false; 2],
+                ..*c
+            })
+            .collect();
+        for groups in [&[&[0u32, 1][..]][..], &[&[0, 1, 2]], &[&[1], &[2, 0]]] {
+            let run = |constraints: &[ContactConstraint]| {
+                let mut batch = packed(groups, constraints);
+                let mut states = bodies.states.clone();
+                batch.warm_start(&mut states);
+                for flip in [false, true] {
+                    batch.solve(&mut states, 240.0, 3.0, true, flip);
+                    batch.solve(&mut states, 240.0, 3.0, false, flip);
+                }
+                let mut out = constraints.to_vec();
+                batch.unpack(&mut out);
+                let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                let velocities: Vec<_> = states
+                    .iter()
+                    .map(|s| (bits(s.linear_velocity), bits(s.angular_velocity)))
+                    .collect();
+                (velocities, out)
+            };
+            let (fast, slow) = (run(&constraints), run(&gathered));
+            assert_eq!(fast.0, slow.0, "{model:?} {groups:?}");
+            for (f, s) in fast.1.iter().zip(&slow.1) {
+                assert_eq!(f.points(), s.points());
+                assert_eq!(f.patch, s.patch);
+            }
+            // The grounds kept their rest state; the dynamic bodies were pushed.
+            assert_eq!(fast.0[1], ([0; 3], [0; 3]));
+            assert_ne!(fast.0[0].0, bits3(bodies.states[0].linear_velocity));
+            assert!(fast.1[0].points().iter().any(|p| p.normal_impulse > 0.0));
+        }
+    }
+}
+
+fn bits3(v: Vec3) -> [u32; 3] {
+    v.to_array().map(f32::to_bits)
 }
 
 /// The groups packed into fresh batches.

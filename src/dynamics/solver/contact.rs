@@ -38,7 +38,7 @@ use super::rolling::RollingRows;
 pub use super::row::{PointRow, RowPart};
 use super::softness::Softness;
 use crate::geometry::MAX_MANIFOLD_POINTS;
-use glam::Vec3;
+use glam::{Quat, Vec3};
 
 /// One point of a contact as detection found it.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -145,6 +145,10 @@ pub struct ContactConstraint {
     pub translation_locked: bool,
     /// Whether A and B may be moved (kinematic and static bodies keep their velocities).
     pub dynamic: [bool; 2],
+    /// Whether A and B are immovable and at rest (velocities and motion since the step's start
+    /// all `+0.0`, no turn), as they stay for the whole step: a batch whose lanes all have such
+    /// a body on one side reads none of its state ([`ContactBatches`](super::batch)).
+    pub still: [bool; 2],
     /// The rolling-resistance rows (none unless the pair has a lever arm).
     pub rolling: RollingRows,
     /// The friction rows of the whole patch under [`FrictionModel::Patch`] (the points' own
@@ -154,6 +158,17 @@ pub struct ContactConstraint {
     /// `(a_b − a_a)·n` (m/s²), to carry a speculative point's approach speed on to the moment
     /// it touches.
     pub closing_acceleration: f32,
+}
+
+/// Whether a body's state is exactly the rest state (`+0.0` velocities and motion, the identity
+/// turn): bit for bit, so that a batch reading constants instead computes the same bits.
+fn at_rest(state: &BodyState) -> bool {
+    let zero = |v: Vec3| v.to_array().iter().all(|x| x.to_bits() == 0);
+    zero(state.linear_velocity)
+        && zero(state.angular_velocity)
+        && zero(state.delta_position)
+        && state.delta_rotation.to_array().map(f32::to_bits)
+            == Quat::IDENTITY.to_array().map(f32::to_bits)
 }
 
 /// Restitution within `0..=1`; a non-finite value (which would fling both bodies to infinity)
@@ -213,6 +228,7 @@ impl ContactConstraint {
             inverse_mass: [Vec3::ZERO; 2],
             translation_locked: false,
             dynamic: [false; 2],
+            still: [false; 2],
             rolling: RollingRows::default(),
             patch: None,
             closing_acceleration: 0.0,
@@ -282,6 +298,7 @@ impl ContactConstraint {
         self.translation_locked =
             !same_on_every_axis(pa.inverse_mass) || !same_on_every_axis(pb.inverse_mass);
         self.dynamic = [pa.dynamic, pb.dynamic];
+        self.still = [(pa, ia), (pb, ib)].map(|(p, i)| !p.dynamic && at_rest(&states[i]));
         self.closing_acceleration = (pb.linear_acceleration - pa.linear_acceleration).dot(n);
         self.rolling = RollingRows::new(
             input.rolling_resistance,

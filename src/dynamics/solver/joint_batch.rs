@@ -101,15 +101,15 @@ impl JointBatch {
 
     /// Applies the accumulated impulses.
     pub(super) fn warm_start(&self, states: &mut [BodyState]) {
-        let mut pair = PairVelocities::load(&self.bodies, states);
+        let mut pair = PairVelocities::load(&self.bodies, [false; 2], states);
         pair.push_point(self, self.impulse);
-        pair.store(&self.bodies, &self.writes, states);
+        pair.store(&self.bodies, ([false; 2], &self.writes), states);
     }
 
     /// One pass: biased (`soft` closes the gaps) or relaxing (rigid), as
     /// [`JointConstraint::solve_point`] per lane.
     pub(super) fn solve(&mut self, states: &mut [BodyState], soft: Softness, use_bias: bool) {
-        let mut pair = PairVelocities::load(&self.bodies, states);
+        let mut pair = PairVelocities::load(&self.bodies, [false; 2], states);
         let [r_a, r_b] = self.arms;
         let cdot = pair.vb + pair.wb.cross(r_b) - pair.va - pair.wa.cross(r_a);
         let soft = if use_bias { soft } else { Softness::RIGID };
@@ -122,7 +122,7 @@ impl JointBatch {
             - self.impulse * Lanes::splat(soft.impulse_scale);
         self.impulse = self.impulse + impulse;
         pair.push_point(self, impulse);
-        pair.store(&self.bodies, &self.writes, states);
+        pair.store(&self.bodies, ([false; 2], &self.writes), states);
     }
 
     /// Takes the rows where the bodies are now, from their motion since the step's start (as

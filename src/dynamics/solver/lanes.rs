@@ -138,6 +138,12 @@ pub struct Quatx4 {
 }
 
 impl Quatx4 {
+    /// The identity in every lane (the bits of `Quat::IDENTITY`).
+    pub const IDENTITY: Self = Self {
+        v: Vec3x4::ZERO,
+        w: Lanes::ONE,
+    };
+
     /// Lane `i` holds `q[i]`.
     #[inline]
     pub fn gather(q: [Quat; LANES]) -> Self {
@@ -199,32 +205,46 @@ pub struct PairVelocities {
 }
 
 impl PairVelocities {
-    /// The velocities of slots `[a, b]` per lane.
-    pub fn load([a, b]: &Slots, states: &[BodyState]) -> Self {
+    /// The velocities of slots `[a, b]` per lane; a `still` side (bodies at rest that nothing
+    /// moves, see [`ContactConstraint::still`](super::contact::ContactConstraint::still)) is
+    /// the zeros its states hold, not gathered.
+    pub fn load([a, b]: &Slots, still: [bool; 2], states: &[BodyState]) -> Self {
         let state = |i: u32| &states[i as usize];
-        Self {
-            va: Vec3x4::gather(a.map(|i| state(i).linear_velocity)),
-            wa: Vec3x4::gather(a.map(|i| state(i).angular_velocity)),
-            vb: Vec3x4::gather(b.map(|i| state(i).linear_velocity)),
-            wb: Vec3x4::gather(b.map(|i| state(i).angular_velocity)),
-        }
+        let side = |slots: &[u32; LANES], still: bool| {
+            if still {
+                (Vec3x4::ZERO, Vec3x4::ZERO)
+            } else {
+                (
+                    Vec3x4::gather(slots.map(|i| state(i).linear_velocity)),
+                    Vec3x4::gather(slots.map(|i| state(i).angular_velocity)),
+                )
+            }
+        };
+        let ((va, wa), (vb, wb)) = (side(a, still[0]), side(b, still[1]));
+        Self { va, wa, vb, wb }
     }
 
     /// Writes the velocities back to slots `bodies`, where `writes` allows (the dynamic bodies
-    /// of real lanes: padding lanes repeat lane 0's slots, and static bodies keep theirs).
-    pub fn store(self, bodies: &Slots, writes: &[[bool; LANES]; 2], states: &mut [BodyState]) {
-        let (va, wa) = (self.va.to_vecs(), self.wa.to_vecs());
-        let (vb, wb) = (self.vb.to_vecs(), self.wb.to_vecs());
-        for lane in 0..LANES {
-            if writes[0][lane] {
-                let s = &mut states[bodies[0][lane] as usize];
-                s.linear_velocity = va[lane];
-                s.angular_velocity = wa[lane];
+    /// of real lanes: padding lanes repeat lane 0's slots, and static bodies keep theirs); a
+    /// `still` side writes nothing.
+    pub fn store(
+        self,
+        bodies: &Slots,
+        (still, writes): ([bool; 2], &[[bool; LANES]; 2]),
+        states: &mut [BodyState],
+    ) {
+        let sides = [(self.va, self.wa), (self.vb, self.wb)];
+        for (k, (v, w)) in sides.into_iter().enumerate() {
+            if still[k] {
+                continue;
             }
-            if writes[1][lane] {
-                let s = &mut states[bodies[1][lane] as usize];
-                s.linear_velocity = vb[lane];
-                s.angular_velocity = wb[lane];
+            let (v, w) = (v.to_vecs(), w.to_vecs());
+            for lane in 0..LANES {
+                if writes[k][lane] {
+                    let s = &mut states[bodies[k][lane] as usize];
+                    s.linear_velocity = v[lane];
+                    s.angular_velocity = w[lane];
+                }
             }
         }
     }
