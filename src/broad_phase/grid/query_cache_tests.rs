@@ -99,6 +99,9 @@ fn answers_equal_direct_queries_over_300_rounds_of_motion_and_edits() {
     }
     // Most bodies barely move: most answers must come from kept lists.
     assert!(reused * 2 > queries, "{reused} of {queries} reused");
+    // Two rounds of lists at most, not 300: a few hundred bytes per key.
+    let bytes = cache.memory_bytes();
+    assert!(bytes > 0 && bytes < 64 * 1024, "{bytes} bytes");
 }
 
 #[test]

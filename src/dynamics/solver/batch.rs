@@ -7,7 +7,9 @@
 //! scalar solver's arithmetic ([`ContactConstraint::solve`], whose module derives the rows) in
 //! every lane, and scatters the velocities back. A lane whose contact has fewer points than the
 //! batch's largest, and the padding lanes of a short batch, hold zero rows: their impulses come
-//! out zero and change nothing, so no lane needs a mask.
+//! out zero and change nothing, so no lane needs a mask. A side whose body is static and at
+//! rest in every lane (the ground under resting bodies) is read as the rest state's constants,
+//! not gathered nor scattered: rapier's one-body contact constraints, the same bits.
 //!
 //! [`ContactBatches`] keeps a step's batches densely, in the order the passes read them: the
 //! batches' shared rows, then their points one after another (as many as each batch has, not
