@@ -22,6 +22,7 @@ use super::error::{GridError, check_aabb};
 use super::stats::GridQueryStats;
 use super::storage::StaticGrid;
 use crate::bounding::Aabb;
+use crate::broad_phase::MAX_PROXY_ID;
 
 /// How much a kept query box is grown on each side, as a fraction of its size along that axis
 /// (a quarter: a resting body's jitter and a slow body's few steps stay inside, while a moving
@@ -87,7 +88,9 @@ impl GridQueryCache {
     /// Writes to `out` (cleared first) what `grid.query(aabb, out)` would: the id of every
     /// object whose AABB intersects `aabb`, once each, ascending. Reuses `key`'s list when
     /// `aabb` lies inside the box it was taken for; `grid` must be the grid given to
-    /// [`GridQueryCache::begin_round`], unchanged since.
+    /// [`GridQueryCache::begin_round`], unchanged since. Memory grows with the largest key, as
+    /// a broad phase's with its largest id: keys above [`MAX_PROXY_ID`] are answered by the
+    /// grid without keeping a list.
     ///
     /// Errors: a non-finite or inverted box (`out` is then left untouched).
     pub fn query(
@@ -98,6 +101,10 @@ impl GridQueryCache {
         out: &mut Vec<u32>,
     ) -> Result<GridQueryStats, GridError> {
         check_aabb(aabb, None)?;
+        if key > MAX_PROXY_ID {
+            // Keys index a list: one past the broad phase's bound would grow it without end.
+            return grid.query(aabb, out);
+        }
         debug_assert_eq!(self.revision, Some(grid.revision()), "begin_round first");
         let index = key as usize;
         if index >= self.entries.len() {

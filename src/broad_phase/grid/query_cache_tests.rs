@@ -229,3 +229,18 @@ fn boxes_near_the_float_range_are_answered_exactly() {
         assert_eq!(cached(&mut cache, &mut grid, 1, &far), vec![2]);
     }
 }
+
+#[test]
+fn a_key_beyond_the_proxy_bound_is_answered_without_a_list_of_4_billion_entries() {
+    let mut grid = cubes(1.0);
+    grid.insert(3, boxed(Vec3::ZERO, Vec3::ONE)).unwrap();
+    let mut cache = GridQueryCache::default();
+    let body = boxed(Vec3::splat(0.5), Vec3::ONE);
+    for _ in 0..2 {
+        cache.begin_round(&grid);
+        let mut out = Vec::new();
+        let stats = cache.query(&mut grid, u32::MAX, &body, &mut out).unwrap();
+        assert_eq!((out, stats.reused_queries), (vec![3], 0));
+    }
+    assert!(cache.memory_bytes() < 1024);
+}
