@@ -549,8 +549,9 @@ fn find_candidate_pairs(
                 continue;
             };
             if !index.grid.is_empty()
-                && let Ok(q) =
-                    (index.grid_queries).query(&mut index.grid, id, &aabb, &mut index.hits)
+                && let Ok(q) = index
+                    .grid_queries
+                    .query(&mut index.grid, id, &aabb, &mut index.hits)
             {
                 grid_work += q;
                 out.pairs

@@ -73,10 +73,7 @@ impl GridQueryCache {
     pub fn begin_round(&mut self, grid: &StaticGrid) {
         std::mem::swap(&mut self.lists, &mut self.previous);
         self.lists.clear();
-        if self.revision.replace(grid.revision()) != Some(grid.revision()) {
-            self.previous.clear();
-            self.entries.clear();
-        }
+        self.forget_if_changed(grid);
         self.round = self.round.wrapping_add(1);
         if self.round == 0 {
             // 2³² rounds later: no entry may look as if this round wrote it.
@@ -87,8 +84,8 @@ impl GridQueryCache {
 
     /// Writes to `out` (cleared first) what `grid.query(aabb, out)` would: the id of every
     /// object whose AABB intersects `aabb`, once each, ascending. Reuses `key`'s list when
-    /// `aabb` lies inside the box it was taken for; `grid` must be the grid given to
-    /// [`GridQueryCache::begin_round`], unchanged since. Memory grows with the largest key, as
+    /// `aabb` lies inside the box it was taken for and `grid` has not changed since it was
+    /// taken. Memory grows with the largest key, as
     /// a broad phase's with its largest id: keys above [`MAX_PROXY_ID`] are answered by the
     /// grid without keeping a list.
     ///
@@ -105,14 +102,20 @@ impl GridQueryCache {
             // Keys index a list: one past the broad phase's bound would grow it without end.
             return grid.query(aabb, out);
         }
-        debug_assert_eq!(self.revision, Some(grid.revision()), "begin_round first");
+        // A grid edited since `begin_round` (a misuse) costs the lists, never a stale answer.
+        self.forget_if_changed(grid);
         let index = key as usize;
         if index >= self.entries.len() {
             self.entries.resize(index + 1, NO_ENTRY);
         }
         let entry = self.entries[index];
-        let (fat, start, len, mut stats) = match self.kept(entry) {
-            Some((start, len)) if entry.fat.contains(aabb) => {
+        let kept = if entry.fat.contains(aabb) {
+            self.kept(entry)
+        } else {
+            None
+        };
+        let (fat, start, len, mut stats) = match kept {
+            Some((start, len)) => {
                 let reused = GridQueryStats {
                     reused_queries: 1,
                     ..GridQueryStats::default()
@@ -145,6 +148,14 @@ impl GridQueryCache {
             round: self.round,
         };
         Ok(stats)
+    }
+
+    /// Forgets every list if `grid` is not the grid they were taken from, unchanged.
+    fn forget_if_changed(&mut self, grid: &StaticGrid) {
+        if self.revision.replace(grid.revision()) != Some(grid.revision()) {
+            self.previous.clear();
+            self.entries.clear();
+        }
     }
 
     /// Where `entry`'s list is in this round's buffer (copied there if the last round wrote

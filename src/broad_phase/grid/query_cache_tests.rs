@@ -244,3 +244,19 @@ fn a_key_beyond_the_proxy_bound_is_answered_without_a_list_of_4_billion_entries(
     }
     assert!(cache.memory_bytes() < 1024);
 }
+
+#[test]
+fn a_grid_edited_without_a_new_round_is_answered_afresh() {
+    let mut grid = cubes(1.0);
+    grid.insert(1, boxed(Vec3::splat(10.0), Vec3::ONE)).unwrap();
+    let mut cache = GridQueryCache::default();
+    let body = boxed(Vec3::ZERO, Vec3::ONE);
+    cache.begin_round(&grid);
+    assert!(cached(&mut cache, &mut grid, 0, &body).is_empty());
+    // The static moves under the body within the round: the kept list must not answer.
+    grid.update(1, boxed(Vec3::splat(0.5), Vec3::ONE)).unwrap();
+    assert_eq!(cached(&mut cache, &mut grid, 0, &body), vec![1]);
+    // And a query before any round is answered too.
+    let mut fresh = GridQueryCache::default();
+    assert_eq!(cached(&mut fresh, &mut grid, 0, &body), vec![1]);
+}
