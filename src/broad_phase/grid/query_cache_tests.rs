@@ -14,6 +14,13 @@ fn boxed(min: Vec3, size: Vec3) -> Aabb {
     Aabb::new(min, min + size)
 }
 
+/// A grid of 1 m cells holding one static, and an empty cache.
+fn one_static(id: u32, aabb: Aabb) -> (StaticGrid, GridQueryCache) {
+    let mut grid = cubes(1.0);
+    grid.insert(id, aabb).unwrap();
+    (grid, GridQueryCache::default())
+}
+
 fn direct(grid: &mut StaticGrid, aabb: &Aabb) -> Vec<u32> {
     let mut out = Vec::new();
     grid.query(aabb, &mut out).unwrap();
@@ -106,9 +113,7 @@ fn answers_equal_direct_queries_over_300_rounds_of_motion_and_edits() {
 
 #[test]
 fn a_box_inside_its_fattened_box_visits_no_cell() {
-    let mut grid = cubes(1.0);
-    grid.insert(7, boxed(Vec3::ZERO, Vec3::ONE)).unwrap();
-    let mut cache = GridQueryCache::default();
+    let (mut grid, mut cache) = one_static(7, boxed(Vec3::ZERO, Vec3::ONE));
     let body = boxed(Vec3::new(0.5, 0.0, 0.9), Vec3::ONE);
     cache.begin_round(&grid);
     let first = {
@@ -138,9 +143,7 @@ fn a_box_inside_its_fattened_box_visits_no_cell() {
 
 #[test]
 fn a_static_moved_into_a_kept_box_is_found_in_the_next_round() {
-    let mut grid = cubes(1.0);
-    grid.insert(1, boxed(Vec3::splat(10.0), Vec3::ONE)).unwrap();
-    let mut cache = GridQueryCache::default();
+    let (mut grid, mut cache) = one_static(1, boxed(Vec3::splat(10.0), Vec3::ONE));
     let body = boxed(Vec3::ZERO, Vec3::ONE);
     cache.begin_round(&grid);
     assert!(cached(&mut cache, &mut grid, 4, &body).is_empty());
@@ -154,9 +157,7 @@ fn a_static_moved_into_a_kept_box_is_found_in_the_next_round() {
 
 #[test]
 fn a_key_left_out_of_one_round_queries_the_grid_again() {
-    let mut grid = cubes(1.0);
-    grid.insert(2, boxed(Vec3::ZERO, Vec3::ONE)).unwrap();
-    let mut cache = GridQueryCache::default();
+    let (mut grid, mut cache) = one_static(2, boxed(Vec3::ZERO, Vec3::ONE));
     let body = boxed(Vec3::splat(0.5), Vec3::ONE);
     cache.begin_round(&grid);
     assert_eq!(cached(&mut cache, &mut grid, 9, &body), vec![2]);
@@ -196,9 +197,7 @@ fn another_grid_with_the_same_objects_is_not_mistaken_for_the_first() {
 
 #[test]
 fn bad_boxes_are_refused_and_leave_the_output_untouched() {
-    let mut grid = cubes(1.0);
-    grid.insert(1, boxed(Vec3::ZERO, Vec3::ONE)).unwrap();
-    let mut cache = GridQueryCache::default();
+    let (mut grid, mut cache) = one_static(1, boxed(Vec3::ZERO, Vec3::ONE));
     cache.begin_round(&grid);
     let mut out = vec![42];
     let nan = Aabb::new(Vec3::new(f32::NAN, 0.0, 0.0), Vec3::ONE);
@@ -232,9 +231,7 @@ fn boxes_near_the_float_range_are_answered_exactly() {
 
 #[test]
 fn a_key_beyond_the_proxy_bound_is_answered_without_a_list_of_4_billion_entries() {
-    let mut grid = cubes(1.0);
-    grid.insert(3, boxed(Vec3::ZERO, Vec3::ONE)).unwrap();
-    let mut cache = GridQueryCache::default();
+    let (mut grid, mut cache) = one_static(3, boxed(Vec3::ZERO, Vec3::ONE));
     let body = boxed(Vec3::splat(0.5), Vec3::ONE);
     for _ in 0..2 {
         cache.begin_round(&grid);
@@ -247,9 +244,7 @@ fn a_key_beyond_the_proxy_bound_is_answered_without_a_list_of_4_billion_entries(
 
 #[test]
 fn a_grid_edited_without_a_new_round_is_answered_afresh() {
-    let mut grid = cubes(1.0);
-    grid.insert(1, boxed(Vec3::splat(10.0), Vec3::ONE)).unwrap();
-    let mut cache = GridQueryCache::default();
+    let (mut grid, mut cache) = one_static(1, boxed(Vec3::splat(10.0), Vec3::ONE));
     let body = boxed(Vec3::ZERO, Vec3::ONE);
     cache.begin_round(&grid);
     assert!(cached(&mut cache, &mut grid, 0, &body).is_empty());
