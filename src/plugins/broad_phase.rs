@@ -541,7 +541,7 @@ fn find_candidate_pairs(
     );
     let moving_pairs = out.pairs.len();
     let mut grid_work = GridQueryStats::default();
-    index.grid_queries.begin_round(&index.grid);
+    index.grid_queries.begin_round();
     if !index.grid.is_empty() || !proxies.unbounded().is_empty() {
         // Sleeping bodies are not paired with scenery: nothing moved.
         for id in proxies.awake_moving_ids() {

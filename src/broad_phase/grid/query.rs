@@ -105,8 +105,8 @@ impl StaticGrid {
         Ok(stats)
     }
 
-    /// Writes to `out` (cleared first) the slots of the objects whose AABB intersects `query`
-    /// (a box already checked), in ascending id order: what [`super::GridQueryCache`] keeps.
+    /// Appends to `out` the slots of the objects whose AABB intersects `query` (a box already
+    /// checked), in ascending id order: what [`super::GridQueryCache`] keeps.
     pub(super) fn intersecting_slots(
         &mut self,
         query: &Aabb,
@@ -119,7 +119,6 @@ impl StaticGrid {
         });
         // Ids are distinct, so sorting the packed words sorts by id.
         scratch.sort_unstable();
-        out.clear();
         out.extend(scratch.iter().map(|&packed| packed as u32));
         stats
     }

@@ -11,7 +11,7 @@
 //!
 //! **The answer is exactly [`StaticGrid::query`]'s** (the same ids in the same ascending order):
 //! the cache changes only what an answer costs. That holds because every edit of the grid gives
-//! it a new revision ([`StaticGrid::revision`]), and a round that sees a new revision forgets
+//! it a new revision ([`StaticGrid::revision`]), and a query that sees a new revision forgets
 //! every list.
 //!
 //! The lists live in two flat buffers: the lists kept last round are read while this round's
@@ -64,16 +64,14 @@ pub struct GridQueryCache {
     revision: Option<u64>,
     /// Scratch for a query of the grid.
     packed: Vec<u64>,
-    found: Vec<u32>,
 }
 
 impl GridQueryCache {
-    /// Starts a round (a step): the lists written in the last round become readable, and if
-    /// `grid` changed since they were taken, every list is forgotten.
-    pub fn begin_round(&mut self, grid: &StaticGrid) {
+    /// Starts a round (a step): the lists written in the last round become readable (to the
+    /// queries of a grid unchanged since they were taken; `query` checks).
+    pub fn begin_round(&mut self) {
         std::mem::swap(&mut self.lists, &mut self.previous);
         self.lists.clear();
-        self.forget_if_changed(grid);
         self.round = self.round.wrapping_add(1);
         if self.round == 0 {
             // 2³² rounds later: no entry may look as if this round wrote it.
@@ -102,7 +100,7 @@ impl GridQueryCache {
             // Keys index a list: one past the broad phase's bound would grow it without end.
             return grid.query(aabb, out);
         }
-        // A grid edited since `begin_round` (a misuse) costs the lists, never a stale answer.
+        // A grid edited since the lists were taken costs them, never a stale answer.
         self.forget_if_changed(grid);
         let index = key as usize;
         if index >= self.entries.len() {
@@ -122,12 +120,11 @@ impl GridQueryCache {
                 };
                 (entry.fat, start, len, reused)
             }
-            _ => {
+            None => {
                 let fat = fattened(aabb);
-                let stats = grid.intersecting_slots(&fat, &mut self.found, &mut self.packed);
                 let start = self.lists.len();
-                self.lists.extend_from_slice(&self.found);
-                (fat, start, self.found.len(), stats)
+                let stats = grid.intersecting_slots(&fat, &mut self.lists, &mut self.packed);
+                (fat, start, self.lists.len() - start, stats)
             }
         };
         let list = &self.lists[start..start + len];
@@ -179,7 +176,7 @@ impl GridQueryCache {
     /// Bytes held by the buffers (capacity), for memory reports.
     pub fn memory_bytes(&self) -> usize {
         self.entries.capacity() * std::mem::size_of::<Entry>()
-            + (self.lists.capacity() + self.previous.capacity() + self.found.capacity()) * 4
+            + (self.lists.capacity() + self.previous.capacity()) * 4
             + self.packed.capacity() * 8
     }
 }

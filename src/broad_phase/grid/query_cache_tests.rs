@@ -81,7 +81,7 @@ fn answers_equal_direct_queries_over_300_rounds_of_motion_and_edits() {
         if round % 7 == 3 {
             edit(&mut grid, &mut rng, &mut next_id);
         }
-        cache.begin_round(&grid);
+        cache.begin_round();
         for (key, aabb) in boxes.iter_mut().enumerate() {
             // Most bodies jitter, some drift, a few jump; every third sits out a round now and
             // then (asleep), and some are asked twice in a round.
@@ -115,7 +115,7 @@ fn answers_equal_direct_queries_over_300_rounds_of_motion_and_edits() {
 fn a_box_inside_its_fattened_box_visits_no_cell() {
     let (mut grid, mut cache) = one_static(7, boxed(Vec3::ZERO, Vec3::ONE));
     let body = boxed(Vec3::new(0.5, 0.0, 0.9), Vec3::ONE);
-    cache.begin_round(&grid);
+    cache.begin_round();
     let first = {
         let mut out = Vec::new();
         let stats = cache.query(&mut grid, 0, &body, &mut out).unwrap();
@@ -125,7 +125,7 @@ fn a_box_inside_its_fattened_box_visits_no_cell() {
     assert_eq!(first.reused_queries, 0);
     // The grid read cells (or, holding one object, scanned it).
     assert!(first.cells_visited + first.object_scans > 0);
-    cache.begin_round(&grid);
+    cache.begin_round();
     // Moved by less than a quarter of its size: still inside, and off the static now.
     let moved = boxed(Vec3::new(0.5, 0.0, 1.1), Vec3::ONE);
     let mut out = Vec::new();
@@ -145,13 +145,13 @@ fn a_box_inside_its_fattened_box_visits_no_cell() {
 fn a_static_moved_into_a_kept_box_is_found_in_the_next_round() {
     let (mut grid, mut cache) = one_static(1, boxed(Vec3::splat(10.0), Vec3::ONE));
     let body = boxed(Vec3::ZERO, Vec3::ONE);
-    cache.begin_round(&grid);
+    cache.begin_round();
     assert!(cached(&mut cache, &mut grid, 4, &body).is_empty());
     grid.update(1, boxed(Vec3::splat(0.5), Vec3::ONE)).unwrap();
-    cache.begin_round(&grid);
+    cache.begin_round();
     assert_eq!(cached(&mut cache, &mut grid, 4, &body), vec![1]);
     grid.remove(1).unwrap();
-    cache.begin_round(&grid);
+    cache.begin_round();
     assert!(cached(&mut cache, &mut grid, 4, &body).is_empty());
 }
 
@@ -159,9 +159,9 @@ fn a_static_moved_into_a_kept_box_is_found_in_the_next_round() {
 fn a_key_left_out_of_one_round_queries_the_grid_again() {
     let (mut grid, mut cache) = one_static(2, boxed(Vec3::ZERO, Vec3::ONE));
     let body = boxed(Vec3::splat(0.5), Vec3::ONE);
-    cache.begin_round(&grid);
+    cache.begin_round();
     assert_eq!(cached(&mut cache, &mut grid, 9, &body), vec![2]);
-    cache.begin_round(&grid);
+    cache.begin_round();
     // Another key fills this round's buffer where key 9's list was.
     assert!(
         cached(
@@ -172,7 +172,7 @@ fn a_key_left_out_of_one_round_queries_the_grid_again() {
         )
         .is_empty()
     );
-    cache.begin_round(&grid);
+    cache.begin_round();
     let mut out = Vec::new();
     let stats = cache.query(&mut grid, 9, &body, &mut out).unwrap();
     assert_eq!((out, stats.reused_queries), (vec![2], 0));
@@ -189,16 +189,16 @@ fn another_grid_with_the_same_objects_is_not_mistaken_for_the_first() {
     second.insert(5, boxed(Vec3::ZERO, Vec3::ONE)).unwrap();
     let mut cache = GridQueryCache::default();
     let body = boxed(Vec3::splat(0.2), Vec3::ONE);
-    cache.begin_round(&first);
+    cache.begin_round();
     assert_eq!(cached(&mut cache, &mut first, 0, &body), vec![1]);
-    cache.begin_round(&second);
+    cache.begin_round();
     assert_eq!(cached(&mut cache, &mut second, 0, &body), vec![5]);
 }
 
 #[test]
 fn bad_boxes_are_refused_and_leave_the_output_untouched() {
     let (mut grid, mut cache) = one_static(1, boxed(Vec3::ZERO, Vec3::ONE));
-    cache.begin_round(&grid);
+    cache.begin_round();
     let mut out = vec![42];
     let nan = Aabb::new(Vec3::new(f32::NAN, 0.0, 0.0), Vec3::ONE);
     assert_eq!(
@@ -222,7 +222,7 @@ fn boxes_near_the_float_range_are_answered_exactly() {
     let mut cache = GridQueryCache::default();
     let huge = Aabb::new(Vec3::splat(-3e38), Vec3::splat(3e38));
     for _ in 0..3 {
-        cache.begin_round(&grid);
+        cache.begin_round();
         assert_eq!(cached(&mut cache, &mut grid, 0, &huge), vec![1, 2]);
         let far = boxed(Vec3::splat(1e30), Vec3::splat(1e29));
         assert_eq!(cached(&mut cache, &mut grid, 1, &far), vec![2]);
@@ -234,7 +234,7 @@ fn a_key_beyond_the_proxy_bound_is_answered_without_a_list_of_4_billion_entries(
     let (mut grid, mut cache) = one_static(3, boxed(Vec3::ZERO, Vec3::ONE));
     let body = boxed(Vec3::splat(0.5), Vec3::ONE);
     for _ in 0..2 {
-        cache.begin_round(&grid);
+        cache.begin_round();
         let mut out = Vec::new();
         let stats = cache.query(&mut grid, u32::MAX, &body, &mut out).unwrap();
         assert_eq!((out, stats.reused_queries), (vec![3], 0));
@@ -246,7 +246,7 @@ fn a_key_beyond_the_proxy_bound_is_answered_without_a_list_of_4_billion_entries(
 fn a_grid_edited_without_a_new_round_is_answered_afresh() {
     let (mut grid, mut cache) = one_static(1, boxed(Vec3::splat(10.0), Vec3::ONE));
     let body = boxed(Vec3::ZERO, Vec3::ONE);
-    cache.begin_round(&grid);
+    cache.begin_round();
     assert!(cached(&mut cache, &mut grid, 0, &body).is_empty());
     // The static moves under the body within the round: the kept list must not answer.
     grid.update(1, boxed(Vec3::splat(0.5), Vec3::ONE)).unwrap();

@@ -40,7 +40,8 @@ struct ContactBatch {
     writes: [[bool; LANES]; 2],
     /// Whether every lane's A (B) is still ([`ContactConstraint::still`]): its state is then
     /// the rest state's constants, not gathered (a ground under resting bodies: the passes
-    /// load and store one body per lane, as rapier's one-body contact constraints do).
+    /// load one body per lane, and store one as for any side that writes no lane, as rapier's
+    /// one-body contact constraints do).
     still: [bool; 2],
     normal: Vec3x4,
     tangents: [Vec3x4; 2],
@@ -173,7 +174,7 @@ impl ContactBatches {
                     warm_start_patch(batch, &self.patches[at as usize], &mut pair);
                 }
             }
-            pair.store(&batch.bodies, (batch.still, &batch.writes), states);
+            pair.store(&batch.bodies, &batch.writes, states);
         }
     }
 
@@ -208,7 +209,7 @@ impl ContactBatches {
                     }
                 }
             }
-            pair.store(&batch.bodies, (batch.still, &batch.writes), states);
+            pair.store(&batch.bodies, &batch.writes, states);
         }
     }
 

@@ -38,7 +38,7 @@ use super::rolling::RollingRows;
 pub use super::row::{PointRow, RowPart};
 use super::softness::Softness;
 use crate::geometry::MAX_MANIFOLD_POINTS;
-use glam::{Quat, Vec3};
+use glam::Vec3;
 
 /// One point of a contact as detection found it.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -160,15 +160,15 @@ pub struct ContactConstraint {
     pub closing_acceleration: f32,
 }
 
-/// Whether a body's state is exactly the rest state (`+0.0` velocities and motion, the identity
-/// turn): bit for bit, so that a batch reading constants instead computes the same bits.
+/// Whether a body's state is [`BodyState::default`], the rest state, bit for bit (`-0.0` is not
+/// `+0.0` here): a batch reading the rest state's constants instead then computes the same bits.
 fn at_rest(state: &BodyState) -> bool {
-    let zero = |v: Vec3| v.to_array().iter().all(|x| x.to_bits() == 0);
-    zero(state.linear_velocity)
-        && zero(state.angular_velocity)
-        && zero(state.delta_position)
-        && state.delta_rotation.to_array().map(f32::to_bits)
-            == Quat::IDENTITY.to_array().map(f32::to_bits)
+    let bits = |s: &BodyState| {
+        let [v, w, p] = [s.linear_velocity, s.angular_velocity, s.delta_position]
+            .map(|v| v.to_array().map(f32::to_bits));
+        (v, w, p, s.delta_rotation.to_array().map(f32::to_bits))
+    };
+    bits(state) == bits(&BodyState::default())
 }
 
 /// Restitution within `0..=1`; a non-finite value (which would fling both bodies to infinity)

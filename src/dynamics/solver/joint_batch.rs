@@ -103,7 +103,7 @@ impl JointBatch {
     pub(super) fn warm_start(&self, states: &mut [BodyState]) {
         let mut pair = PairVelocities::load(&self.bodies, [false; 2], states);
         pair.push_point(self, self.impulse);
-        pair.store(&self.bodies, ([false; 2], &self.writes), states);
+        pair.store(&self.bodies, &self.writes, states);
     }
 
     /// One pass: biased (`soft` closes the gaps) or relaxing (rigid), as
@@ -122,7 +122,7 @@ impl JointBatch {
             - self.impulse * Lanes::splat(soft.impulse_scale);
         self.impulse = self.impulse + impulse;
         pair.push_point(self, impulse);
-        pair.store(&self.bodies, ([false; 2], &self.writes), states);
+        pair.store(&self.bodies, &self.writes, states);
     }
 
     /// Takes the rows where the bodies are now, from their motion since the step's start (as

@@ -226,16 +226,11 @@ impl PairVelocities {
 
     /// Writes the velocities back to slots `bodies`, where `writes` allows (the dynamic bodies
     /// of real lanes: padding lanes repeat lane 0's slots, and static bodies keep theirs); a
-    /// `still` side writes nothing.
-    pub fn store(
-        self,
-        bodies: &Slots,
-        (still, writes): ([bool; 2], &[[bool; LANES]; 2]),
-        states: &mut [BodyState],
-    ) {
+    /// side that writes no lane (a still ground) is not even unpacked.
+    pub fn store(self, bodies: &Slots, writes: &[[bool; LANES]; 2], states: &mut [BodyState]) {
         let sides = [(self.va, self.wa), (self.vb, self.wb)];
         for (k, (v, w)) in sides.into_iter().enumerate() {
-            if still[k] {
+            if !writes[k].contains(&true) {
                 continue;
             }
             let (v, w) = (v.to_vecs(), w.to_vecs());
