@@ -6,7 +6,9 @@
 //! - `sphere_overlap`: 1,000 balls of radius 2 m, each every collider it touches (urto's
 //!   `overlapping`; parry's `intersect_aabb` and `intersection_test`);
 //! - `build` and `refit` of the tree over the 10,000 boxes (parry's refit is its leaf updates
-//!   and `refit`, as rapier does each step).
+//!   and `refit`, as rapier does each step);
+//! - `churn_10k`: the same with one collider despawned and one spawned each step (urto keeps
+//!   its tree: the new one in a small tree, the gone one retired; parry removes and inserts).
 //!
 //! Before timing, the answers are compared and printed: the same first hits, the same overlaps.
 //! (Hits more than 1 mm apart are rays grazing a ball 40–90 m away, where the chord is nearly
@@ -26,7 +28,7 @@ use parry3d::shape::{Ball, Cuboid, SharedShape};
 use rng::Rng;
 use std::hint::black_box;
 use urto::geometry::{Isometry, Shape};
-use urto::spatial::{Ray, SpatialIndex};
+use urto::spatial::{Ray, SpatialIndex, StableIds};
 
 const COLLIDERS: usize = 10_000;
 const QUERIES: usize = 1_000;
@@ -228,6 +230,58 @@ fn bench(c: &mut Criterion) {
     group.bench_function("parry3d_refit", |b| {
         b.iter(|| {
             for (i, (shape, pose)) in scene.theirs.iter().enumerate() {
+                bvh.insert_or_update_partially(shape.compute_aabb(pose), i as u32, 0.0);
+            }
+            bvh.refit(&mut workspace);
+        })
+    });
+    group.finish();
+    churn(c, &scene, &aabbs);
+}
+
+/// A step of a game that despawns one collider and spawns one elsewhere (a bullet): the
+/// index takes every box again in the order an ECS table gives after a swap-remove and a
+/// spawn, with ids from [`StableIds`] as the ECS gives them (the new collider a new key).
+/// parry's tree as rapier's broad phase keeps it: leaves updated, one removed, one inserted
+/// (its index reused), refitted. The rebuild this replaces is `tree_10k/urto_build`.
+fn churn(c: &mut Criterion, scene: &Scene, aabbs: &[ParryAabb]) {
+    let mut group = c.benchmark_group("churn_10k");
+    let mut rng = Rng::new(9);
+    let spawns: Vec<Isometry> = (0..997)
+        .map(|_| Isometry::new(rng.in_ball(50.0), rng.rotation()))
+        .collect();
+    // Scene slots in table order, each slot's current key and pose.
+    let mut order: Vec<usize> = (0..COLLIDERS).collect();
+    let mut keys: Vec<u64> = (0..COLLIDERS as u64).collect();
+    let mut poses: Vec<Isometry> = scene.ours.iter().map(|(_, p)| *p).collect();
+    let (mut ids, mut ours) = (StableIds::default(), SpatialIndex::default());
+    let mut step = 0usize;
+    group.bench_function("urto_one_replaced", |b| {
+        b.iter(|| {
+            step += 1;
+            let slot = order.swap_remove((step * 7919) % COLLIDERS);
+            order.push(slot);
+            keys[slot] = (COLLIDERS + step) as u64;
+            poses[slot] = spawns[step % spawns.len()];
+            ids.begin();
+            let items = order
+                .iter()
+                .map(|&i| (ids.id(keys[i]), &scene.ours[i].0, poses[i]));
+            black_box(ours.update(items));
+            ids.finish();
+        })
+    });
+    let mut bvh = Bvh::from_leaves(BvhBuildStrategy::Binned, aabbs);
+    let mut workspace = BvhWorkspace::default();
+    let mut poses: Vec<_> = scene.theirs.iter().map(|(_, p)| *p).collect();
+    group.bench_function("parry3d_one_replaced", |b| {
+        b.iter(|| {
+            step += 1;
+            let slot = (step * 7919) % COLLIDERS;
+            bvh.remove(slot as u32);
+            let at = spawns[step % spawns.len()];
+            poses[slot] = parry3d::math::Pose::from_parts(at.translation, at.rotation);
+            for (i, ((shape, _), pose)) in scene.theirs.iter().zip(&poses).enumerate() {
                 bvh.insert_or_update_partially(shape.compute_aabb(pose), i as u32, 0.0);
             }
             bvh.refit(&mut workspace);

@@ -5,7 +5,7 @@
 //! convention as the contact tests (a contact at distance exactly zero is reported with depth 0).
 
 use crate::geometry::Isometry;
-use glam::Vec3;
+use glam::{Mat3A, Vec3};
 
 /// A box `[min, max]` with faces parallel to the axes of its frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -136,9 +136,23 @@ impl Aabb {
     #[must_use]
     pub fn transformed(&self, pose: &Isometry) -> Aabb {
         let center = pose.transform_point(self.center());
-        let abs = pose.rotation_matrix().abs();
-        Aabb::from_center_half_extents(center, abs * self.half_extents())
+        Aabb::from_center_half_extents(center, rotated_half_extents(pose, self.half_extents()))
     }
+
+    /// The box of a box of `half_extents` centred on `pose`'s origin (a cuboid collider):
+    /// [`Self::transformed`] without moving a centre at the origin.
+    #[must_use]
+    pub fn of_centred_box(half_extents: Vec3, pose: &Isometry) -> Aabb {
+        Aabb::from_center_half_extents(pose.translation, rotated_half_extents(pose, half_extents))
+    }
+}
+
+/// `|R| h`, the half extents of a turned box's bounding box, in SIMD lanes (the arithmetic of
+/// `Mat3 * Vec3`, column by column: the same bits, a third of the instructions).
+#[inline]
+fn rotated_half_extents(pose: &Isometry, h: Vec3) -> Vec3 {
+    let m = Mat3A::from_quat(pose.rotation);
+    (m.x_axis.abs() * h.x + m.y_axis.abs() * h.y + m.z_axis.abs() * h.z).into()
 }
 
 #[cfg(test)]
@@ -173,6 +187,23 @@ mod tests {
                 t.expanded(1e-4)
                     .contains_point(pose.transform_point(corner))
             );
+        }
+    }
+
+    #[test]
+    fn turned_boxes_are_bit_identical_to_the_scalar_matrix_product_on_10000_poses() {
+        let mut rng = crate::test_rng::TestRng::new(21);
+        for _ in 0..10_000 {
+            let pose = Isometry::new(rng.vec3(-50.0, 50.0), rng.rotation());
+            let h = rng.vec3(0.01, 3.0);
+            let scalar = Aabb::from_center_half_extents(
+                pose.transform_point(Vec3::ZERO),
+                pose.rotation_matrix().abs() * h,
+            );
+            let centred = Aabb::of_centred_box(h, &pose);
+            let moved = Aabb::from_center_half_extents(Vec3::ZERO, h).transformed(&pose);
+            assert_eq!(centred, scalar);
+            assert_eq!(moved, scalar);
         }
     }
 

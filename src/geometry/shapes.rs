@@ -261,9 +261,7 @@ impl Shape {
             Self::Sphere(s) => {
                 Aabb::from_center_half_extents(pose.translation, Vec3::splat(s.radius))
             }
-            Self::Cuboid(c) => {
-                Aabb::from_center_half_extents(Vec3::ZERO, c.half_extents).transformed(pose)
-            }
+            Self::Cuboid(c) => Aabb::of_centred_box(c.half_extents, pose),
             Self::HalfSpace(_) => Aabb::new(Vec3::NEG_INFINITY, Vec3::INFINITY),
             Self::Capsule(c) => {
                 let (bottom, top) = c.segment(pose);

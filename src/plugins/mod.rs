@@ -57,7 +57,7 @@ pub use rotation::RotationPlugin;
 pub use sleep::SleepPlugin;
 pub use soft_step::{SoftStepPlugin, SoftStepSolver, SolveBodies, SpeculativeMargin};
 pub use spatial_query::{
-    PointProjection, RayHit, SpatialQuery, SpatialQueryFilter, SpatialQueryIndex,
+    IndexRefreshes, PointProjection, RayHit, SpatialQuery, SpatialQueryFilter, SpatialQueryIndex,
     SpatialQueryPlugin,
 };
 pub use step_app::step_app;

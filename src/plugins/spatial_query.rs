@@ -16,7 +16,8 @@
 //! ```
 //!
 //! The index is built lazily: the first query after a physics step refreshes it (refit in
-//! `O(n)` while the colliders are the same ones, rebuilt when they change), so a game that
+//! `O(n)` while the colliders are the same ones; when a few came or went, the tree is kept and
+//! only the new ones indexed apart; rebuilt when many did), so a game that
 //! never queries pays nothing and one that queries pays once per step, whatever the number of
 //! queries. It sees the world as the last step left it; bodies a game moves or spawns between
 //! steps are seen after the next step, or at once after [`SpatialQuery::refresh`]. Roots are
@@ -26,7 +27,9 @@
 use crate::components::*;
 use crate::geometry::{Isometry, Shape};
 use crate::plugins::required_resources::RequireResource;
-use crate::spatial::{ColliderLookup, IndexUpdate, LayerMask, QueryError, Ray, SpatialIndex};
+use crate::spatial::{
+    ColliderLookup, IndexUpdate, LayerMask, QueryError, Ray, SpatialIndex, StableIds,
+};
 use crate::stats::PhysicsStats;
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
@@ -53,19 +56,29 @@ pub struct SpatialQueryIndex {
 #[derive(Default)]
 struct IndexState {
     index: SpatialIndex,
-    /// Entity of each index id.
-    entities: Vec<Entity>,
+    /// The index id of each collider entity, stable while others come and go (so that a
+    /// change of a few colliders keeps the index's tree).
+    ids: StableIds<Entity>,
     /// The physics step of the last refresh.
     step: Option<u64>,
-    rebuilds: u64,
-    refits: u64,
+    refreshes: IndexRefreshes,
+}
+
+/// How the query index was refreshed so far (see [`SpatialQueryIndex::refreshes`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct IndexRefreshes {
+    /// Colliders came or went, many: the tree rebuilt.
+    pub rebuilds: u64,
+    /// Colliders came or went, a few: the tree kept (see [`crate::spatial::ColliderTree`]).
+    pub updates: u64,
+    /// The same colliders: the boxes refitted.
+    pub refits: u64,
 }
 
 impl SpatialQueryIndex {
-    /// How many times the tree was rebuilt and refitted (for tests and the curious).
-    pub fn refreshes(&self) -> (u64, u64) {
-        let state = self.lock();
-        (state.rebuilds, state.refits)
+    /// How many times the tree was rebuilt, updated and refitted (for tests and the curious).
+    pub fn refreshes(&self) -> IndexRefreshes {
+        self.lock().refreshes
     }
 
     fn lock(&self) -> MutexGuard<'_, IndexState> {
@@ -159,13 +172,21 @@ pub struct SpatialQuery<'w, 's> {
 
 /// The ECS colliders by index id.
 struct Lookup<'a, 'w, 's> {
-    entities: &'a [Entity],
+    ids: &'a StableIds<Entity>,
     colliders: &'a Query<'w, 's, QueryCollider, Without<Quarantined>>,
+}
+
+impl Lookup<'_, '_, '_> {
+    /// The entity of `id`. The index reports only ids its filter accepted and the look-up
+    /// found, which have entities; the placeholder stands in for what cannot happen.
+    fn entity(&self, id: u32) -> Entity {
+        self.ids.key(id).unwrap_or(Entity::PLACEHOLDER)
+    }
 }
 
 impl ColliderLookup for Lookup<'_, '_, '_> {
     fn collider(&self, id: u32) -> Option<(&Shape, Isometry)> {
-        let e = *self.entities.get(id as usize)?;
+        let e = self.ids.key(id)?;
         let row = self.colliders.get(e).ok()?;
         Some((&row.1.shape, pose_of(&row)))
     }
@@ -200,15 +221,19 @@ impl SpatialQuery<'_, '_> {
         let step = self.stats.as_ref().map(|s| s.step);
         if force || step.is_none() || state.step != step {
             let state = &mut *state;
-            let entities = &mut state.entities;
-            entities.clear();
-            let colliders = self.colliders.iter().enumerate().map(|(id, row)| {
-                entities.push(row.0);
-                (id as u32, &row.1.shape, pose_of(&row))
-            });
-            match state.index.update(colliders) {
-                IndexUpdate::Refitted => state.refits += 1,
-                IndexUpdate::Rebuilt => state.rebuilds += 1,
+            let ids = &mut state.ids;
+            ids.begin();
+            let colliders = self
+                .colliders
+                .iter()
+                .map(|row| (ids.id(row.0), &row.1.shape, pose_of(&row)));
+            let update = state.index.update(colliders);
+            state.ids.finish();
+            let counts = &mut state.refreshes;
+            match update {
+                IndexUpdate::Refitted => counts.refits += 1,
+                IndexUpdate::Updated => counts.updates += 1,
+                IndexUpdate::Rebuilt => counts.rebuilds += 1,
             }
             state.step = step;
         }
@@ -221,8 +246,8 @@ impl SpatialQuery<'_, '_> {
     }
 
     /// Whether the collider `id` passes `filter`.
-    fn accepts(&self, entities: &[Entity], id: u32, filter: &SpatialQueryFilter) -> bool {
-        let Some(&e) = entities.get(id as usize) else {
+    fn accepts(&self, ids: &StableIds<Entity>, id: u32, filter: &SpatialQueryFilter) -> bool {
+        let Some(e) = ids.key(id) else {
             return false;
         };
         let layers = self.colliders.get(e).ok().map(|row| row.6);
@@ -238,14 +263,12 @@ impl SpatialQuery<'_, '_> {
         query: impl FnOnce(&mut SpatialIndex, &Lookup, &dyn Fn(u32) -> bool) -> R,
     ) -> R {
         let mut state = self.fresh(false);
-        let IndexState {
-            index, entities, ..
-        } = &mut *state;
+        let IndexState { index, ids, .. } = &mut *state;
         let lookup = Lookup {
-            entities,
+            ids,
             colliders: &self.colliders,
         };
-        query(index, &lookup, &|id| self.accepts(entities, id, filter))
+        query(index, &lookup, &|id| self.accepts(ids, id, filter))
     }
 
     /// The nearest collider the ray from `origin` along `direction` hits within `max_distance`
@@ -273,7 +296,7 @@ impl SpatialQuery<'_, '_> {
         let ray = Ray::new(origin, direction)?;
         self.with_index(filter, |index, lookup, accept| {
             let hit = index.cast_sphere(lookup, &ray, radius, max_distance, accept)?;
-            Ok(hit.map(|h| to_ray_hit(lookup.entities, h)))
+            Ok(hit.map(|h| to_ray_hit(lookup, h)))
         })
     }
 
@@ -296,7 +319,7 @@ impl SpatialQuery<'_, '_> {
         };
         self.with_index(filter, |index, lookup, accept| {
             let hit = index.cast_box(lookup, &cast, accept)?;
-            Ok(hit.map(|h| to_ray_hit(lookup.entities, h)))
+            Ok(hit.map(|h| to_ray_hit(lookup, h)))
         })
     }
 
@@ -322,7 +345,7 @@ impl SpatialQuery<'_, '_> {
         };
         self.with_index(filter, |index, lookup, accept| {
             let hit = index.cast_capsule(lookup, &cast, accept)?;
-            Ok(hit.map(|h| to_ray_hit(lookup.entities, h)))
+            Ok(hit.map(|h| to_ray_hit(lookup, h)))
         })
     }
 
@@ -338,10 +361,7 @@ impl SpatialQuery<'_, '_> {
         self.with_index(filter, |index, lookup, accept| {
             let mut hits = Vec::new();
             index.cast_ray_all(lookup, &ray, max_distance, accept, &mut hits)?;
-            Ok(hits
-                .into_iter()
-                .map(|h| to_ray_hit(lookup.entities, h))
-                .collect())
+            Ok(hits.into_iter().map(|h| to_ray_hit(lookup, h)).collect())
         })
     }
 
@@ -358,10 +378,7 @@ impl SpatialQuery<'_, '_> {
         self.with_index(filter, |index, lookup, accept| {
             let mut ids = Vec::new();
             index.overlapping(lookup, (shape, &pose), accept, &mut ids);
-            Ok(ids
-                .into_iter()
-                .map(|id| lookup.entities[id as usize])
-                .collect())
+            Ok(ids.into_iter().map(|id| lookup.entity(id)).collect())
         })
     }
 
@@ -377,7 +394,7 @@ impl SpatialQuery<'_, '_> {
         self.with_index(filter, |index, lookup, accept| {
             let found = index.nearest(lookup, point, max_distance, accept)?;
             Ok(found.map(|(id, hit)| PointProjection {
-                entity: lookup.entities[id as usize],
+                entity: lookup.entity(id),
                 point: hit.point,
                 distance: hit.distance,
                 inside: hit.inside,
@@ -399,9 +416,9 @@ impl SpatialQuery<'_, '_> {
     }
 }
 
-fn to_ray_hit(entities: &[Entity], h: crate::spatial::QueryHit) -> RayHit {
+fn to_ray_hit(lookup: &Lookup, h: crate::spatial::QueryHit) -> RayHit {
     RayHit {
-        entity: entities[h.id as usize],
+        entity: lookup.entity(h.id),
         distance: h.hit.distance,
         point: h.hit.point,
         normal: h.hit.normal,

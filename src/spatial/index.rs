@@ -1,4 +1,4 @@
-//! The query index: every collider's box in an [`AabbTree`] (half-spaces aside, tested
+//! The query index: every collider's box in a [`ColliderTree`] (half-spaces aside, tested
 //! directly), and the queries a game asks — first hit and all hits of a ray, a sphere cast,
 //! the colliders overlapping a shape, the colliders containing a point — answered by visiting
 //! only the boxes the query meets and testing those shapes exactly (the shape tests of
@@ -12,8 +12,9 @@
 use super::box_cast::{BoxCast, cast_box};
 use super::capsule_cast::{CapsuleCast, cast_capsule};
 use super::cast::{CastHit, QueryError, Ray, cast_sphere, check_max_distance};
+use super::collider_tree::ColliderTree;
 use super::nearest::{PointHit, nearest_point};
-use super::tree::{AabbTree, RaySegment};
+use super::tree::RaySegment;
 use crate::bounding::Aabb;
 use crate::bvh::QueryScratch;
 use crate::ccd::CONTACT_TOLERANCE_RELATIVE;
@@ -47,14 +48,17 @@ pub struct QueryHit {
 pub enum IndexUpdate {
     /// The same colliders in the same order: boxes refitted, `O(n)`.
     Refitted,
-    /// Colliders came or went: tree rebuilt, `O(n log n)`.
+    /// Colliders came or went, a few: the tree kept, the new ones in a small tree of their
+    /// own and the gone ones retired (see [`ColliderTree`]).
+    Updated,
+    /// Colliders came or went, many (or the first time): tree rebuilt, `O(n log n)`.
     Rebuilt,
 }
 
 /// The colliders' boxes and the buffers of the queries.
 #[derive(Debug, Default)]
 pub struct SpatialIndex {
-    tree: AabbTree,
+    tree: ColliderTree,
     /// Half-spaces (and any shape with a box that is not finite): tested by every query.
     unbounded: Vec<u32>,
     items: Vec<(u32, Aabb)>,
@@ -66,7 +70,9 @@ pub struct SpatialIndex {
 }
 
 impl SpatialIndex {
-    /// Indexes `colliders` (`id`, shape, world pose).
+    /// Indexes `colliders` (`id`, shape, world pose). Ids that stay with their colliders
+    /// (the ECS's stable ids) let a change of a few colliders keep the tree: see
+    /// [`ColliderTree::update`].
     pub fn update<'a>(
         &mut self,
         colliders: impl IntoIterator<Item = (u32, &'a Shape, Isometry)>,
@@ -81,12 +87,7 @@ impl SpatialIndex {
                 self.unbounded.push(id);
             }
         }
-        if self.tree.refit(&self.items) {
-            IndexUpdate::Refitted
-        } else {
-            self.tree.build(&self.items);
-            IndexUpdate::Rebuilt
-        }
+        self.tree.update(&self.items)
     }
 
     /// How much the boxes are grown for a cast: the exact tests accept hits within

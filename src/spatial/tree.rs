@@ -5,14 +5,17 @@
 //! Built top-down by binned surface-area splits along the longest axis of the boxes' centres
 //! (Wald 2007; a median split where the centres do not spread), stored in a flat array whose children follow their parent, so a
 //! refit (the same colliders, new boxes) is one backward pass in `O(n)`: the query index of a
-//! scene whose bodies only moved is refitted every step, rebuilt only when colliders come or
-//! go.
+//! scene whose bodies only moved is refitted every step; how it follows colliders that come
+//! and go is [`ColliderTree`](super::ColliderTree)'s.
 
 use crate::bounding::{Aabb, WideBox};
 use glam::{Vec3, Vec3A};
 
 /// Most items in a leaf.
 const LEAF_SIZE: usize = 4;
+
+/// The id of a retired item (see [`AabbTree::retire`]).
+pub(crate) const RETIRED: u32 = u32::MAX;
 
 /// A node: a leaf holds `count > 0` items from `first`; an inner node's children are
 /// `first` and `first + 1`.
@@ -145,7 +148,7 @@ impl AabbTree {
     }
 
     /// Recomputes every node's box, children before parents (children follow their parent).
-    fn refit_nodes(&mut self) {
+    pub(crate) fn refit_nodes(&mut self) {
         for n in (0..self.nodes.len()).rev() {
             let Node { first, count, .. } = self.nodes[n];
             let (first, count) = (first as usize, count as usize);
@@ -159,7 +162,40 @@ impl AabbTree {
         }
     }
 
-    /// Number of items.
+    /// The leaf slot the last build gave its `input`-th item.
+    pub(crate) fn slot_of_input(&self, input: usize) -> usize {
+        self.slot_of_input[input] as usize
+    }
+
+    /// A new box for the item in `slot` (the nodes are refitted by [`Self::refit_nodes`]).
+    pub(crate) fn set_box(&mut self, slot: usize, aabb: &Aabb) {
+        self.boxes[slot] = (*aabb).into();
+    }
+
+    /// Takes the item in `slot` out: its id becomes [`RETIRED`] and its box empty, so no
+    /// overlap query reaches it and the next refit leaves it out of its parents' boxes (a ray
+    /// may still be handed it: callers skip the id).
+    pub(crate) fn retire(&mut self, slot: usize) {
+        self.ids[slot] = RETIRED;
+        self.boxes[slot] = WideBox::EMPTY;
+    }
+
+    /// The surface area heuristic's cost of the tree relative to its root: the sum of the
+    /// nodes' surface areas over the root's, the expected number of nodes a random ray through
+    /// the root visits (MacDonald and Booth 1990). A refit tree whose boxes moved apart grows
+    /// it; `None` for an empty tree or a root without a finite, positive area.
+    pub fn relative_cost(&self) -> Option<f32> {
+        let root = self.nodes.first()?.aabb.surface_area();
+        let sum: f64 = self
+            .nodes
+            .iter()
+            .map(|n| n.aabb.surface_area() as f64)
+            .sum();
+        let cost = (sum / root as f64) as f32;
+        (root > 0.0 && cost.is_finite()).then_some(cost)
+    }
+
+    /// Number of items (retired ones included).
     pub fn len(&self) -> usize {
         self.ids.len()
     }

@@ -95,7 +95,7 @@ fn spatial_query_hits_filters_and_lists_entities_in_a_bevy_world() {
 }
 
 #[test]
-fn the_query_index_refits_after_a_step_and_rebuilds_after_a_spawn() {
+fn the_query_index_refits_after_a_step_and_keeps_its_tree_through_a_spawn_and_a_despawn() {
     let (mut app, [.., ball]) = ecs_scene();
     let cast = |app: &mut App| {
         app.world_mut()
@@ -109,24 +109,35 @@ fn the_query_index_refits_after_a_step_and_rebuilds_after_a_spawn() {
     };
     assert_eq!(cast(&mut app), Some(ball));
     let counts = |app: &App| {
-        app.world()
+        let r = app
+            .world()
             .resource::<urto::plugins::SpatialQueryIndex>()
-            .refreshes()
+            .refreshes();
+        (r.rebuilds, r.updates, r.refits)
     };
-    assert_eq!(counts(&app), (1, 0));
+    assert_eq!(counts(&app), (1, 0, 0));
     // Two queries in one step refresh once.
     cast(&mut app);
-    assert_eq!(counts(&app), (1, 0));
+    assert_eq!(counts(&app), (1, 0, 0));
     urto::step(app.world_mut(), 1).unwrap();
     cast(&mut app);
-    assert_eq!(counts(&app), (1, 1));
-    // A ball spawned above: seen after the next step (a rebuild).
+    assert_eq!(counts(&app), (1, 0, 1));
+    // A ball spawned above: seen after the next step, the tree kept (an update).
     let high = common::ball(&mut app, Vec3::new(0.0, 0.0, 6.0));
     urto::step(app.world_mut(), 1).unwrap();
     assert_eq!(cast(&mut app), Some(high));
-    assert_eq!(counts(&app), (2, 1));
+    assert_eq!(counts(&app), (1, 1, 1));
+    // Despawned: the ray reaches the resting ball again, still without a rebuild.
+    app.world_mut().despawn(high);
+    urto::step(app.world_mut(), 1).unwrap();
+    assert_eq!(cast(&mut app), Some(ball));
+    assert_eq!(counts(&app), (1, 2, 1));
+    // Spawned again (its id reused by another entity): hit as itself.
+    let again = common::ball(&mut app, Vec3::new(0.0, 0.0, 7.0));
+    urto::step(app.world_mut(), 1).unwrap();
+    assert_eq!(cast(&mut app), Some(again));
     // A quarantined collider is never hit.
-    app.world_mut().entity_mut(high).insert(Quarantined {
+    app.world_mut().entity_mut(again).insert(Quarantined {
         reason: "test".into(),
     });
     assert_eq!(cast(&mut app), Some(ball));

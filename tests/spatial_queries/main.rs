@@ -16,7 +16,7 @@ use urto::bvh::QueryScratch;
 use urto::geometry::contacts::contact;
 use urto::geometry::{Isometry, MeshCollider, Shape, TriMesh};
 use urto::prelude::*;
-use urto::spatial::{QueryError, QueryHit, Ray, SpatialIndex, cast_sphere};
+use urto::spatial::{IndexUpdate, QueryError, QueryHit, Ray, SpatialIndex, StableIds, cast_sphere};
 
 /// `n` colliders in a 40 m cube — balls, turned boxes, two meshes (a ball and a torus) — and
 /// two half-spaces: a ground below everything and a tilted wall.
@@ -276,7 +276,7 @@ fn a_refit_after_motion_answers_as_a_fresh_build_on_300_rays() {
             .enumerate()
             .map(|(i, (s, p))| (i as u32, s, *p)),
     );
-    assert_eq!(update, urto::spatial::IndexUpdate::Refitted);
+    assert_eq!(update, IndexUpdate::Refitted);
     let mut fresh = indexed(&colliders);
     for _ in 0..300 {
         let ray = random_ray(&mut rng);
@@ -284,6 +284,68 @@ fn a_refit_after_motion_answers_as_a_fresh_build_on_300_rays() {
         let b = fresh.cast_ray(&*colliders, &ray, 50.0, |_| true).unwrap();
         assert_eq!(a, b);
     }
+}
+
+#[test]
+fn colliders_coming_and_going_for_60_rounds_answer_as_a_fresh_build_on_1200_rays_and_overlaps() {
+    let mut rng = Rng::new(15);
+    let pool = scene(&mut rng, 260);
+    // Table order: (key, collider); a key is never reused, as an entity is not.
+    let mut live: Vec<(u64, (Shape, Isometry))> =
+        (0..200u64).map(|k| (k, pool[k as usize].clone())).collect();
+    let mut next_key = 200u64;
+    let (mut ids, mut index) = (StableIds::default(), SpatialIndex::default());
+    let (mut kinds, mut a, mut b) = (Vec::new(), Vec::new(), Vec::new());
+    for _ in 0..60 {
+        for _ in 0..rng.below(4) {
+            let at = rng.below(live.len());
+            live.swap_remove(at);
+        }
+        for _ in 0..rng.below(4) {
+            let collider = pool[rng.below(pool.len())].clone();
+            live.push((next_key, collider));
+            next_key += 1;
+        }
+        for (_, (_, pose)) in live.iter_mut() {
+            pose.translation += rng.in_ball(0.3);
+        }
+        // The colliders by their stable id (ids freed this round hold a stand-in never indexed).
+        ids.begin();
+        let given: Vec<u32> = live.iter().map(|(key, _)| ids.id(*key)).collect();
+        ids.finish();
+        let mut by_id = vec![
+            (Shape::sphere(1.0), Isometry::IDENTITY);
+            1 + *given.iter().max().unwrap() as usize
+        ];
+        for (id, (_, collider)) in given.iter().zip(&live) {
+            by_id[*id as usize] = collider.clone();
+        }
+        let items = || {
+            given
+                .iter()
+                .map(|&id| (id, &by_id[id as usize].0, by_id[id as usize].1))
+        };
+        kinds.push(index.update(items()));
+        let mut fresh = SpatialIndex::default();
+        fresh.update(items());
+        for _ in 0..20 {
+            let ray = random_ray(&mut rng);
+            index
+                .cast_ray_all(&*by_id, &ray, 60.0, |_| true, &mut a)
+                .unwrap();
+            fresh
+                .cast_ray_all(&*by_id, &ray, 60.0, |_| true, &mut b)
+                .unwrap();
+            assert_eq!(a, b);
+            let at = Isometry::from_translation(rng.in_ball(20.0));
+            let (mut c, mut d) = (Vec::new(), Vec::new());
+            index.overlapping(&*by_id, (&Shape::sphere(3.0), &at), |_| true, &mut c);
+            fresh.overlapping(&*by_id, (&Shape::sphere(3.0), &at), |_| true, &mut d);
+            assert_eq!(c, d);
+        }
+    }
+    let kept = kinds.iter().filter(|k| **k == IndexUpdate::Updated).count();
+    assert!(kept > 30, "{kept} of 60 rounds kept the tree: {kinds:?}");
 }
 
 /// The five shapes the parry3d oracles check, each with its parry twin and whether it is solid

@@ -1,0 +1,314 @@
+//! The query index's tree as colliders come and go. Rebuilding the [`AabbTree`] over 10,000
+//! boxes takes milliseconds; a game that spawns or despawns a bullet every step would pay that
+//! at every step's first query. So a change keeps the tree: a collider that went has its slot
+//! retired (its box emptied, its key never reported), one that came goes into a small second
+//! tree of the recent colliders, rebuilt alone (`O(k log k)` for `k` recent), and the moved
+//! ones are refitted as before. The whole is rebuilt once the recent ones pass about `2√n` or
+//! the retired a quarter of the main tree, or once its refits have worn it (boxes that moved
+//! apart: its surface-area cost grown by half). This is the simplest form of Bentley and Saxe's
+//! static-to-dynamic transformation (1980): a static structure for the many, a small one for
+//! the insertions, merged by rebuilding.
+//!
+//! Both trees hold *keys* (an item's index at its tree's build), and the caller's ids are
+//! looked up by key, so any `u32` is an id (even the retired slots' marker) and a key retired
+//! is never mistaken for a caller's id.
+
+use super::index::IndexUpdate;
+use super::tree::{AabbTree, RaySegment};
+use crate::bounding::Aabb;
+use glam::Vec3;
+
+/// Marks a slot of the recent tree in [`ColliderTree::placed`].
+const RECENT: u32 = 1 << 31;
+/// No key (in the location scratch).
+const NONE: u32 = u32::MAX;
+/// How much the main tree's relative cost ([`AabbTree::relative_cost`]) may grow over its
+/// build's before it is rebuilt: refits follow boxes that move apart (bodies flying across
+/// the scene, an id handed to a collider elsewhere), and a tree whose nodes overlap more
+/// makes every query visit more of them.
+const WORN: f32 = 1.5;
+/// Updates between two checks of the relative cost (it reads every node).
+const CHECK_EVERY: u32 = 8;
+
+/// The main tree, the recent colliders' tree and the retired slots (see the [module](self)).
+#[derive(Clone, Debug, Default)]
+pub struct ColliderTree {
+    main: AabbTree,
+    /// The caller's id of each main key.
+    main_ids: Vec<u32>,
+    /// Main slots retired since the main tree was built.
+    retired: usize,
+    recent: AabbTree,
+    /// The caller's id of each recent key.
+    recent_ids: Vec<u32>,
+    /// The items of the last update in their order: the caller's id and where its box is (a
+    /// main slot, or a recent slot with [`RECENT`] set), so that the same ids in the same
+    /// order are refitted without a look-up.
+    placed: Vec<(u32, u32)>,
+    /// Scratch, all [`NONE`] between updates: the departure of each caller id.
+    location: Vec<u32>,
+    /// Scratch: the positions of items not at their last place.
+    arrivals: Vec<u32>,
+    /// Scratch: the ids and places of the last update's items not at their place now.
+    departures: Vec<(u32, u32)>,
+    /// Scratch: the positions of the items for the recent tree.
+    recent_members: Vec<u32>,
+    /// Scratch: the recent items, keyed.
+    recent_items: Vec<(u32, Aabb)>,
+    /// The main tree's relative cost when it was built.
+    built_cost: Option<f32>,
+    /// Updates since the cost was last checked.
+    unchecked: u32,
+}
+
+impl ColliderTree {
+    /// Takes this step's items (the caller's id and box), keeping what it can: the same ids
+    /// in the same order are refitted, a few ids changed update the trees incrementally, and a
+    /// change too large for that (or ids too sparse to index) rebuilds, as does a tree worn
+    /// by its refits (its relative cost grown by half since its build, checked every
+    /// [`CHECK_EVERY`] updates).
+    pub fn update(&mut self, items: &[(u32, Aabb)]) -> IndexUpdate {
+        match self.sync(items) {
+            Some(kind) if !self.worn() => kind,
+            _ => {
+                self.rebuild(items);
+                IndexUpdate::Rebuilt
+            }
+        }
+    }
+
+    /// Whether the main tree's relative cost grew past [`WORN`] times its build's (checked
+    /// every [`CHECK_EVERY`] calls, `false` in between).
+    fn worn(&mut self) -> bool {
+        self.unchecked += 1;
+        if self.unchecked < CHECK_EVERY {
+            return false;
+        }
+        self.unchecked = 0;
+        match (self.main.relative_cost(), self.built_cost) {
+            (Some(now), Some(built)) => now > WORN * built,
+            _ => false,
+        }
+    }
+
+    /// One main tree over every item; no recent or retired ones.
+    fn rebuild(&mut self, items: &[(u32, Aabb)]) {
+        self.recent_items.clear();
+        self.recent_items.extend(
+            items
+                .iter()
+                .enumerate()
+                .map(|(key, &(_, b))| (key as u32, b)),
+        );
+        self.main.build(&self.recent_items);
+        self.main_ids.clear();
+        self.main_ids.extend(items.iter().map(|&(id, _)| id));
+        self.retired = 0;
+        self.built_cost = self.main.relative_cost();
+        self.unchecked = 0;
+        self.recent.build(&[]);
+        self.recent_ids.clear();
+        self.recent_items.clear();
+        self.placed.clear();
+        let main = &self.main;
+        self.placed.extend(
+            items
+                .iter()
+                .enumerate()
+                .map(|(key, &(id, _))| (id, main.slot_of_input(key) as u32)),
+        );
+    }
+
+    /// Follows the items into the trees without rebuilding the main one: an item with the id
+    /// the last update had at its position keeps its place (the common case: one comparison);
+    /// the others are matched by id against the places left ([`Self::claim_arrivals`]), and
+    /// what is left over retires (main) or goes into a rebuilt recent tree (new). `None` when
+    /// the main tree should be rebuilt instead.
+    fn sync(&mut self, items: &[(u32, Aabb)]) -> Option<IndexUpdate> {
+        if self.main_ids.len() == self.retired {
+            return None;
+        }
+        self.arrivals.clear();
+        self.departures.clear();
+        self.recent_members.clear();
+        let kept = items.len().min(self.placed.len());
+        for (i, (&(id, aabb), &(old, at))) in items.iter().zip(&self.placed).enumerate() {
+            if id != old {
+                self.arrivals.push(i as u32);
+                self.departures.push((old, at));
+            } else if at & RECENT == 0 {
+                self.main.set_box(at as usize, &aabb);
+            } else {
+                self.recent_members.push(i as u32);
+            }
+        }
+        self.arrivals.extend(kept as u32..items.len() as u32);
+        self.departures.extend_from_slice(&self.placed[kept..]);
+        if self.arrivals.is_empty() && self.departures.is_empty() {
+            for &i in &self.recent_members {
+                let at = self.placed[i as usize].1 & !RECENT;
+                self.recent.set_box(at as usize, &items[i as usize].1);
+            }
+            self.main.refit_nodes();
+            self.recent.refit_nodes();
+            return Some(IndexUpdate::Refitted);
+        }
+        self.placed.resize(items.len(), (0, 0));
+        self.claim_arrivals(items)?;
+        let live = self.main_ids.len() - self.retired;
+        let recent_limit = 16 + 2 * (live as f64).sqrt() as usize;
+        if self.recent_members.len() > recent_limit || 4 * self.retired > self.main_ids.len() {
+            return None;
+        }
+        self.rebuild_recent(items);
+        self.main.refit_nodes();
+        Some(IndexUpdate::Updated)
+    }
+
+    /// Gives each arrival (an item not at its last place) the place its id left, if one did:
+    /// a main slot takes its box, a recent one makes it a recent member again; arrivals with
+    /// no place become recent members, and places no arrival took retire. `None` (nothing
+    /// changed but boxes and places to be rebuilt) when the ids are too sparse to index by.
+    fn claim_arrivals(&mut self, items: &[(u32, Aabb)]) -> Option<()> {
+        let bound = 4 * items.len() + 1024;
+        let ids = self.departures.iter().map(|d| d.0);
+        let largest = ids
+            .chain(self.arrivals.iter().map(|&i| items[i as usize].0))
+            .max();
+        if largest.is_some_and(|id| id as usize > bound) {
+            return None;
+        }
+        let largest = largest.map_or(0, |id| id as usize);
+        if self.location.len() <= largest {
+            self.location.resize(largest + 1, NONE);
+        }
+        for (d, &(id, _)) in self.departures.iter().enumerate() {
+            self.location[id as usize] = d as u32;
+        }
+        for &i in &self.arrivals {
+            let (id, aabb) = items[i as usize];
+            let d = self.location[id as usize];
+            let place = if d == NONE {
+                NONE
+            } else {
+                self.departures[d as usize].1
+            };
+            if place == NONE || place & RECENT != 0 {
+                self.recent_members.push(i);
+            } else {
+                self.main.set_box(place as usize, &aabb);
+                self.placed[i as usize] = (id, place);
+            }
+            if d != NONE {
+                // Taken: a second arrival of the same id is new.
+                self.departures[d as usize].1 = NONE;
+            }
+        }
+        for &(id, place) in &self.departures {
+            self.location[id as usize] = NONE;
+            if place != NONE && place & RECENT == 0 {
+                self.main.retire(place as usize);
+                self.retired += 1;
+            }
+        }
+        Some(())
+    }
+
+    /// The recent tree anew over the recent members, and their places.
+    fn rebuild_recent(&mut self, items: &[(u32, Aabb)]) {
+        self.recent_items.clear();
+        self.recent_ids.clear();
+        for (key, &i) in self.recent_members.iter().enumerate() {
+            let (id, aabb) = items[i as usize];
+            self.recent_items.push((key as u32, aabb));
+            self.recent_ids.push(id);
+        }
+        self.recent.build(&self.recent_items);
+        for (key, &i) in self.recent_members.iter().enumerate() {
+            let slot = self.recent.slot_of_input(key) as u32;
+            self.placed[i as usize] = (items[i as usize].0, RECENT | slot);
+        }
+    }
+
+    /// Items indexed (retired ones not counted).
+    pub fn len(&self) -> usize {
+        self.main_ids.len() - self.retired + self.recent_ids.len()
+    }
+
+    /// Whether no item is indexed.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// How many items sit in the recent tree and how many main slots are retired.
+    pub fn pending(&self) -> (usize, usize) {
+        (self.recent_ids.len(), self.retired)
+    }
+
+    /// The box around every item (`Aabb::EMPTY` when empty).
+    pub fn bounds(&self) -> Aabb {
+        self.main.bounds().union(&self.recent.bounds())
+    }
+
+    /// Calls `visit(id)` for every item whose box overlaps `aabb` (see
+    /// [`AabbTree::overlapping`]).
+    pub fn overlapping(&self, aabb: &Aabb, stack: &mut Vec<u32>, mut visit: impl FnMut(u32)) {
+        for (tree, ids) in self.trees() {
+            tree.overlapping(aabb, stack, |key| {
+                if let Some(&id) = ids.get(key as usize) {
+                    visit(id);
+                }
+            });
+        }
+    }
+
+    /// Walks the items whose grown box `ray` enters before `max` (see
+    /// [`AabbTree::along_ray`]): the recent tree first, then the main one, with the `max`
+    /// the first left.
+    pub fn along_ray(
+        &self,
+        ray: &RaySegment,
+        grow: f32,
+        mut max: f32,
+        stack: &mut Vec<(u32, f32)>,
+        mut visit: impl FnMut(u32, f32) -> Option<f32>,
+    ) {
+        for (tree, ids) in self.trees() {
+            tree.along_ray(ray, grow, max, stack, |key, t| {
+                let new_max = visit(*ids.get(key as usize)?, t)?;
+                max = max.min(new_max);
+                Some(new_max)
+            });
+        }
+    }
+
+    /// Walks the items whose box lies within `sqrt(max2)` of `p` (see
+    /// [`AabbTree::near_point`]), the recent tree first.
+    pub fn near_point(
+        &self,
+        p: Vec3,
+        mut max2: f32,
+        stack: &mut Vec<(u32, f32)>,
+        mut visit: impl FnMut(u32, f32) -> Option<f32>,
+    ) {
+        for (tree, ids) in self.trees() {
+            tree.near_point(p, max2, stack, |key, d2| {
+                let new_max2 = visit(*ids.get(key as usize)?, d2)?;
+                max2 = max2.min(new_max2);
+                Some(new_max2)
+            });
+        }
+    }
+
+    /// The recent tree, then the main one, each with its keys' ids.
+    fn trees(&self) -> [(&AabbTree, &[u32]); 2] {
+        [
+            (&self.recent, &self.recent_ids),
+            (&self.main, &self.main_ids),
+        ]
+    }
+}
+
+#[cfg(test)]
+#[path = "collider_tree_tests.rs"]
+mod tests;
