@@ -59,6 +59,8 @@ pub struct ColliderTree {
     built_cost: Option<f32>,
     /// Updates since the cost was last checked.
     unchecked: u32,
+    /// A stream found the tree worn ([`Self::finish_stream`]): the next update rebuilds.
+    rebuild_due: bool,
 }
 
 impl ColliderTree {
@@ -69,12 +71,55 @@ impl ColliderTree {
     /// [`CHECK_EVERY`] updates).
     pub fn update(&mut self, items: &[(u32, Aabb)]) -> IndexUpdate {
         match self.sync(items) {
-            Some(kind) if !self.worn() => kind,
+            Some(kind) if !self.rebuild_due && !self.worn() => kind,
             _ => {
                 self.rebuild(items);
                 IndexUpdate::Rebuilt
             }
         }
+    }
+
+    /// Streams the `at`-th item's box in while the ids are the last update's, in order:
+    /// `true` if `id` is the one the last update had there (its box is then written), `false`
+    /// otherwise (nothing written; the caller collects the items and calls [`Self::update`],
+    /// starting with [`Self::last_items`]). Saves a refit the list of items.
+    pub fn stream_box(&mut self, at: usize, id: u32, aabb: &Aabb) -> bool {
+        match self.placed.get(at) {
+            Some(&(old, slot)) if old == id => {
+                if slot & RECENT == 0 {
+                    self.main.set_box(slot as usize, aabb);
+                } else {
+                    self.recent.set_box((slot & !RECENT) as usize, aabb);
+                }
+                true
+            }
+            _ => false,
+        }
+    }
+
+    /// Appends the first `count` items of the last update with the boxes they hold now.
+    pub fn last_items(&self, count: usize, out: &mut Vec<(u32, Aabb)>) {
+        out.extend(self.placed[..count].iter().map(|&(id, slot)| {
+            let aabb = if slot & RECENT == 0 {
+                self.main.box_at(slot as usize)
+            } else {
+                self.recent.box_at((slot & !RECENT) as usize)
+            };
+            (id, aabb)
+        }));
+    }
+
+    /// Ends a stream that gave every item of the last update in order ([`Self::stream_box`]
+    /// `true` for each): the nodes refitted, or `false` when there were fewer items, or the
+    /// tree is worn (the update then rebuilds it), and the caller goes on to [`Self::update`].
+    pub fn finish_stream(&mut self, count: usize) -> bool {
+        if count != self.placed.len() {
+            return false;
+        }
+        self.main.refit_nodes();
+        self.recent.refit_nodes();
+        self.rebuild_due = self.worn();
+        !self.rebuild_due
     }
 
     /// Whether the main tree's relative cost grew past [`WORN`] times its build's (checked
@@ -106,6 +151,7 @@ impl ColliderTree {
         self.retired = 0;
         self.built_cost = self.main.relative_cost();
         self.unchecked = 0;
+        self.rebuild_due = false;
         self.recent.build(&[]);
         self.recent_ids.clear();
         self.recent_items.clear();

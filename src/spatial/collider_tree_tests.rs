@@ -191,3 +191,45 @@ fn boxes_scattered_anew_under_the_same_ids_rebuild_within_8_updates_and_keep_the
     let still: Vec<_> = (0..24).map(|_| tree.update(&items)).collect();
     assert!(still.iter().all(|k| *k == IndexUpdate::Refitted));
 }
+
+/// An update as `SpatialIndex::update` makes it: boxes streamed while the ids are the last
+/// update's, then the list.
+fn streamed(tree: &mut ColliderTree, items: &[(u32, Aabb)]) -> IndexUpdate {
+    let mut at = 0;
+    while at < items.len() && tree.stream_box(at, items[at].0, &items[at].1) {
+        at += 1;
+    }
+    if at == items.len() && tree.finish_stream(at) {
+        return IndexUpdate::Refitted;
+    }
+    let mut list = Vec::new();
+    tree.last_items(at, &mut list);
+    list.extend_from_slice(&items[at..]);
+    assert_eq!(list, items);
+    tree.update(&list)
+}
+
+#[test]
+fn streamed_updates_refit_keep_and_rebuild_as_listed_ones_and_a_worn_stream_rebuilds_within_8() {
+    let mut rng = TestRng::new(16);
+    let mut items: Vec<(u32, Aabb)> = (0..800).map(|i| (i, random_box(&mut rng))).collect();
+    let (mut tree, mut listed) = (ColliderTree::default(), ColliderTree::default());
+    for round in 0..40 {
+        if round % 3 == 1 {
+            let at = rng.below(items.len() as u32) as usize;
+            items.swap_remove(at);
+            items.push((900 + round, random_box(&mut rng)));
+        }
+        for (_, b) in &mut items {
+            *b = Aabb::from_center_half_extents(b.center() + rng.vec3(-0.1, 0.1), b.half_extents());
+        }
+        assert_eq!(streamed(&mut tree, &items), listed.update(&items));
+        assert_queries_match_brute_force(&tree, &items, &mut rng);
+    }
+    for (_, b) in &mut items {
+        *b = random_box(&mut rng);
+    }
+    let kinds: Vec<_> = (0..8).map(|_| streamed(&mut tree, &items)).collect();
+    assert!(kinds.contains(&IndexUpdate::Rebuilt), "{kinds:?}");
+    assert_queries_match_brute_force(&tree, &items, &mut rng);
+}

@@ -79,13 +79,31 @@ impl SpatialIndex {
     ) -> IndexUpdate {
         self.items.clear();
         self.unbounded.clear();
+        // While the ids are the last update's in order (most steps), each box goes straight
+        // into the tree; at the first other id the items so far are collected and the rest
+        // follows into the list `ColliderTree::update` takes.
+        let mut streamed = Some(0);
         for (id, shape, pose) in colliders {
             let aabb = shape.world_aabb(&pose);
-            if aabb.is_valid() && aabb.is_finite() {
-                self.items.push((id, aabb));
-            } else {
+            if !(aabb.is_valid() && aabb.is_finite()) {
                 self.unbounded.push(id);
+            } else if let Some(at) = streamed {
+                if self.tree.stream_box(at, id, &aabb) {
+                    streamed = Some(at + 1);
+                } else {
+                    streamed = None;
+                    self.tree.last_items(at, &mut self.items);
+                    self.items.push((id, aabb));
+                }
+            } else {
+                self.items.push((id, aabb));
             }
+        }
+        if let Some(count) = streamed {
+            if self.tree.finish_stream(count) {
+                return IndexUpdate::Refitted;
+            }
+            self.tree.last_items(count, &mut self.items);
         }
         self.tree.update(&self.items)
     }

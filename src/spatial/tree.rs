@@ -172,6 +172,11 @@ impl AabbTree {
         self.boxes[slot] = (*aabb).into();
     }
 
+    /// The box of the item in `slot`.
+    pub(crate) fn box_at(&self, slot: usize) -> Aabb {
+        self.boxes[slot].into()
+    }
+
     /// Takes the item in `slot` out: its id becomes [`RETIRED`] and its box empty, so no
     /// overlap query reaches it and the next refit leaves it out of its parents' boxes (a ray
     /// may still be handed it: callers skip the id).
