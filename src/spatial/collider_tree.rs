@@ -18,6 +18,9 @@ use super::tree::{AabbTree, RaySegment};
 use crate::bounding::Aabb;
 use glam::Vec3;
 
+/// A visit of a pruning walk: an item's key and its distance, to a new limit or `None`.
+type Visit<'a> = dyn FnMut(u32, f32) -> Option<f32> + 'a;
+
 /// Marks a slot of the recent tree in [`ColliderTree::placed`].
 const RECENT: u32 = 1 << 31;
 /// No key (in the location scratch).
@@ -309,39 +312,48 @@ impl ColliderTree {
     }
 
     /// Walks the items whose grown box `ray` enters before `max` (see
-    /// [`AabbTree::along_ray`]): the recent tree first, then the main one, with the `max`
-    /// the first left.
+    /// [`AabbTree::along_ray`]).
     pub fn along_ray(
         &self,
         ray: &RaySegment,
         grow: f32,
-        mut max: f32,
+        max: f32,
         stack: &mut Vec<(u32, f32)>,
-        mut visit: impl FnMut(u32, f32) -> Option<f32>,
+        visit: impl FnMut(u32, f32) -> Option<f32>,
     ) {
-        for (tree, ids) in self.trees() {
-            tree.along_ray(ray, grow, max, stack, |key, t| {
-                let new_max = visit(*ids.get(key as usize)?, t)?;
-                max = max.min(new_max);
-                Some(new_max)
-            });
-        }
+        let walk =
+            |tree: &AabbTree, max, visit: &mut Visit| tree.along_ray(ray, grow, max, stack, visit);
+        self.pruning_walk(max, walk, visit);
     }
 
     /// Walks the items whose box lies within `sqrt(max2)` of `p` (see
-    /// [`AabbTree::near_point`]), the recent tree first.
+    /// [`AabbTree::near_point`]).
     pub fn near_point(
         &self,
         p: Vec3,
-        mut max2: f32,
+        max2: f32,
         stack: &mut Vec<(u32, f32)>,
+        visit: impl FnMut(u32, f32) -> Option<f32>,
+    ) {
+        let walk =
+            |tree: &AabbTree, max2, visit: &mut Visit| tree.near_point(p, max2, stack, visit);
+        self.pruning_walk(max2, walk, visit);
+    }
+
+    /// A walk that prunes by a limit (`walk(tree, limit, visit)`, `visit` returning a new
+    /// limit or `None`) over the recent tree, then the main one, each key handed to `visit`
+    /// as the caller's id, the main walk starting from the limit the recent one left.
+    fn pruning_walk(
+        &self,
+        mut limit: f32,
+        mut walk: impl FnMut(&AabbTree, f32, &mut Visit),
         mut visit: impl FnMut(u32, f32) -> Option<f32>,
     ) {
         for (tree, ids) in self.trees() {
-            tree.near_point(p, max2, stack, |key, d2| {
-                let new_max2 = visit(*ids.get(key as usize)?, d2)?;
-                max2 = max2.min(new_max2);
-                Some(new_max2)
+            walk(tree, limit, &mut |key, x| {
+                let new_limit = visit(*ids.get(key as usize)?, x)?;
+                limit = limit.min(new_limit);
+                Some(new_limit)
             });
         }
     }

@@ -49,6 +49,14 @@ fn assert_queries_match_brute_force(tree: &ColliderTree, items: &[(u32, Aabb)], 
     }
 }
 
+/// `n` random boxes with ids `0..n`, and a tree updated with them.
+fn indexed(n: u32, rng: &mut TestRng) -> (Vec<(u32, Aabb)>, ColliderTree) {
+    let items: Vec<(u32, Aabb)> = (0..n).map(|i| (i, random_box(rng))).collect();
+    let mut tree = ColliderTree::default();
+    assert_eq!(tree.update(&items), IndexUpdate::Rebuilt);
+    (items, tree)
+}
+
 fn assert_same(mut found: Vec<u32>, mut expected: Vec<u32>) {
     found.sort_unstable();
     expected.sort_unstable();
@@ -98,9 +106,7 @@ fn churn_of_up_to_12_ids_a_round_keeps_every_query_equal_to_brute_force_over_80_
 #[test]
 fn one_collider_added_a_round_to_1000_rebuilds_at_most_3_times_in_150_rounds() {
     let mut rng = TestRng::new(12);
-    let mut items: Vec<(u32, Aabb)> = (0..1000).map(|i| (i, random_box(&mut rng))).collect();
-    let mut tree = ColliderTree::default();
-    assert_eq!(tree.update(&items), IndexUpdate::Rebuilt);
+    let (mut items, mut tree) = indexed(1000, &mut rng);
     let mut rebuilds = 0;
     for round in 0..150 {
         items.push((1000 + round, random_box(&mut rng)));
@@ -148,9 +154,7 @@ fn duplicate_sparse_and_extreme_ids_are_each_reported_once_per_item() {
 #[test]
 fn a_first_hit_walk_prunes_across_both_trees_to_the_nearest_entry() {
     let mut rng = TestRng::new(14);
-    let mut items: Vec<(u32, Aabb)> = (0..500).map(|i| (i, random_box(&mut rng))).collect();
-    let mut tree = ColliderTree::default();
-    tree.update(&items);
+    let (mut items, mut tree) = indexed(500, &mut rng);
     items.extend((500..520).map(|i| (i, random_box(&mut rng))));
     assert_eq!(tree.update(&items), IndexUpdate::Updated);
     assert_eq!(tree.pending(), (20, 0));
@@ -175,9 +179,7 @@ fn a_first_hit_walk_prunes_across_both_trees_to_the_nearest_entry() {
 #[test]
 fn boxes_scattered_anew_under_the_same_ids_rebuild_within_8_updates_and_keep_the_cost_under_1_5x() {
     let mut rng = TestRng::new(15);
-    let mut items: Vec<(u32, Aabb)> = (0..1000).map(|i| (i, random_box(&mut rng))).collect();
-    let mut tree = ColliderTree::default();
-    tree.update(&items);
+    let (mut items, mut tree) = indexed(1000, &mut rng);
     let built = tree.main.relative_cost().unwrap();
     // Every box moves to a random place of the same cube: the refit tree's nodes span it all.
     for (_, b) in &mut items {
