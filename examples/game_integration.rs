@@ -35,6 +35,7 @@ use std::error::Error;
 use std::time::{Duration, Instant};
 use support::RecordingArgs;
 use urto::debug::{DebugColor, RerunDebugPlugin};
+use urto::plugins::SpatialQueryIndex;
 use urto::prelude::*;
 
 /// A player ball steering to a goal past crates and a turret, as a Bevy game runs it.
@@ -442,6 +443,7 @@ fn end_after_playtime(
     score: Res<Score>,
     stats: Res<PhysicsStats>,
     players: Query<&ComputedMass, With<Player>>,
+    index: Option<Res<SpatialQueryIndex>>,
     mut exit: MessageWriter<AppExit>,
 ) {
     if time.elapsed_secs() < run.seconds {
@@ -497,6 +499,13 @@ fn end_after_playtime(
         "  collisions started (messages read once a frame): {}",
         score.collisions_started
     );
+    if let Some(index) = index {
+        let r = index.refreshes();
+        println!(
+            "  the query index: refitted {} times, kept through spawns and despawns {}, rebuilt {}",
+            r.refits, r.updates, r.rebuilds
+        );
+    }
     println!("  wall time: {:.2} s", run.started.elapsed().as_secs_f64());
     support::print_recording(&run.recording);
     exit.write(AppExit::Success);
