@@ -441,9 +441,8 @@ fn end_after_playtime(
     fixed: Res<Time<Fixed>>,
     run: Res<Run>,
     score: Res<Score>,
-    stats: Res<PhysicsStats>,
+    (stats, index): (Res<PhysicsStats>, Option<Res<SpatialQueryIndex>>),
     players: Query<&ComputedMass, With<Player>>,
-    index: Option<Res<SpatialQueryIndex>>,
     mut exit: MessageWriter<AppExit>,
 ) {
     if time.elapsed_secs() < run.seconds {
