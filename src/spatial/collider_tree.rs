@@ -100,9 +100,10 @@ impl ColliderTree {
         }
     }
 
-    /// Appends the first `count` items of the last update with the boxes they hold now.
+    /// Appends the first `count` items of the last update (all of them if it had fewer) with
+    /// the boxes they hold now.
     pub fn last_items(&self, count: usize, out: &mut Vec<(u32, Aabb)>) {
-        out.extend(self.placed[..count].iter().map(|&(id, slot)| {
+        out.extend(self.placed.iter().take(count).map(|&(id, slot)| {
             let aabb = if slot & RECENT == 0 {
                 self.main.box_at(slot as usize)
             } else {
