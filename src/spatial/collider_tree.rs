@@ -56,8 +56,8 @@ pub struct ColliderTree {
     departures: Vec<(u32, u32)>,
     /// Scratch: the positions of the items for the recent tree.
     recent_members: Vec<u32>,
-    /// Scratch: the recent items, keyed.
-    recent_items: Vec<(u32, Aabb)>,
+    /// Scratch: items keyed for a build (the main tree's or the recent one's).
+    keyed: Vec<(u32, Aabb)>,
     /// The main tree's relative cost when it was built.
     built_cost: Option<f32>,
     /// Updates since the cost was last checked.
@@ -86,14 +86,11 @@ impl ColliderTree {
     /// `true` if `id` is the one the last update had there (its box is then written), `false`
     /// otherwise (nothing written; the caller collects the items and calls [`Self::update`],
     /// starting with [`Self::last_items`]). Saves a refit the list of items.
+    #[inline]
     pub fn stream_box(&mut self, at: usize, id: u32, aabb: &Aabb) -> bool {
         match self.placed.get(at) {
-            Some(&(old, slot)) if old == id => {
-                if slot & RECENT == 0 {
-                    self.main.set_box(slot as usize, aabb);
-                } else {
-                    self.recent.set_box((slot & !RECENT) as usize, aabb);
-                }
+            Some(&(old, place)) if old == id => {
+                self.set_placed_box(place, aabb);
                 true
             }
             _ => false,
@@ -103,14 +100,27 @@ impl ColliderTree {
     /// Appends the first `count` items of the last update (all of them if it had fewer) with
     /// the boxes they hold now.
     pub fn last_items(&self, count: usize, out: &mut Vec<(u32, Aabb)>) {
-        out.extend(self.placed.iter().take(count).map(|&(id, slot)| {
-            let aabb = if slot & RECENT == 0 {
-                self.main.box_at(slot as usize)
-            } else {
-                self.recent.box_at((slot & !RECENT) as usize)
-            };
-            (id, aabb)
-        }));
+        let boxed = |&(id, place): &(u32, u32)| (id, self.placed_box(place));
+        out.extend(self.placed.iter().take(count).map(boxed));
+    }
+
+    /// Writes the box of the item at `place` (a main slot, or a recent one with [`RECENT`]).
+    #[inline]
+    fn set_placed_box(&mut self, place: u32, aabb: &Aabb) {
+        if place & RECENT == 0 {
+            self.main.set_box(place as usize, aabb);
+        } else {
+            self.recent.set_box((place & !RECENT) as usize, aabb);
+        }
+    }
+
+    /// The box of the item at `place`.
+    fn placed_box(&self, place: u32) -> Aabb {
+        if place & RECENT == 0 {
+            self.main.box_at(place as usize)
+        } else {
+            self.recent.box_at((place & !RECENT) as usize)
+        }
     }
 
     /// Ends a stream that gave every item of the last update in order ([`Self::stream_box`]
@@ -142,14 +152,14 @@ impl ColliderTree {
 
     /// One main tree over every item; no recent or retired ones.
     fn rebuild(&mut self, items: &[(u32, Aabb)]) {
-        self.recent_items.clear();
-        self.recent_items.extend(
+        self.keyed.clear();
+        self.keyed.extend(
             items
                 .iter()
                 .enumerate()
                 .map(|(key, &(_, b))| (key as u32, b)),
         );
-        self.main.build(&self.recent_items);
+        self.main.build(&self.keyed);
         self.main_ids.clear();
         self.main_ids.extend(items.iter().map(|&(id, _)| id));
         self.retired = 0;
@@ -158,7 +168,7 @@ impl ColliderTree {
         self.rebuild_due = false;
         self.recent.build(&[]);
         self.recent_ids.clear();
-        self.recent_items.clear();
+        self.keyed.clear();
         self.placed.clear();
         let main = &self.main;
         self.placed.extend(
@@ -182,13 +192,15 @@ impl ColliderTree {
         self.departures.clear();
         self.recent_members.clear();
         let kept = items.len().min(self.placed.len());
-        for (i, (&(id, aabb), &(old, at))) in items.iter().zip(&self.placed).enumerate() {
+        for (i, (&(id, aabb), &(old, place))) in items.iter().zip(&self.placed).enumerate() {
             if id != old {
                 self.arrivals.push(i as u32);
-                self.departures.push((old, at));
-            } else if at & RECENT == 0 {
-                self.main.set_box(at as usize, &aabb);
+                self.departures.push((old, place));
+            } else if place & RECENT == 0 {
+                self.main.set_box(place as usize, &aabb);
             } else {
+                // Its box is written below if nothing else changed; if something did, the
+                // recent tree is rebuilt from the items.
                 self.recent_members.push(i as u32);
             }
         }
@@ -196,8 +208,8 @@ impl ColliderTree {
         self.departures.extend_from_slice(&self.placed[kept..]);
         if self.arrivals.is_empty() && self.departures.is_empty() {
             for &i in &self.recent_members {
-                let at = self.placed[i as usize].1 & !RECENT;
-                self.recent.set_box(at as usize, &items[i as usize].1);
+                let slot = self.placed[i as usize].1 & !RECENT;
+                self.recent.set_box(slot as usize, &items[i as usize].1);
             }
             self.main.refit_nodes();
             self.recent.refit_nodes();
@@ -266,14 +278,14 @@ impl ColliderTree {
 
     /// The recent tree anew over the recent members, and their places.
     fn rebuild_recent(&mut self, items: &[(u32, Aabb)]) {
-        self.recent_items.clear();
+        self.keyed.clear();
         self.recent_ids.clear();
         for (key, &i) in self.recent_members.iter().enumerate() {
             let (id, aabb) = items[i as usize];
-            self.recent_items.push((key as u32, aabb));
+            self.keyed.push((key as u32, aabb));
             self.recent_ids.push(id);
         }
-        self.recent.build(&self.recent_items);
+        self.recent.build(&self.keyed);
         for (key, &i) in self.recent_members.iter().enumerate() {
             let slot = self.recent.slot_of_input(key) as u32;
             self.placed[i as usize] = (items[i as usize].0, RECENT | slot);
