@@ -325,7 +325,8 @@ impl ColliderTree {
     }
 
     /// Walks the items whose grown box `ray` enters before `max` (see
-    /// [`AabbTree::along_ray`]).
+    /// [`AabbTree::along_ray`]); returns the limit the walk ended with (the least of `max`
+    /// and what `visit` returned), for a walk of another tree to start from.
     pub fn along_ray(
         &self,
         ray: &RaySegment,
@@ -333,35 +334,37 @@ impl ColliderTree {
         max: f32,
         stack: &mut Vec<(u32, f32)>,
         visit: impl FnMut(u32, f32) -> Option<f32>,
-    ) {
+    ) -> f32 {
         let walk =
             |tree: &AabbTree, max, visit: &mut Visit| tree.along_ray(ray, grow, max, stack, visit);
-        self.pruning_walk(max, walk, visit);
+        self.pruning_walk(max, walk, visit)
     }
 
     /// Walks the items whose box lies within `sqrt(max2)` of `p` (see
-    /// [`AabbTree::near_point`]).
+    /// [`AabbTree::near_point`]); returns the limit the walk ended with, as
+    /// [`Self::along_ray`] does.
     pub fn near_point(
         &self,
         p: Vec3,
         max2: f32,
         stack: &mut Vec<(u32, f32)>,
         visit: impl FnMut(u32, f32) -> Option<f32>,
-    ) {
+    ) -> f32 {
         let walk =
             |tree: &AabbTree, max2, visit: &mut Visit| tree.near_point(p, max2, stack, visit);
-        self.pruning_walk(max2, walk, visit);
+        self.pruning_walk(max2, walk, visit)
     }
 
     /// A walk that prunes by a limit (`walk(tree, limit, visit)`, `visit` returning a new
     /// limit or `None`) over the recent tree, then the main one, each key handed to `visit`
-    /// as the caller's id, the main walk starting from the limit the recent one left.
+    /// as the caller's id, the main walk starting from the limit the recent one left; returns
+    /// the limit it ended with.
     fn pruning_walk(
         &self,
         mut limit: f32,
         mut walk: impl FnMut(&AabbTree, f32, &mut Visit),
         mut visit: impl FnMut(u32, f32) -> Option<f32>,
-    ) {
+    ) -> f32 {
         for (tree, ids) in self.trees() {
             walk(tree, limit, &mut |key, x| {
                 let new_limit = visit(*ids.get(key as usize)?, x)?;
@@ -369,6 +372,7 @@ impl ColliderTree {
                 Some(new_limit)
             });
         }
+        limit
     }
 
     /// The recent tree, then the main one, each with its keys' ids.

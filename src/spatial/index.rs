@@ -55,12 +55,18 @@ pub enum IndexUpdate {
     Rebuilt,
 }
 
-/// The colliders' boxes and the buffers of the queries.
+/// The colliders' boxes, in two groups, and the buffers of the queries.
+///
+/// The *moving* group is read whole at every [`Self::update`]; the *still* group only when
+/// [`Self::update_still`] is called, which a caller does when it knows a still collider
+/// changed: the ECS puts the static bodies nobody wrote to since the last step there (its
+/// settled statics), so that a level's scenery costs nothing per step (Avian keeps static
+/// colliders in a tree of their own for the same reason). Queries search both groups, so ids
+/// must be unique across them.
 #[derive(Debug, Default)]
 pub struct SpatialIndex {
-    tree: ColliderTree,
-    /// Half-spaces (and any shape with a box that is not finite): tested by every query.
-    unbounded: Vec<u32>,
+    moving: Group,
+    still: Group,
     items: Vec<(u32, Aabb)>,
     node_stack: Vec<u32>,
     ray_stack: Vec<(u32, f32)>,
@@ -69,15 +75,22 @@ pub struct SpatialIndex {
     contact: ContactScratch,
 }
 
-impl SpatialIndex {
-    /// Indexes `colliders` (`id`, shape, world pose). Ids that stay with their colliders
-    /// (the ECS's stable ids) let a change of a few colliders keep the tree: see
-    /// [`ColliderTree::update`].
-    pub fn update<'a>(
+/// One group of colliders: a tree over the bounded ones and the list of the others.
+#[derive(Debug, Default)]
+struct Group {
+    tree: ColliderTree,
+    /// Half-spaces (and any shape with a box that is not finite): tested by every query.
+    unbounded: Vec<u32>,
+}
+
+impl Group {
+    /// Takes the group's colliders anew: see [`SpatialIndex::update`]. `items` is scratch.
+    fn update<'a>(
         &mut self,
         colliders: impl IntoIterator<Item = (u32, &'a Shape, Isometry)>,
+        items: &mut Vec<(u32, Aabb)>,
     ) -> IndexUpdate {
-        self.items.clear();
+        items.clear();
         self.unbounded.clear();
         // While the ids are the last update's in order (most steps), each box goes straight
         // into the tree; at the first other id the items so far are collected and the rest
@@ -92,20 +105,45 @@ impl SpatialIndex {
                     streamed = Some(at + 1);
                 } else {
                     streamed = None;
-                    self.tree.last_items(at, &mut self.items);
-                    self.items.push((id, aabb));
+                    self.tree.last_items(at, items);
+                    items.push((id, aabb));
                 }
             } else {
-                self.items.push((id, aabb));
+                items.push((id, aabb));
             }
         }
         if let Some(count) = streamed {
             if self.tree.finish_stream(count) {
                 return IndexUpdate::Refitted;
             }
-            self.tree.last_items(count, &mut self.items);
+            self.tree.last_items(count, items);
         }
-        self.tree.update(&self.items)
+        self.tree.update(items)
+    }
+
+    fn len(&self) -> usize {
+        self.tree.len() + self.unbounded.len()
+    }
+}
+
+impl SpatialIndex {
+    /// Indexes the moving group's `colliders` (`id`, shape, world pose), keeping the still
+    /// group as it is. Ids that stay with their colliders (the ECS's stable ids) let a change
+    /// of a few colliders keep the tree: see [`ColliderTree::update`].
+    pub fn update<'a>(
+        &mut self,
+        colliders: impl IntoIterator<Item = (u32, &'a Shape, Isometry)>,
+    ) -> IndexUpdate {
+        self.moving.update(colliders, &mut self.items)
+    }
+
+    /// Indexes the still group's `colliders` as [`Self::update`] does the moving group's;
+    /// their ids must differ from the moving group's.
+    pub fn update_still<'a>(
+        &mut self,
+        colliders: impl IntoIterator<Item = (u32, &'a Shape, Isometry)>,
+    ) -> IndexUpdate {
+        self.still.update(colliders, &mut self.items)
     }
 
     /// How much the boxes are grown for a cast: the exact tests accept hits within
@@ -113,7 +151,7 @@ impl SpatialIndex {
     /// the sweep's length, which is at most the distance across the tree's boxes; grown by it,
     /// no box culls a shape the exact test would hit.
     fn slack(&self, ray: &Ray, radius: f32, max: f32) -> f32 {
-        let bounds = self.tree.bounds();
+        let bounds = self.moving.tree.bounds().union(&self.still.tree.bounds());
         let across = (ray.origin() - bounds.center()).length() + bounds.half_extents().length();
         let length = if across.is_finite() {
             across.min(max)
@@ -123,9 +161,9 @@ impl SpatialIndex {
         2.0 * CONTACT_TOLERANCE_RELATIVE * (radius + length + 1.0)
     }
 
-    /// Colliders indexed (bounded and unbounded).
+    /// Colliders indexed (bounded and unbounded, both groups).
     pub fn len(&self) -> usize {
-        self.tree.len() + self.unbounded.len()
+        self.moving.len() + self.still.len()
     }
 
     /// Whether nothing is indexed.
@@ -254,15 +292,20 @@ impl SpatialIndex {
             // Boxes entered beyond the nearest hit so far cannot hold a nearer one.
             best.map(|b| b.hit.distance)
         };
-        for i in 0..self.unbounded.len() {
-            consider(self.unbounded[i], &mut self.mesh);
+        let (groups, mesh) = ([&self.moving, &self.still], &mut self.mesh);
+        for &id in groups.iter().flat_map(|g| &g.unbounded) {
+            consider(id, mesh);
         }
         let segment = RaySegment::new(ray.origin(), ray.direction());
-        let mesh = &mut self.mesh;
-        self.tree
-            .along_ray(&segment, grow, max, &mut self.ray_stack, |id, _| {
-                consider(id, mesh)
-            });
+        // The still tree's walk starts from the nearest hit the moving one found.
+        let mut limit = max;
+        for group in groups {
+            limit = group
+                .tree
+                .along_ray(&segment, grow, limit, &mut self.ray_stack, |id, _| {
+                    consider(id, mesh)
+                });
+        }
         best
     }
 
@@ -285,17 +328,20 @@ impl SpatialIndex {
                 out.push(QueryHit { id, hit });
             }
         };
-        for i in 0..self.unbounded.len() {
-            consider(self.unbounded[i], &mut self.mesh);
+        let grow = self.slack(ray, 0.0, max);
+        let (groups, mesh) = ([&self.moving, &self.still], &mut self.mesh);
+        for &id in groups.iter().flat_map(|g| &g.unbounded) {
+            consider(id, mesh);
         }
         let segment = RaySegment::new(ray.origin(), ray.direction());
-        let grow = self.slack(ray, 0.0, max);
-        let mesh = &mut self.mesh;
-        self.tree
-            .along_ray(&segment, grow, max, &mut self.ray_stack, |id, _| {
-                consider(id, mesh);
-                None
-            });
+        for group in groups {
+            group
+                .tree
+                .along_ray(&segment, grow, max, &mut self.ray_stack, |id, _| {
+                    consider(id, mesh);
+                    None
+                });
+        }
         out.sort_by(|a, b| {
             a.hit
                 .distance
@@ -317,11 +363,14 @@ impl SpatialIndex {
     ) {
         out.clear();
         self.candidates.clear();
-        self.candidates.extend_from_slice(&self.unbounded);
         let query_box = shape.world_aabb(pose);
-        let candidates = &mut self.candidates;
-        self.tree
-            .overlapping(&query_box, &mut self.node_stack, |id| candidates.push(id));
+        for group in [&self.moving, &self.still] {
+            let candidates = &mut self.candidates;
+            candidates.extend_from_slice(&group.unbounded);
+            group
+                .tree
+                .overlapping(&query_box, &mut self.node_stack, |id| candidates.push(id));
+        }
         for &id in &self.candidates {
             if !accept(id) {
                 continue;
@@ -391,13 +440,17 @@ impl SpatialIndex {
             None
         };
         let mut max2 = max_distance * max_distance;
-        for &id in &self.unbounded {
+        let groups = [&self.moving, &self.still];
+        for &id in groups.iter().flat_map(|g| &g.unbounded) {
             if let Some(d2) = consider(id) {
                 max2 = max2.min(d2);
             }
         }
-        self.tree
-            .near_point(point, max2, &mut self.ray_stack, |id, _| consider(id));
+        for group in groups {
+            max2 = group
+                .tree
+                .near_point(point, max2, &mut self.ray_stack, |id, _| consider(id));
+        }
         Ok(best)
     }
 }

@@ -6,6 +6,7 @@
 mod common;
 mod ecs;
 mod nearest_and_casts;
+mod still_group;
 
 use bevy_app::App;
 use bevy_ecs::prelude::*;
