@@ -20,14 +20,41 @@ use crate::components::*;
 use crate::plugins::table_ticks::{dense, mark, written_ticks};
 use bevy_ecs::bundle::InsertMode;
 use bevy_ecs::change_detection::ContiguousComponentTicksRef;
+use bevy_ecs::lifecycle::HookContext;
 use bevy_ecs::prelude::*;
 use bevy_ecs::query::ContiguousQueryData;
 use bevy_ecs::system::entity_command;
+use bevy_ecs::world::DeferredWorld;
 use bevy_transform::components::Transform;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// A static body no game code wrote to since the last step's end: left out of the change scans.
 #[derive(Component, Clone, Copy, Debug, Default)]
+#[component(on_add = note_settling, on_remove = note_settling)]
 pub(crate) struct Settled;
+
+/// Names the set of settled bodies: a new value whenever a body gains or loses [`Settled`]
+/// (despawns included), so that a reader keeping something per settled body (the spatial
+/// queries' still group) knows the set is unchanged without reading it. Values come from one
+/// counter for every world, so a resource put back after game code removed it never repeats
+/// a value a reader kept.
+#[derive(Resource, Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct SettledRevision(pub(crate) u64);
+
+impl Default for SettledRevision {
+    fn default() -> Self {
+        Self(NEXT_SETTLED_REVISION.fetch_add(1, Ordering::Relaxed))
+    }
+}
+
+static NEXT_SETTLED_REVISION: AtomicU64 = AtomicU64::new(1);
+
+/// The [`Settled`] marker's hooks: the set of settled bodies changed.
+fn note_settling(mut world: DeferredWorld, _: HookContext) {
+    if let Some(mut revision) = world.get_resource_mut::<SettledRevision>() {
+        *revision = SettledRevision::default();
+    }
+}
 
 /// Change scans leave settled bodies out.
 pub(crate) type Unsettled = Without<Settled>;

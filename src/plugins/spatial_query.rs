@@ -23,10 +23,22 @@
 //! steps are seen after the next step, or at once after [`SpatialQuery::refresh`]. Roots are
 //! read at their [`Position`] and [`Rotation`], parts of compound bodies at their
 //! [`GlobalPose`]. Quarantined colliders are never hit.
+//!
+//! Static scenery is not read at each step. A [`Static`] root body nobody wrote to since the
+//! last step is *settled* (the marker the step's change scans leave out, see `settle.rs`), and
+//! settled colliders sit in the index's still group ([`SpatialIndex::update_still`]), read
+//! again only when a body settles or stops being settled (or is despawned): the marker's hooks
+//! give the set a new revision. A level of 100,000 static colliders then costs its queries
+//! nothing per step, where it cost a box and a refit per collider (Avian keeps its static
+//! colliders in a tree of their own for the same reason). A static the game moves leaves the
+//! group at the next step (it is no longer settled) and comes back settled at that step's end.
+//! Index ids tell the groups apart: a moving collider's is twice its stable key, a settled
+//! one's twice plus one.
 
 use crate::components::*;
 use crate::geometry::{Isometry, Shape};
 use crate::plugins::required_resources::RequireResource;
+use crate::plugins::settle::{Settled, SettledRevision};
 use crate::spatial::{
     ColliderLookup, IndexUpdate, LayerMask, QueryError, Ray, SpatialIndex, StableIds,
 };
@@ -56,11 +68,15 @@ pub struct SpatialQueryIndex {
 #[derive(Default)]
 struct IndexState {
     index: SpatialIndex,
-    /// The index id of each collider entity, stable while others come and go (so that a
-    /// change of a few colliders keeps the index's tree).
+    /// The key of each moving collider entity, stable while others come and go (so that a
+    /// change of a few colliders keeps the index's tree); its index id is `2 key`.
     ids: StableIds<Entity>,
+    /// The key of each settled one, in the index's still group; its index id is `2 key + 1`.
+    still_ids: StableIds<Entity>,
     /// The physics step of the last refresh.
     step: Option<u64>,
+    /// The settled bodies' revision when the still group was last read.
+    still_seen: Option<u64>,
     refreshes: IndexRefreshes,
 }
 
@@ -73,6 +89,9 @@ pub struct IndexRefreshes {
     pub updates: u64,
     /// The same colliders: the boxes refitted.
     pub refits: u64,
+    /// The settled static bodies read again (some settled, or stopped being settled): their
+    /// tree is otherwise kept as it is, unread (see the [module](self)).
+    pub still_reads: u64,
 }
 
 impl SpatialQueryIndex {
@@ -160,35 +179,80 @@ type QueryCollider = (
     Option<&'static CollisionLayers>,
 );
 
+/// A settled static body's collider: a root, at its position.
+type StillCollider = (
+    Entity,
+    &'static Collider,
+    &'static Position,
+    &'static Rotation,
+    Option<&'static CollisionLayers>,
+);
+type Moving = (Without<Quarantined>, Without<Settled>);
+type Still = (Without<Quarantined>, With<Settled>);
+
 /// Ray casts, sphere casts, overlap and point queries against the colliders (see the
 /// [module](self)).
 #[derive(SystemParam)]
 pub struct SpatialQuery<'w, 's> {
     shared: Option<Res<'w, SpatialQueryIndex>>,
     own: Local<'s, SpatialQueryIndex>,
-    colliders: Query<'w, 's, QueryCollider, Without<Quarantined>>,
+    colliders: Query<'w, 's, QueryCollider, Moving>,
+    still: Query<'w, 's, StillCollider, Still>,
+    settled: Option<Res<'w, SettledRevision>>,
     stats: Option<Res<'w, PhysicsStats>>,
 }
 
-/// The ECS colliders by index id.
+/// The ECS colliders by index id: even ids are moving colliders' keys, odd ones settled
+/// colliders' (see [`IndexState`]).
 struct Lookup<'a, 'w, 's> {
     ids: &'a StableIds<Entity>,
-    colliders: &'a Query<'w, 's, QueryCollider, Without<Quarantined>>,
+    still_ids: &'a StableIds<Entity>,
+    colliders: &'a Query<'w, 's, QueryCollider, Moving>,
+    still: &'a Query<'w, 's, StillCollider, Still>,
 }
 
 impl Lookup<'_, '_, '_> {
+    /// The entity of `id`, if it has one.
+    fn key(&self, id: u32) -> Option<Entity> {
+        if id & 1 == 0 {
+            self.ids.key(id >> 1)
+        } else {
+            self.still_ids.key(id >> 1)
+        }
+    }
+
     /// The entity of `id`. The index reports only ids its filter accepted and the look-up
     /// found, which have entities; the placeholder stands in for what cannot happen.
     fn entity(&self, id: u32) -> Entity {
-        self.ids.key(id).unwrap_or(Entity::PLACEHOLDER)
+        self.key(id).unwrap_or(Entity::PLACEHOLDER)
+    }
+
+    /// Whether the collider `id` is there and passes `filter`.
+    fn accepts(&self, id: u32, filter: &SpatialQueryFilter) -> bool {
+        let Some(e) = self.key(id) else {
+            return false;
+        };
+        let layers = if id & 1 == 0 {
+            self.colliders.get(e).ok().map(|row| row.6)
+        } else {
+            self.still.get(e).ok().map(|row| row.4)
+        };
+        let member =
+            |l: Option<&CollisionLayers>| l.map_or(LayerMask::DEFAULT, |l| l.0.memberships);
+        layers.is_some_and(|l| member(l).intersects(filter.mask)) && !filter.excluded.contains(&e)
     }
 }
 
 impl ColliderLookup for Lookup<'_, '_, '_> {
     fn collider(&self, id: u32) -> Option<(&Shape, Isometry)> {
-        let e = self.ids.key(id)?;
-        let row = self.colliders.get(e).ok()?;
-        Some((&row.1.shape, pose_of(&row)))
+        let e = self.key(id)?;
+        if id & 1 == 0 {
+            let row = self.colliders.get(e).ok()?;
+            Some((&row.1.shape, pose_of(&row)))
+        } else {
+            let (_, collider, position, rotation, _) = self.still.get(e).ok()?;
+            Some((&collider.shape, Isometry::new(position.0, rotation.0)))
+        }
     }
 }
 
@@ -215,7 +279,8 @@ impl SpatialQuery<'_, '_> {
         self.shared.as_deref().unwrap_or(&self.own)
     }
 
-    /// The index, refreshed if a step ran since (or `force`).
+    /// The index, refreshed if a step ran since (or `force`): the moving colliders read
+    /// whole, the settled ones only if their set changed (or `force`).
     fn fresh(&self, force: bool) -> MutexGuard<'_, IndexState> {
         let mut state = self.index().lock();
         let step = self.stats.as_ref().map(|s| s.step);
@@ -226,7 +291,7 @@ impl SpatialQuery<'_, '_> {
             let colliders = self
                 .colliders
                 .iter()
-                .map(|row| (ids.id(row.0), &row.1.shape, pose_of(&row)));
+                .map(|row| (ids.id(row.0) << 1, &row.1.shape, pose_of(&row)));
             let update = state.index.update(colliders);
             state.ids.finish();
             let counts = &mut state.refreshes;
@@ -235,25 +300,42 @@ impl SpatialQuery<'_, '_> {
                 IndexUpdate::Updated => counts.updates += 1,
                 IndexUpdate::Rebuilt => counts.rebuilds += 1,
             }
+            let seen = self.settled_set();
+            if force || seen.is_none() || state.still_seen != seen {
+                self.read_still(state);
+                state.still_seen = seen;
+            }
             state.step = step;
         }
         state
     }
 
+    /// The settled bodies' revision: unchanged, no body settled or stopped being settled (or
+    /// was despawned) since the still group was read. `None` without it (removed by game code
+    /// until the next step puts it back, or no core plugin): the group is read each time.
+    fn settled_set(&self) -> Option<u64> {
+        self.settled.as_ref().map(|r| r.0)
+    }
+
+    /// Reads the settled colliders into the index's still group.
+    fn read_still(&self, state: &mut IndexState) {
+        let ids = &mut state.still_ids;
+        ids.begin();
+        let colliders = self
+            .still
+            .iter()
+            .map(|(e, collider, position, rotation, _)| {
+                let pose = Isometry::new(position.0, rotation.0);
+                ((ids.id(e) << 1) | 1, &collider.shape, pose)
+            });
+        state.index.update_still(colliders);
+        state.still_ids.finish();
+        state.refreshes.still_reads += 1;
+    }
+
     /// Re-reads every collider's pose now (after a game moved or spawned bodies between steps).
     pub fn refresh(&self) {
         drop(self.fresh(true));
-    }
-
-    /// Whether the collider `id` passes `filter`.
-    fn accepts(&self, ids: &StableIds<Entity>, id: u32, filter: &SpatialQueryFilter) -> bool {
-        let Some(e) = ids.key(id) else {
-            return false;
-        };
-        let layers = self.colliders.get(e).ok().map(|row| row.6);
-        let member =
-            |l: Option<&CollisionLayers>| l.map_or(LayerMask::DEFAULT, |l| l.0.memberships);
-        layers.is_some_and(|l| member(l).intersects(filter.mask)) && !filter.excluded.contains(&e)
     }
 
     /// Runs a query on the fresh index with the ECS lookup and `filter` as the acceptance test.
@@ -263,12 +345,19 @@ impl SpatialQuery<'_, '_> {
         query: impl FnOnce(&mut SpatialIndex, &Lookup, &dyn Fn(u32) -> bool) -> R,
     ) -> R {
         let mut state = self.fresh(false);
-        let IndexState { index, ids, .. } = &mut *state;
+        let IndexState {
+            index,
+            ids,
+            still_ids,
+            ..
+        } = &mut *state;
         let lookup = Lookup {
             ids,
+            still_ids,
             colliders: &self.colliders,
+            still: &self.still,
         };
-        query(index, &lookup, &|id| self.accepts(ids, id, filter))
+        query(index, &lookup, &|id| lookup.accepts(id, filter))
     }
 
     /// The nearest collider the ray from `origin` along `direction` hits within `max_distance`
@@ -424,3 +513,7 @@ fn to_ray_hit(lookup: &Lookup, h: crate::spatial::QueryHit) -> RayHit {
         normal: h.hit.normal,
     }
 }
+
+#[cfg(test)]
+#[path = "spatial_query_tests.rs"]
+mod tests;

@@ -5,6 +5,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 mod ecs;
+mod ecs_still;
 mod nearest_and_casts;
 mod still_group;
 

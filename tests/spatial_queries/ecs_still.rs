@@ -1,0 +1,229 @@
+//! The ECS query index's still group: settled static bodies are read again only when the set
+//! of settled bodies changes, and the answers stay those of a fresh index over the world
+//! while the game moves, turns, reshapes, despawns, spawns, quarantines and un-statics them.
+
+use super::*;
+use urto::plugins::SpatialQueryIndex;
+
+/// Every collider of the world (flat roots) at its position, as `(entity, shape, pose)`.
+fn world_colliders(world: &mut World) -> Vec<(Entity, Shape, Isometry)> {
+    let mut q = world
+        .query_filtered::<(Entity, &Collider, &Position, Option<&Rotation>), Without<Quarantined>>(
+        );
+    let mut out: Vec<_> = q
+        .iter(world)
+        .map(|(e, c, p, r)| {
+            let pose = Isometry::new(p.0, r.map_or(glam::Quat::IDENTITY, |r| r.0));
+            (e, c.shape.clone(), pose)
+        })
+        .collect();
+    out.sort_by_key(|(e, ..)| *e);
+    out
+}
+
+/// What `SpatialQuery` answers to `rays` (every hit: entity and distance) and `boxes`
+/// (overlapping entities, sorted).
+type Answers = (Vec<Vec<(Entity, f32)>>, Vec<Vec<Entity>>);
+
+fn ecs_answers(app: &mut App, rays: &[Ray], boxes: &[Isometry], refresh: bool) -> Answers {
+    let (rays, boxes) = (rays.to_vec(), boxes.to_vec());
+    app.world_mut()
+        .run_system_once(move |q: SpatialQuery| {
+            if refresh {
+                q.refresh();
+            }
+            let all = SpatialQueryFilter::default();
+            let hits = rays
+                .iter()
+                .map(|r| {
+                    let hits = q
+                        .cast_ray_all(r.origin(), r.direction(), 60.0, &all)
+                        .unwrap();
+                    hits.iter().map(|h| (h.entity, h.distance)).collect()
+                })
+                .collect();
+            let shape = Shape::cuboid(Vec3::new(2.0, 3.0, 1.5));
+            let overlaps = boxes
+                .iter()
+                .map(|pose| {
+                    let mut found = q.overlapping(&shape, *pose, &all).unwrap();
+                    found.sort();
+                    found
+                })
+                .collect();
+            (hits, overlaps)
+        })
+        .unwrap()
+}
+
+/// The same questions asked of a fresh core index over the world's colliders.
+fn fresh_answers(world: &mut World, rays: &[Ray], boxes: &[Isometry]) -> Answers {
+    let colliders = world_colliders(world);
+    let shapes: Vec<(Shape, Isometry)> =
+        colliders.iter().map(|(_, s, p)| (s.clone(), *p)).collect();
+    let mut index = indexed(&shapes);
+    let mut all = Vec::new();
+    let hits = rays
+        .iter()
+        .map(|r| {
+            // The ray as `SpatialQuery` makes it from its origin and direction.
+            let r = &Ray::new(r.origin(), r.direction()).unwrap();
+            index
+                .cast_ray_all(&*shapes, r, 60.0, |_| true, &mut all)
+                .unwrap();
+            all.iter()
+                .map(|h| (colliders[h.id as usize].0, h.hit.distance))
+                .collect()
+        })
+        .collect();
+    let shape = Shape::cuboid(Vec3::new(2.0, 3.0, 1.5));
+    let overlaps = boxes
+        .iter()
+        .map(|pose| {
+            let mut ids = Vec::new();
+            index.overlapping(&*shapes, (&shape, pose), |_| true, &mut ids);
+            let mut found: Vec<Entity> = ids.iter().map(|&i| colliders[i as usize].0).collect();
+            found.sort();
+            found
+        })
+        .collect();
+    (hits, overlaps)
+}
+
+/// Hits sorted by distance then entity: the index orders ties by its own ids.
+fn canonical((mut hits, overlaps): Answers) -> Answers {
+    for h in &mut hits {
+        h.sort_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+    }
+    (hits, overlaps)
+}
+
+fn random_static(rng: &mut Rng) -> (Collider, Position, Rotation, Static) {
+    let collider = match rng.below(3) {
+        0 => Collider::sphere(rng.range(0.3, 1.5)),
+        1 => Collider::cuboid(
+            rng.range(0.2, 2.0),
+            rng.range(0.2, 2.0),
+            rng.range(0.2, 2.0),
+        ),
+        _ => Collider::capsule(rng.range(0.0, 1.0), rng.range(0.2, 0.8)),
+    };
+    (
+        collider,
+        Position(rng.in_ball(20.0)),
+        Rotation(rng.rotation()),
+        Static,
+    )
+}
+
+fn still_reads(app: &App) -> u64 {
+    app.world()
+        .resource::<SpatialQueryIndex>()
+        .refreshes()
+        .still_reads
+}
+
+/// 300 statics, a wall and 60 balls flying in zero gravity; for 40 steps the game edits a few
+/// statics each step (moves, turns, reshapes, despawns, spawns, quarantines and releases,
+/// takes `Static` away or gives it), and the queries after each step (and after edits made
+/// between steps and a [`SpatialQuery::refresh`]) equal a fresh index's over the world. Then
+/// 30 quiet steps read the settled statics not once.
+#[test]
+fn settled_statics_edited_for_40_steps_answer_as_a_fresh_index_and_30_quiet_steps_read_them_0_times()
+ {
+    let mut app = common::app();
+    let mut rng = Rng::new(43);
+    let world = app.world_mut();
+    let mut statics: Vec<Entity> = (0..300)
+        .map(|_| world.spawn(random_static(&mut rng)).id())
+        .collect();
+    world.spawn((
+        Collider::half_space(Vec3::new(1.0, 0.2, 0.0)),
+        Position::new(-25.0, 0.0, 0.0),
+        Static,
+    ));
+    for _ in 0..60 {
+        world.spawn((
+            Collider::sphere(0.4),
+            Position(rng.in_ball(20.0)),
+            Velocity(rng.in_ball(3.0)),
+        ));
+    }
+    let mut quarantined: Vec<Entity> = Vec::new();
+    for step in 0..40 {
+        let world = app.world_mut();
+        // The statics edited (or spawned) this step, each aimed at by a ray and a box below.
+        let mut edited = Vec::new();
+        for _ in 0..rng.below(4) {
+            let e = statics[rng.below(statics.len())];
+            edited.push(e);
+            let mut entity = world.entity_mut(e);
+            match rng.below(9) {
+                0 => drop(entity.insert(Position(rng.in_ball(20.0)))),
+                1 => drop(entity.insert(Rotation(rng.rotation()))),
+                2 => drop(entity.insert(Collider::sphere(rng.range(0.5, 2.0)))),
+                3 => {
+                    entity.despawn();
+                    statics.retain(|&s| s != e);
+                }
+                4 => {
+                    entity.insert(Quarantined {
+                        reason: "test".into(),
+                    });
+                    quarantined.push(e);
+                }
+                5 => drop(entity.remove::<Static>()),
+                6 => drop(entity.insert(Static)),
+                7 => drop(entity.remove::<Collider>()),
+                _ => statics.push(world.spawn(random_static(&mut rng)).id()),
+            }
+        }
+        if step % 3 == 0
+            && let Some(e) = quarantined.pop()
+            && let Ok(mut entity) = app.world_mut().get_entity_mut(e)
+        {
+            entity.remove::<Quarantined>();
+            edited.push(e);
+        }
+        edited.extend(statics.last());
+        urto::step(app.world_mut(), 1).unwrap();
+        let mut rays: Vec<Ray> = (0..20).map(|_| random_ray(&mut rng)).collect();
+        let mut boxes: Vec<Isometry> = (0..10)
+            .map(|_| Isometry::new(rng.in_ball(20.0), rng.rotation()))
+            .collect();
+        for e in edited {
+            if let Some(at) = app.world().get::<Position>(e).map(|p| p.0) {
+                let from = at + rng.in_ball(1.0).normalize_or(Vec3::X) * 25.0;
+                rays.push(Ray::new(from, at - from).unwrap());
+                boxes.push(Isometry::new(at, rng.rotation()));
+            }
+        }
+        let ours = canonical(ecs_answers(&mut app, &rays, &boxes, false));
+        let fresh = canonical(fresh_answers(app.world_mut(), &rays, &boxes));
+        assert_eq!(ours, fresh, "step {step}");
+        // Moved between steps: seen after a refresh.
+        let e = statics[rng.below(statics.len())];
+        if let Ok(mut entity) = app.world_mut().get_entity_mut(e) {
+            entity.insert(Position(rng.in_ball(20.0)));
+        }
+        let ours = canonical(ecs_answers(&mut app, &rays, &boxes, true));
+        let fresh = canonical(fresh_answers(app.world_mut(), &rays, &boxes));
+        assert_eq!(ours, fresh, "step {step}, refreshed");
+    }
+    urto::step(app.world_mut(), 2).unwrap();
+    let rays: Vec<Ray> = (0..20).map(|_| random_ray(&mut rng)).collect();
+    ecs_answers(&mut app, &rays, &[], false);
+    let reads = still_reads(&app);
+    for _ in 0..30 {
+        urto::step(app.world_mut(), 1).unwrap();
+        let ours = canonical(ecs_answers(&mut app, &rays, &[], false));
+        assert_eq!(ours, canonical(fresh_answers(app.world_mut(), &rays, &[])));
+    }
+    assert_eq!(
+        still_reads(&app),
+        reads,
+        "quiet steps read no settled static"
+    );
+    let refreshes = app.world().resource::<SpatialQueryIndex>().refreshes();
+    assert!(refreshes.refits >= 30, "{refreshes:?}");
+}
