@@ -112,7 +112,7 @@ fn split_all(colliders: &[(Shape, Isometry)], still: bool) -> SpatialIndex {
 fn a_still_group_keeps_its_poses_through_40_moving_updates_until_it_is_updated() {
     let mut rng = Rng::new(42);
     let mut colliders = scene(&mut rng, 200);
-    let is_still = |i: usize| i % 2 == 0;
+    let is_still = |i: usize| i.is_multiple_of(2);
     let mut index = split(&colliders, is_still);
     let first_poses = colliders.clone();
     for round in 0..40 {
