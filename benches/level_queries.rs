@@ -1,0 +1,82 @@
+//! Spatial queries in a level of static scenery, through the ECS: `URTO_BENCH_STATICS` static
+//! boxes (default 100,000, on a lattice over a ground) and 1,000 balls drifting above them in
+//! zero gravity. One iteration is one physics step, alone (`step`) or followed by one ray cast
+//! (`step_and_ray`): the first query after a step refreshes the query index, so the difference
+//! between the two is what the queries cost a step. Settled statics sit in the index's still
+//! group and are not read again while none changes; before they were, every collider's box
+//! was computed again at each step's first query.
+//!
+//! Quick run: `URTO_BENCH_STATICS=10000 cargo bench --bench level_queries -- --quick`.
+
+use bevy_app::App;
+use bevy_ecs::system::SystemId;
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use glam::Vec3;
+use std::hint::black_box;
+use urto::plugins::SpatialQueryIndex;
+use urto::prelude::*;
+
+const BALLS: usize = 1_000;
+
+/// A lattice of `statics` unit boxes 3 m apart on a ground, and the drifting balls.
+fn level(statics: usize) -> App {
+    let mut app = App::new();
+    app.add_plugins(UrtoPlugins::default());
+    let world = app.world_mut();
+    world.spawn((Collider::half_space(Vec3::Z), Static));
+    let side = (statics as f64).sqrt().ceil() as usize;
+    for i in 0..statics {
+        let at = Vec3::new((i % side) as f32 * 3.0, (i / side) as f32 * 3.0, 0.5);
+        world.spawn((Collider::cuboid(0.5, 0.5, 0.5), Position(at), Static));
+    }
+    let extent = side as f32 * 3.0;
+    for i in 0..BALLS {
+        let t = i as f32 / BALLS as f32;
+        let at = Vec3::new(t * extent, (t * 97.0).fract() * extent, 10.0 + 5.0 * t);
+        let v = Vec3::new((t * 13.0).fract() - 0.5, (t * 29.0).fract() - 0.5, 0.0);
+        world.spawn((Collider::sphere(0.4), Position(at), Velocity(v)));
+    }
+    urto::step(app.world_mut(), 5).expect("the level steps");
+    app
+}
+
+/// A ray down onto the middle of the level.
+fn ray_system(app: &mut App, statics: usize) -> SystemId<(), Option<f32>> {
+    let middle = (statics as f64).sqrt() as f32 * 1.5;
+    let from = Vec3::new(middle + 0.1, middle + 0.2, 30.0);
+    app.world_mut().register_system(move |q: SpatialQuery| {
+        let all = SpatialQueryFilter::default();
+        let hit = q.cast_ray(from, -Vec3::Z, 100.0, &all);
+        hit.ok().flatten().map(|h| h.distance)
+    })
+}
+
+fn bench(c: &mut Criterion) {
+    let sizes = std::env::var("URTO_BENCH_STATICS").unwrap_or_else(|_| "100000".into());
+    for statics in sizes
+        .split(',')
+        .filter_map(|s| s.trim().parse::<usize>().ok())
+    {
+        let mut app = level(statics);
+        let ray = ray_system(&mut app, statics);
+        let hit = app.world_mut().run_system(ray).expect("the ray runs");
+        let mut group = c.benchmark_group(format!("level_queries/{statics}"));
+        group.bench_function(BenchmarkId::new("step", statics), |b| {
+            b.iter(|| urto::step(app.world_mut(), 1).expect("steps"))
+        });
+        group.bench_function(BenchmarkId::new("step_and_ray", statics), |b| {
+            b.iter(|| {
+                urto::step(app.world_mut(), 1).expect("steps");
+                black_box(app.world_mut().run_system(ray).expect("the ray runs"))
+            })
+        });
+        group.finish();
+        let refreshes = app.world().resource::<SpatialQueryIndex>().refreshes();
+        println!(
+            "level_queries/{statics}: the ray hit at {hit:?} m; index refreshes {refreshes:?}"
+        );
+    }
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
