@@ -40,9 +40,9 @@ fn level(statics: usize) -> App {
     app
 }
 
-/// A ray down onto the middle of the level.
+/// A ray down onto a box in the middle of the level (its top 29 m below).
 fn ray_system(app: &mut App, statics: usize) -> SystemId<(), Option<f32>> {
-    let middle = (statics as f64).sqrt() as f32 * 1.5;
+    let middle = ((statics as f64).sqrt().ceil() as usize / 2) as f32 * 3.0;
     let from = Vec3::new(middle + 0.1, middle + 0.2, 30.0);
     app.world_mut().register_system(move |q: SpatialQuery| {
         let all = SpatialQueryFilter::default();
