@@ -1,7 +1,7 @@
-//! Spatial queries for game code: the [`SpatialQuery`] system parameter casts rays and spheres,
-//! lists overlaps and point containment, with a [`SpatialQueryFilter`] (layers, excluded
-//! entities), answered by the core's [`SpatialIndex`] (a box tree over the colliders, never a
-//! scan of every collider).
+//! Spatial queries for game code: the [`SpatialQuery`] system parameter casts rays and any
+//! convex shape, lists overlaps and point containment, with a [`SpatialQueryFilter`] (layers,
+//! excluded entities), answered by the core's [`SpatialIndex`] (a box tree over the colliders,
+//! never a scan of every collider).
 //!
 //! ```
 //! # use bevy_ecs::prelude::*;
@@ -434,6 +434,30 @@ impl SpatialQuery<'_, '_> {
         };
         self.with_index(filter, |index, lookup, accept| {
             let hit = index.cast_capsule(lookup, &cast, accept)?;
+            Ok(hit.map(|h| to_ray_hit(lookup, h)))
+        })
+    }
+
+    /// The nearest collider any convex `shape` (a ball, box, capsule, cylinder, cone,
+    /// ellipsoid or convex hull) at `pose` meets when moved (without turning) along `direction`
+    /// for at most `max_distance`; a half-space or a mesh is refused
+    /// ([`QueryError::NotCastable`]). A shape starting in contact hits at distance 0.
+    pub fn cast_shape(
+        &self,
+        shape: &Shape,
+        pose: Isometry,
+        direction: Vec3,
+        max_distance: f32,
+        filter: &SpatialQueryFilter,
+    ) -> Result<Option<RayHit>, QueryError> {
+        let cast = crate::spatial::ShapeCast {
+            pose,
+            shape,
+            direction: Ray::new(pose.translation, direction)?.direction(),
+            max_distance,
+        };
+        self.with_index(filter, |index, lookup, accept| {
+            let hit = index.cast_shape(lookup, &cast, accept)?;
             Ok(hit.map(|h| to_ray_hit(lookup, h)))
         })
     }

@@ -35,6 +35,9 @@ pub enum QueryError {
     /// A cast shape's size that is negative, not finite or above the largest supported: a box's
     /// half extents, or a capsule's `(half_length, radius, 0)`.
     BadSize(Vec3),
+    /// A shape that cannot be cast: a half-space (unbounded) or a mesh (not convex; cast its
+    /// convex pieces).
+    NotCastable,
 }
 
 impl fmt::Display for QueryError {
@@ -48,6 +51,7 @@ impl fmt::Display for QueryError {
                 f,
                 "cast shape size {s} is negative, not finite or too large"
             ),
+            Self::NotCastable => write!(f, "a half-space or a mesh cannot be cast"),
         }
     }
 }

@@ -14,6 +14,7 @@ use super::capsule_cast::{CapsuleCast, cast_capsule};
 use super::cast::{CastHit, QueryError, Ray, cast_sphere, check_max_distance};
 use super::collider_tree::ColliderTree;
 use super::nearest::{PointHit, nearest_point};
+use super::shape_cast::{ShapeCast, cast_shape, castable};
 use super::tree::RaySegment;
 use crate::bounding::Aabb;
 use crate::bvh::QueryScratch;
@@ -235,6 +236,28 @@ impl SpatialIndex {
         Ok(self.first_hit(&ray, grow, max, accept, |id, mesh| {
             let (shape, pose) = colliders.collider(id)?;
             cast_capsule(cast, shape, &pose, mesh)
+        }))
+    }
+
+    /// The nearest collider `accept`ed that `cast`'s shape meets (see [`cast_shape`]: any
+    /// convex shape; its direction must be unit); the tree is walked along the shape's path,
+    /// its boxes grown by the shape's bounding radius.
+    pub fn cast_shape<L: ColliderLookup + ?Sized>(
+        &mut self,
+        colliders: &L,
+        cast: &ShapeCast,
+        accept: impl FnMut(u32) -> bool,
+    ) -> Result<Option<QueryHit>, QueryError> {
+        let max = check_max_distance(cast.max_distance)?;
+        if !castable(cast.shape) {
+            return Err(QueryError::NotCastable);
+        }
+        let size = Vec3::splat(cast.shape.bounding_radius());
+        let (ray, grow) =
+            self.shape_cast_start((cast.shape, size), &cast.pose, cast.direction, max)?;
+        Ok(self.first_hit(&ray, grow, max, accept, |id, mesh| {
+            let (shape, pose) = colliders.collider(id)?;
+            cast_shape(cast, shape, &pose, mesh)
         }))
     }
 

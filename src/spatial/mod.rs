@@ -14,6 +14,8 @@
 //! - [`box_cast`]: a box cast against one shape (separating axes with velocity for polytopes).
 //! - [`capsule_cast`]: a capsule cast against one shape (conservative advancement on exact
 //!   distances, closed forms for balls and planes).
+//! - [`shape_cast`]: a cast of any convex shape against one shape (the casts above for balls,
+//!   boxes and capsules; conservative advancement on GJK distances for the others).
 //! - [`stable_ids`]: small ids that stay with their colliders while others come and go.
 //! - [`nearest`]: the point of one collider nearest to a query point.
 //! - [`index`]: the queries over the tree — ray casts (first hit, all hits), sphere casts,
@@ -30,6 +32,7 @@ pub mod collider_tree;
 pub mod index;
 pub mod layers;
 pub mod nearest;
+pub mod shape_cast;
 pub mod stable_ids;
 pub mod tree;
 
@@ -40,5 +43,6 @@ pub use collider_tree::ColliderTree;
 pub use index::{ColliderLookup, IndexUpdate, QueryHit, SpatialIndex};
 pub use layers::{LayerMask, Layers};
 pub use nearest::{PointHit, nearest_point};
+pub use shape_cast::{ShapeCast, cast_shape, castable};
 pub use stable_ids::StableIds;
 pub use tree::{AabbTree, RaySegment};

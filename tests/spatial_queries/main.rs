@@ -7,6 +7,7 @@ mod common;
 mod ecs;
 mod ecs_still;
 mod nearest_and_casts;
+mod shape_casts;
 mod still_group;
 
 use bevy_app::App;

@@ -80,7 +80,7 @@ fn nearest_colliders_equal_brute_force_on_500_points_over_402_colliders() {
 
 /// parry3d's first hit of `caster` at `pose` moved along the unit `direction` for at most 12 m
 /// against `target` at `at`, stopping at penetration (as our casts do).
-fn parry_cast(
+pub(super) fn parry_cast(
     (caster, pose): (&dyn parry3d::shape::Shape, &Isometry),
     direction: Vec3,
     (target, at): (&dyn parry3d::shape::Shape, &Isometry),

@@ -1,0 +1,181 @@
+//! A cast of any convex shape: the first contact of a ball, box, capsule, cylinder, cone,
+//! ellipsoid or convex hull translated along a direction (its orientation fixed) with one
+//! shape, what Avian's `cast_shape` and rapier's `cast_shape` answer for any collider.
+//!
+//! - **Ball, box, capsule casters** take their own casts ([`cast_sphere`], [`cast_box`],
+//!   [`cast_capsule`]): closed forms and exact distances.
+//! - **Cylinder, cone, ellipsoid and hull casters**, by target:
+//!   - a ball: the ball swept the other way against the caster at rest (`ccd`'s exact sweeps);
+//!   - a half-space: the caster's support point along the plane's inward normal, one division;
+//!   - a convex shape: conservative advancement (Mirtich 1996) on the GJK/EPA signed distance,
+//!     stepping to where the gap's tangent meets zero (the gap of a translating convex pair is
+//!     convex in the travel, so the step is safe; see `advance_convex`);
+//!   - a mesh: its hierarchy walked with the box around the caster's swept bounding sphere, and
+//!     each triangle met by conservative advancement on the GJK distance between the caster
+//!     and the triangle (meshes are two-sided surfaces), the nearest hit kept.
+//!
+//! Half-spaces and meshes are not castable (one is unbounded, the other not convex):
+//! [`castable`] says so before any query. Conventions are those of [`cast_sphere`]: a caster
+//! that starts touching or overlapping hits at distance 0, the normal points out of the target
+//! towards the caster.
+
+use super::box_cast::{
+    ADVANCE_TOLERANCE, BoxCast, Gap, advance_convex, against_ball, against_convex, against_plane,
+    cast_box,
+};
+use super::capsule_cast::{CapsuleCast, cast_capsule};
+use super::cast::{CastHit, Ray, cast_sphere};
+use crate::bounding::{Bv, Obb, RelativePose};
+use crate::bvh::QueryScratch;
+use crate::geometry::convex::core_distance;
+use crate::geometry::convex::support::ConvexPart;
+use crate::geometry::{Isometry, MeshCollider, Shape};
+use glam::{Mat3, Vec3};
+use std::cell::Cell;
+use std::ops::ControlFlow;
+
+/// A shape cast: `shape` at `pose`, moving along the unit `direction` for at most
+/// `max_distance`.
+#[derive(Clone, Copy, Debug)]
+pub struct ShapeCast<'a> {
+    /// Where the shape starts.
+    pub pose: Isometry,
+    /// The shape cast: convex ([`castable`]).
+    pub shape: &'a Shape,
+    /// Unit direction of travel.
+    pub direction: Vec3,
+    /// Farthest travel considered.
+    pub max_distance: f32,
+}
+
+/// Whether `shape` can be cast: every convex shape; not a half-space or a mesh.
+pub fn castable(shape: &Shape) -> bool {
+    !matches!(shape, Shape::HalfSpace(_) | Shape::TriMesh(_))
+}
+
+/// The first contact of the cast with `target` at `at`, or `None` within its reach (or for a
+/// caster that is not [`castable`]).
+pub fn cast_shape(
+    cast: &ShapeCast,
+    target: &Shape,
+    at: &Isometry,
+    scratch: &mut QueryScratch,
+) -> Option<CastHit> {
+    let (pose, direction, max) = (cast.pose, cast.direction, cast.max_distance);
+    match cast.shape {
+        Shape::Sphere(s) => {
+            let ray = Ray::new(pose.translation, direction).ok()?;
+            let aabb = target.world_aabb(at);
+            cast_sphere(&ray, s.radius, max, (target, at, &aabb), scratch)
+        }
+        Shape::Cuboid(c) => {
+            let cast = BoxCast {
+                pose,
+                half_extents: c.half_extents,
+                direction,
+                max_distance: max,
+            };
+            cast_box(&cast, target, at, scratch)
+        }
+        Shape::Capsule(c) => {
+            let cast = CapsuleCast {
+                pose,
+                capsule: *c,
+                direction,
+                max_distance: max,
+            };
+            cast_capsule(&cast, target, at, scratch)
+        }
+        Shape::HalfSpace(_) | Shape::TriMesh(_) => None,
+        caster => convex_cast((caster, &pose), (direction, max), (target, at), scratch),
+    }
+}
+
+/// A convex caster without a cast of its own against any target (see the [module](self)).
+fn convex_cast(
+    (shape, pose): (&Shape, &Isometry),
+    motion: (Vec3, f32),
+    (target, at): (&Shape, &Isometry),
+    scratch: &mut QueryScratch,
+) -> Option<CastHit> {
+    match target {
+        Shape::Sphere(s) => against_ball((shape, pose), motion, at.translation, s, scratch),
+        Shape::HalfSpace(h) => {
+            let part = ConvexPart::of_shape(shape, *pose)?;
+            let inward = -at.transform_vector(h.normal);
+            against_plane(part.support(inward), part.rounding, motion, at, h)
+        }
+        Shape::TriMesh(m) => against_mesh((shape, pose), motion, at, m, scratch),
+        _ => against_convex((shape, pose), motion, (target, at)),
+    }
+}
+
+/// A convex caster against a mesh's triangles, in the mesh's frame (see the [module](self)).
+fn against_mesh(
+    (shape, pose): (&Shape, &Isometry),
+    (direction, max): (Vec3, f32),
+    at: &Isometry,
+    mesh: &MeshCollider,
+    scratch: &mut QueryScratch,
+) -> Option<CastHit> {
+    let start = at.inv_mul(pose);
+    let local = at.inverse_transform_vector(direction);
+    let radius = shape.bounding_radius();
+    // The box around the caster's bounding sphere all along its path, for the node test.
+    let swept = Obb {
+        center: start.translation + local * (0.5 * max),
+        axes: Mat3::IDENTITY,
+        half_extents: local.abs() * (0.5 * max) + Vec3::splat(radius + ADVANCE_TOLERANCE),
+    };
+    let same_frame = RelativePose::new(&Isometry::IDENTITY);
+    let tolerance = ADVANCE_TOLERANCE * (1.0 + radius);
+    let best: Cell<Option<CastHit>> = Cell::new(None);
+    mesh.bvh().descend(
+        scratch,
+        |bv| bv.overlaps(&swept, &same_frame),
+        |t| {
+            let Some(tri) = mesh.mesh().triangle(t as usize) else {
+                return ControlFlow::Continue(());
+            };
+            let triangle = ConvexPart::triangle(&tri);
+            // Only a nearer hit than the best so far matters.
+            let limit = best.get().map_or(max, |b| b.distance);
+            let hit = advance_convex(limit, tolerance, local, |t| {
+                let moved = Isometry::new(start.translation + local * t, start.rotation);
+                triangle_gap(&triangle, shape, &moved, local)
+            });
+            if let Some(hit) = hit
+                && best.get().is_none_or(|b| hit.distance < b.distance)
+            {
+                best.set(Some(hit));
+            }
+            ControlFlow::Continue(())
+        },
+    );
+    best.get().map(|hit| CastHit {
+        distance: hit.distance,
+        point: at.transform_point(hit.point),
+        normal: at.transform_vector(hit.normal),
+    })
+}
+
+/// The gap between a triangle and the caster at `moved` (both in the mesh's frame); a pair
+/// with no defined distance (a flat caster in the triangle's plane) counts as touching.
+fn triangle_gap(triangle: &ConvexPart, shape: &Shape, moved: &Isometry, direction: Vec3) -> Gap {
+    let touching = Gap {
+        distance: 0.0,
+        on_target: moved.translation,
+        normal: -direction,
+    };
+    let Some(caster) = ConvexPart::of_shape(shape, *moved) else {
+        return touching;
+    };
+    match core_distance(triangle, &caster) {
+        Some(d) => Gap {
+            distance: d.distance,
+            on_target: d.on_a,
+            normal: d.normal,
+        },
+        None => touching,
+    }
+}
