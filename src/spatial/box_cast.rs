@@ -43,7 +43,8 @@ pub struct BoxCast {
 
 /// Conservative advancement stops this close to the target (relative to the sizes involved).
 pub(crate) const ADVANCE_TOLERANCE: f32 = 1e-5;
-/// Conservative advancement gives up (reporting its last safe distance) after this many steps.
+/// Conservative advancement gives up (no hit) after this many steps; its steps converge
+/// quadratically ([`advance_convex`]), so only a pathological gap function reaches it.
 const ADVANCE_ITERATIONS: u32 = 64;
 
 /// The first contact of the cast with `shape` at `target`, or `None` within its reach.
@@ -248,7 +249,7 @@ fn against_capsule(cast: &BoxCast, pose: &Isometry, c: &Capsule) -> Option<CastH
     let (a, b) = c.segment(pose);
     let h = cast.half_extents;
     let tolerance = ADVANCE_TOLERANCE * (1.0 + h.max_element() + c.half_length + c.radius);
-    advance(cast.max_distance, tolerance, |t| {
+    advance_convex(cast.max_distance, tolerance, cast.direction, |t| {
         let at = Isometry::new(
             cast.pose.translation + cast.direction * t,
             cast.pose.rotation,
@@ -278,42 +279,17 @@ pub(crate) struct Gap {
     pub normal: Vec3,
 }
 
-/// Conservative advancement (Mirtich 1996) of a caster moving at unit speed along a line:
-/// `gap(t)` is its [`Gap`] to the target once moved by `t`, which the caster cannot close faster
-/// than one per unit travelled, so it moves on by that distance until within `tolerance` (a
-/// hit) or past `max` (none). A caster that starts touching or overlapping hits at 0.
-pub(crate) fn advance(
-    max: f32,
-    tolerance: f32,
-    mut gap: impl FnMut(f32) -> Gap,
-) -> Option<CastHit> {
-    let mut t = 0.0f32;
-    for _ in 0..ADVANCE_ITERATIONS {
-        let g = gap(t);
-        if g.distance <= tolerance {
-            return Some(CastHit {
-                distance: t,
-                point: g.on_target,
-                normal: g.normal,
-            });
-        }
-        t += g.distance;
-        if t > max {
-            return None;
-        }
-    }
-    None
-}
-
 /// Conservative advancement for a convex caster against a convex target (`direction` the
 /// caster's unit motion). The gap between two convex shapes, one translating, is a convex
 /// function of the travel (the distance from a point moving on a line to their Minkowski
 /// difference), so the tangent at `t`, of slope `normal · direction`, meets zero no later than
-/// the gap does: stepping there (Newton's step, from below) is conservative, and much faster
-/// than [`advance`]'s unit-speed step when the caster comes at a glance (there the unit steps
-/// shrink geometrically and run out of iterations). A gap that does not shrink never will: no
-/// hit. A step that lands inside the target (the normal's rounding) is bisected back to the
-/// surface.
+/// the gap does: stepping there (Newton's step, from below) is conservative (Mirtich 1996's
+/// conservative advancement with the gap's own slope for the speed bound), and much faster
+/// than a unit-speed step when the caster comes at a glance: unit steps shrink geometrically
+/// there and ran out of iterations, missing a capsule sliding onto a floor at 2°. A gap that
+/// does not shrink never will: no hit. A step that lands inside the target (the normal's
+/// rounding) is bisected back to the surface, so a hit is always a place within `tolerance`
+/// *outside* the target (or the start, when it starts touching).
 pub(crate) fn advance_convex(
     max: f32,
     tolerance: f32,
@@ -326,10 +302,10 @@ pub(crate) fn advance_convex(
         normal: g.normal,
     };
     let (mut safe, mut g) = (0.0f32, gap(0.0));
-    if g.distance <= tolerance {
-        return Some(hit(0.0, &g));
-    }
     for _ in 0..ADVANCE_ITERATIONS {
+        if g.distance <= tolerance {
+            return Some(hit(safe, &g));
+        }
         // Not closing (or a NaN normal): never nearer.
         let closing = -g.normal.dot(direction);
         if closing.is_nan() || closing <= 0.0 {
@@ -340,20 +316,18 @@ pub(crate) fn advance_convex(
             return None;
         }
         let next = gap(t);
-        if next.distance > tolerance {
-            (safe, g) = (t, next);
-        } else if next.distance >= -tolerance {
-            return Some(hit(t, &next));
-        } else {
+        if next.distance < 0.0 {
             let (t, g) = bisect_to_surface((safe, t), tolerance, &mut gap);
             return Some(hit(t, &g));
         }
+        (safe, g) = (t, next);
     }
     None
 }
 
-/// The surface between `apart` (the caster clear of the target) and `inside` (overlapping it),
-/// by bisection: the first place found within `tolerance`, or the last place found apart.
+/// The surface between `apart` (the caster clear of the target) and `inside` (overlapping
+/// it), by bisection: the first place found outside within `tolerance`, or the last place
+/// found apart.
 fn bisect_to_surface(
     (mut apart, mut inside): (f32, f32),
     tolerance: f32,
@@ -361,11 +335,14 @@ fn bisect_to_surface(
 ) -> (f32, Gap) {
     for _ in 0..ADVANCE_ITERATIONS {
         let mid = 0.5 * (apart + inside);
+        if mid <= apart || mid >= inside {
+            break;
+        }
         let g = gap(mid);
-        if g.distance > tolerance {
-            apart = mid;
-        } else if g.distance < -tolerance {
+        if g.distance < 0.0 {
             inside = mid;
+        } else if g.distance > tolerance {
+            apart = mid;
         } else {
             return (mid, g);
         }

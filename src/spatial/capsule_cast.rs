@@ -4,27 +4,26 @@
 //! - **Sphere**: the sphere swept the other way against the capsule (`ccd`'s exact capsule
 //!   sweep: a cylinder and two balls); only the relative motion matters.
 //! - **Half-space**: the capsule's lower cap against the plane, one division.
-//! - **Box, capsule, mesh**: conservative advancement (Mirtich 1996) on the exact distance from
-//!   the capsule's inner segment — to a box (the piecewise-quadratic distance of
-//!   `capsule_cuboid.rs`), to a segment (Ericson §5.1.9), to a mesh's nearest triangle (through
-//!   its hierarchy, a node visited only while nearer than the best triangle).
+//! - **Box, capsule**: conservative advancement (Mirtich 1996) on the exact distance from the
+//!   capsule's inner segment — to a box (the piecewise-quadratic distance of
+//!   `capsule_cuboid.rs`), to a segment (Ericson §5.1.9) — stepping to where the gap's tangent
+//!   meets zero (`advance_convex`: the gap of a translating convex pair is convex in the travel).
+//! - **Mesh**: each triangle its swept box meets, as any convex cast does
+//!   ([`super::shape_cast`]): a character's capsule sliding onto a floor at a glance finds it.
 //!
 //! Conventions are those of [`cast_sphere`](super::cast_sphere): a capsule that starts touching
 //! or overlapping hits at distance 0, the normal points out of the target towards the capsule,
 //! meshes are two-sided surfaces.
 
 use super::box_cast::{
-    ADVANCE_TOLERANCE, Gap, advance, against_ball, against_convex, against_plane,
+    ADVANCE_TOLERANCE, Gap, advance_convex, against_ball, against_convex, against_plane,
 };
 use super::cast::CastHit;
+use super::shape_cast::against_mesh;
 use crate::bvh::QueryScratch;
-use crate::geometry::contacts::{
-    Segment, closest_segment_box, closest_segment_points, segment_triangle_closest,
-};
-use crate::geometry::{Capsule, Isometry, MeshCollider, Shape};
+use crate::geometry::contacts::{Segment, closest_segment_box, closest_segment_points};
+use crate::geometry::{Capsule, Isometry, Shape};
 use glam::Vec3;
-use std::cell::Cell;
-use std::ops::ControlFlow;
 
 /// A capsule cast: `capsule` at `pose`, moving along the unit `direction` for at most
 /// `max_distance`.
@@ -83,7 +82,7 @@ pub fn cast_capsule(
             let low = if n.dot(a) <= n.dot(b) { a } else { b };
             against_plane(low, r, (cast.direction, cast.max_distance), target, h)
         }
-        Shape::Cuboid(c) => advance(cast.max_distance, tolerance, |t| {
+        Shape::Cuboid(c) => advance_convex(cast.max_distance, tolerance, cast.direction, |t| {
             let (a, b) = cast.segment_at(t);
             let local = (
                 target.inverse_transform_point(a),
@@ -98,7 +97,7 @@ pub fn cast_capsule(
         }),
         Shape::Capsule(other) => {
             let (c0, c1) = other.segment(target);
-            advance(cast.max_distance, tolerance, |t| {
+            advance_convex(cast.max_distance, tolerance, cast.direction, |t| {
                 let (a, b) = cast.segment_at(t);
                 let (on_axis, on_other) = closest_segment_points(
                     Segment { start: a, end: b },
@@ -112,50 +111,10 @@ pub fn cast_capsule(
             let motion = (cast.direction, cast.max_distance);
             against_convex((&me, &cast.pose), motion, (shape, target))
         }
-        Shape::TriMesh(m) => advance(cast.max_distance, tolerance, |t| {
-            let (a, b) = cast.segment_at(t);
-            let (p0, p1) = (
-                target.inverse_transform_point(a),
-                target.inverse_transform_point(b),
-            );
-            let (on_mesh, on_axis) = nearest_on_mesh(m, p0, p1, scratch);
-            gap_from(
-                target.transform_point(on_mesh),
-                target.transform_point(on_axis),
-                0.0,
-            )
-        }),
+        Shape::TriMesh(m) => {
+            let me = Shape::Capsule(cast.capsule);
+            let motion = (cast.direction, cast.max_distance);
+            against_mesh((&me, &cast.pose), motion, target, m, scratch)
+        }
     }
-}
-
-/// The closest points `(on the mesh, on the segment)` of the segment from `p0` to `p1` (mesh
-/// frame): a node of the hierarchy is visited while its box is nearer than the best triangle.
-fn nearest_on_mesh(
-    mesh: &MeshCollider,
-    p0: Vec3,
-    p1: Vec3,
-    scratch: &mut QueryScratch,
-) -> (Vec3, Vec3) {
-    let best = Cell::new((f32::INFINITY, p0, p0));
-    mesh.bvh().descend(
-        scratch,
-        |bv| {
-            // The segment in the box's frame, against the box.
-            let local = |p: Vec3| bv.axes.transpose() * (p - bv.center);
-            let (s, q) = closest_segment_box(local(p0), local(p1), bv.half_extents);
-            (s - q).length_squared() <= best.get().0
-        },
-        |t| {
-            if let Some(tri) = mesh.mesh().triangle(t as usize) {
-                let (on_axis, on_tri) = segment_triangle_closest(&tri, p0, p1);
-                let d2 = (on_axis - on_tri).length_squared();
-                if d2 < best.get().0 {
-                    best.set((d2, on_tri, on_axis));
-                }
-            }
-            ControlFlow::Continue(())
-        },
-    );
-    let (_, on_mesh, on_axis) = best.get();
-    (on_mesh, on_axis)
 }

@@ -111,7 +111,7 @@ fn convex_cast(
 }
 
 /// A convex caster against a mesh's triangles, in the mesh's frame (see the [module](self)).
-fn against_mesh(
+pub(super) fn against_mesh(
     (shape, pose): (&Shape, &Isometry),
     (direction, max): (Vec3, f32),
     at: &Isometry,

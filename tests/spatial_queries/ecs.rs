@@ -251,6 +251,25 @@ fn spatial_query_finds_the_nearest_collider_and_casts_a_box_with_a_filter() {
         (inside.entity, inside.inside, inside.distance),
         (block, true, 0.0)
     );
+    // A cylinder (radius 0.5, upright) cast along x above the ball meets the block's face at
+    // x = 4, 3.5 m on; a mesh cannot be cast.
+    let (cylinder, refused) = app
+        .world_mut()
+        .run_system_once(|q: SpatialQuery| {
+            let all = SpatialQueryFilter::default();
+            let at = Isometry::from_translation(Vec3::new(0.0, 0.0, 1.5));
+            let cylinder = Shape::cylinder(0.4, 0.5);
+            let hit = q.cast_shape(&cylinder, at, Vec3::X, 20.0, &all).unwrap();
+            let cube = TriMesh::cuboid(Vec3::ONE).unwrap();
+            let mesh = Shape::TriMesh(MeshCollider::new(cube).unwrap());
+            let refused = q.cast_shape(&mesh, at, Vec3::X, 1.0, &all);
+            (hit, refused)
+        })
+        .unwrap();
+    let cylinder = cylinder.unwrap();
+    assert_eq!(cylinder.entity, block);
+    assert!((cylinder.distance - 3.5).abs() < 1e-3, "{cylinder:?}");
+    assert_eq!(refused, Err(QueryError::NotCastable));
 }
 
 /// Bodies whose layers interact with none are left out of the broad phase, and each way back

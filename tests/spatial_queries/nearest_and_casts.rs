@@ -105,7 +105,8 @@ pub(super) fn parry_cast(
 }
 
 #[test]
-fn box_casts_touch_within_1e_4_and_agree_with_parry3d_within_1e_3_on_2500_casts_at_five_shapes() {
+fn box_casts_touch_within_1e_4_and_agree_with_parry3d_within_1e_3_of_gap_on_2500_casts_at_five_shapes()
+ {
     use urto::spatial::{BoxCast, cast_box};
     let mut rng = Rng::new(23);
     let shapes = shapes_with_parry_twins();
@@ -135,7 +136,10 @@ fn box_casts_touch_within_1e_4_and_agree_with_parry3d_within_1e_3_on_2500_casts_
             let context = format!("{shape:?} {cast:?} {target:?}: {ours:?} vs {theirs:?}");
             match (ours, theirs) {
                 (Some(h), Some(t)) => {
-                    let error = (h.distance - t.time_of_impact).abs();
+                    // The gap the travel between the two hits closes: at a glancing approach
+                    // a gap within the tolerances spans a longer travel.
+                    let closing = h.normal.dot(direction).abs();
+                    let error = (h.distance - t.time_of_impact).abs() * closing;
                     assert!(error < 1e-3, "{context}");
                     worst = worst.max(error);
                     // Independently of parry: touching at our distance, apart 1e-4 before it.
@@ -184,7 +188,7 @@ fn box_casts_touch_within_1e_4_and_agree_with_parry3d_within_1e_3_on_2500_casts_
 /// parry3d's capsule casts run up to 5e-3 from the contact (its rounded-segment GJK tolerance),
 /// so each of ours is also checked independently: touching within 1e-4, apart 1e-4 before.
 #[test]
-fn capsule_casts_touch_within_1e_4_and_agree_with_parry3d_within_1e_2_on_2500_casts() {
+fn capsule_casts_touch_within_1e_4_and_agree_with_parry3d_within_1e_2_of_gap_on_2500_casts() {
     use urto::geometry::Capsule;
     use urto::spatial::{CapsuleCast, cast_capsule};
     let mut rng = Rng::new(25);
@@ -229,7 +233,8 @@ fn capsule_casts_touch_within_1e_4_and_agree_with_parry3d_within_1e_2_on_2500_ca
                     if h.distance > 1e-3 {
                         assert!(!capsule_at(h.distance - 1e-4, 0.0), "already: {context}");
                     }
-                    let error = (h.distance - t.time_of_impact).abs();
+                    let closing = h.normal.dot(direction).abs();
+                    let error = (h.distance - t.time_of_impact).abs() * closing;
                     assert!(error < 1e-2, "{context}");
                     worst = worst.max(error);
                     hits += 1;

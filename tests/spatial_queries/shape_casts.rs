@@ -256,3 +256,95 @@ fn index_shape_casts_equal_brute_force_on_400_casts_over_302_colliders_and_refus
         "{refused:?}"
     );
 }
+
+/// A cast coming at a glance (2°) onto a box's top face or a mesh floor: the unit steps of
+/// conservative advancement shrink by `sin 2°` each and ran out of iterations (a miss); every
+/// cast now meets the face where the closed form says, within 1e-4 of gap (the travel times
+/// `sin 2°`: the advancement stops within its tolerance of the surface, and at 2° a gap spans
+/// 29 times its length of travel).
+#[test]
+fn casts_at_a_2_degree_glance_hit_a_box_top_and_a_mesh_floor_within_1e_4_of_gap_of_the_closed_form()
+{
+    use urto::geometry::Capsule;
+    use urto::spatial::{CapsuleCast, cast_capsule};
+    let mut scratch = QueryScratch::new();
+    let (angle, gap) = (2.0f32.to_radians(), 0.3);
+    let direction = Vec3::new(angle.cos(), 0.0, -angle.sin());
+    let expected = gap / angle.sin();
+    let target = (Shape::cuboid(Vec3::ONE), Isometry::IDENTITY);
+    let casters = [
+        (Shape::capsule(0.4, 0.2), 0.6),
+        (Shape::cylinder(0.3, 0.5), 0.3),
+        (Shape::ellipsoid(Vec3::new(0.5, 0.4, 0.25)), 0.25),
+    ];
+    for (caster, below) in &casters {
+        // The caster's lowest point `gap` above the top face, far enough back to land on it.
+        let start = Vec3::new(-8.5, 0.0, 1.0 + gap + below);
+        let cast = ShapeCast {
+            pose: Isometry::from_translation(start),
+            shape: caster,
+            direction,
+            max_distance: 20.0,
+        };
+        let hit = cast_shape(&cast, &target.0, &target.1, &mut scratch);
+        let d = hit.map(|h| h.distance);
+        assert!(
+            d.is_some_and(|d| ((d - expected) * angle.sin()).abs() < 1e-4),
+            "{caster:?}: {d:?} vs {expected}"
+        );
+    }
+    // The capsule's own cast against a box, and a box's against a capsule lying on the ground.
+    let capsule = Capsule {
+        half_length: 0.4,
+        radius: 0.2,
+    };
+    let own = CapsuleCast {
+        pose: Isometry::from_translation(Vec3::new(-8.5, 0.0, 1.0 + gap + 0.6)),
+        capsule,
+        direction,
+        max_distance: 20.0,
+    };
+    let d = cast_capsule(&own, &target.0, &target.1, &mut scratch).map(|h| h.distance);
+    assert!(
+        d.is_some_and(|d| ((d - expected) * angle.sin()).abs() < 1e-4),
+        "capsule: {d:?}"
+    );
+    let lying = Isometry::new(
+        Vec3::ZERO,
+        Quat::from_rotation_y(std::f32::consts::FRAC_PI_2),
+    );
+    let boxed = BoxCast {
+        pose: Isometry::from_translation(Vec3::new(-8.5, 0.0, 0.2 + gap + 0.5)),
+        half_extents: Vec3::splat(0.5),
+        direction,
+        max_distance: 20.0,
+    };
+    let d = cast_box(&boxed, &Shape::Capsule(capsule), &lying, &mut scratch).map(|h| h.distance);
+    assert!(
+        d.is_some_and(|d| ((d - expected) * angle.sin()).abs() < 1e-4),
+        "box: {d:?}"
+    );
+    // A character's capsule onto a floor of two triangles (its top at z = 1).
+    let corners = [(-20.0, -20.0), (20.0, -20.0), (20.0, 20.0), (-20.0, 20.0)];
+    let vertices = corners.map(|(x, y)| Vec3::new(x, y, 1.0)).to_vec();
+    let floor = TriMesh::new(vertices, vec![[0, 1, 2], [0, 2, 3]]).unwrap();
+    let floor = Shape::TriMesh(MeshCollider::new(floor).unwrap());
+    let d = cast_capsule(&own, &floor, &Isometry::IDENTITY, &mut scratch).map(|h| h.distance);
+    assert!(
+        d.is_some_and(|d| ((d - expected) * angle.sin()).abs() < 1e-4),
+        "capsule on a mesh: {d:?}"
+    );
+    for (caster, below) in &casters {
+        let cast = ShapeCast {
+            pose: Isometry::from_translation(Vec3::new(-8.5, 0.0, 1.0 + gap + below)),
+            shape: caster,
+            direction,
+            max_distance: 20.0,
+        };
+        let d = cast_shape(&cast, &floor, &Isometry::IDENTITY, &mut scratch).map(|h| h.distance);
+        assert!(
+            d.is_some_and(|d| ((d - expected) * angle.sin()).abs() < 1e-4),
+            "{caster:?} on a mesh: {d:?}"
+        );
+    }
+}

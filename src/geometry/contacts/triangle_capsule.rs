@@ -102,17 +102,6 @@ fn crossing(tri: &Triangle, p0: Vec3, p1: Vec3) -> Option<(Vec3, f32, f32)> {
     ((tri.closest_point(at) - at).length_squared() <= slack * slack).then_some((n, h0, h1))
 }
 
-/// The closest points `(on the segment, on the triangle)`, equal where the segment crosses it.
-pub(crate) fn segment_triangle_closest(tri: &Triangle, p0: Vec3, p1: Vec3) -> (Vec3, Vec3) {
-    match crossing(tri, p0, p1) {
-        Some((_, h0, h1)) => {
-            let at = p0 + (p1 - p0) * (h0 / (h0 - h1));
-            (at, at)
-        }
-        None => closest_segment_triangle(tri, p0, p1, [p0, p1].map(|p| tri.closest_point(p))),
-    }
-}
-
 /// The closest points `(on the segment, on the triangle)` of a segment that does not cross the
 /// triangle: the nearer of the segment's ends to the triangle (`feet`, their nearest triangle
 /// points) and the segment against each edge.
