@@ -10,9 +10,10 @@
 //!   - a convex shape: conservative advancement (Mirtich 1996) on the GJK/EPA signed distance,
 //!     stepping to where the gap's tangent meets zero (the gap of a translating convex pair is
 //!     convex in the travel, so the step is safe; see `advance_convex`);
-//!   - a mesh: its hierarchy walked with the box around the caster's swept bounding sphere, and
-//!     each triangle met by conservative advancement on the GJK distance between the caster
-//!     and the triangle (meshes are two-sided surfaces), the nearest hit kept.
+//!   - a mesh: its hierarchy walked along the path of the caster's bounding sphere (a node or
+//!     a triangle whose box, grown by that sphere, the path enters beyond the nearest hit so
+//!     far is passed over), and each triangle met by conservative advancement on the GJK
+//!     distance between the caster and the triangle (meshes are two-sided surfaces).
 //!
 //! Half-spaces and meshes are not castable (one is unbounded, the other not convex):
 //! [`castable`] says so before any query. Conventions are those of [`cast_sphere`]: a caster
@@ -25,12 +26,13 @@ use super::box_cast::{
 };
 use super::capsule_cast::{CapsuleCast, cast_capsule};
 use super::cast::{CastHit, Ray, cast_sphere};
-use crate::bounding::{Bv, Obb, RelativePose};
+use super::tree::RaySegment;
+use crate::bounding::Aabb;
 use crate::bvh::QueryScratch;
 use crate::geometry::convex::core_distance;
 use crate::geometry::convex::support::ConvexPart;
 use crate::geometry::{Isometry, MeshCollider, Shape};
-use glam::{Mat3, Vec3};
+use glam::Vec3;
 use std::cell::Cell;
 use std::ops::ControlFlow;
 
@@ -120,26 +122,37 @@ pub(super) fn against_mesh(
 ) -> Option<CastHit> {
     let start = at.inv_mul(pose);
     let local = at.inverse_transform_vector(direction);
+    // Within this of the centre's path the caster may touch (its bounding sphere, and the
+    // advancement's tolerance).
     let radius = shape.bounding_radius();
-    // The box around the caster's bounding sphere all along its path, for the node test.
-    let swept = Obb {
-        center: start.translation + local * (0.5 * max),
-        axes: Mat3::IDENTITY,
-        half_extents: local.abs() * (0.5 * max) + Vec3::splat(radius + ADVANCE_TOLERANCE),
-    };
-    let same_frame = RelativePose::new(&Isometry::IDENTITY);
+    let reach = radius + ADVANCE_TOLERANCE * (2.0 + radius);
+    let path = RaySegment::new(start.translation, local);
     let tolerance = ADVANCE_TOLERANCE * (1.0 + radius);
     let best: Cell<Option<CastHit>> = Cell::new(None);
+    // Only a nearer hit than the best so far matters: a node or a triangle whose box, grown by
+    // the reach, the centre's path does not enter before it is passed over (most of a terrain
+    // under a glancing cast).
+    let limit = || best.get().map_or(max, |b| b.distance);
     mesh.bvh().descend(
         scratch,
-        |bv| bv.overlaps(&swept, &same_frame),
+        |node| {
+            let to_node = node.axes.transpose();
+            let along =
+                RaySegment::new(to_node * (start.translation - node.center), to_node * local);
+            let h = node.half_extents + Vec3::splat(reach);
+            along.entry(&Aabb::new(-h, h), limit()).is_some()
+        },
         |t| {
             let Some(tri) = mesh.mesh().triangle(t as usize) else {
                 return ControlFlow::Continue(());
             };
+            let limit = limit();
+            let [a, b, c] = tri.vertices();
+            let grown = Aabb::new(a.min(b).min(c), a.max(b).max(c)).expanded(reach);
+            if path.entry(&grown, limit).is_none() {
+                return ControlFlow::Continue(());
+            }
             let triangle = ConvexPart::triangle(&tri);
-            // Only a nearer hit than the best so far matters.
-            let limit = best.get().map_or(max, |b| b.distance);
             let hit = advance_convex(limit, tolerance, local, |t| {
                 let moved = Isometry::new(start.translation + local * t, start.rotation);
                 triangle_gap(&triangle, shape, &moved, local)
