@@ -10,10 +10,11 @@
 //!   - a convex shape: conservative advancement (Mirtich 1996) on the GJK/EPA signed distance,
 //!     stepping to where the gap's tangent meets zero (the gap of a translating convex pair is
 //!     convex in the travel, so the step is safe; see `advance_convex`);
-//!   - a mesh: its hierarchy walked along the path of the caster's bounding sphere (a node or
-//!     a triangle whose box, grown by that sphere, the path enters beyond the nearest hit so
-//!     far is passed over), and each triangle met by conservative advancement on the GJK
-//!     distance between the caster and the triangle (meshes are two-sided surfaces).
+//!   - a mesh: its hierarchy walked along the path of the caster's bounding sphere, nearest
+//!     node first (a node or a triangle whose box, grown by that sphere, the path enters
+//!     beyond the nearest hit so far is passed over), and each triangle met by conservative
+//!     advancement on the GJK distance between the caster and the triangle (meshes are
+//!     two-sided surfaces).
 //!
 //! Half-spaces and meshes are not castable (one is unbounded, the other not convex):
 //! [`castable`] says so before any query. Conventions are those of [`cast_sphere`]: a caster
@@ -27,14 +28,12 @@ use super::box_cast::{
 use super::capsule_cast::{CapsuleCast, cast_capsule};
 use super::cast::{CastHit, Ray, cast_sphere};
 use super::tree::RaySegment;
-use crate::bounding::Aabb;
+use crate::bounding::{Aabb, Obb};
 use crate::bvh::QueryScratch;
 use crate::geometry::convex::core_distance;
 use crate::geometry::convex::support::ConvexPart;
 use crate::geometry::{Isometry, MeshCollider, Shape};
 use glam::Vec3;
-use std::cell::Cell;
-use std::ops::ControlFlow;
 
 /// A shape cast: `shape` at `pose`, moving along the unit `direction` for at most
 /// `max_distance`.
@@ -107,18 +106,19 @@ fn convex_cast(
             let inward = -at.transform_vector(h.normal);
             against_plane(part.support(inward), part.rounding, motion, at, h)
         }
-        Shape::TriMesh(m) => against_mesh((shape, pose), motion, at, m, scratch),
+        Shape::TriMesh(m) => against_mesh((shape, pose), motion, at, m),
         _ => against_convex((shape, pose), motion, (target, at)),
     }
 }
 
-/// A convex caster against a mesh's triangles, in the mesh's frame (see the [module](self)).
+/// A convex caster against a mesh's triangles, in the mesh's frame (see the [module](self)):
+/// the hierarchy walked nearest node first along the caster's path, as the query index walks
+/// its tree for a ray, so that the first hits found bound the rest of the walk.
 pub(super) fn against_mesh(
     (shape, pose): (&Shape, &Isometry),
     (direction, max): (Vec3, f32),
     at: &Isometry,
     mesh: &MeshCollider,
-    scratch: &mut QueryScratch,
 ) -> Option<CastHit> {
     let start = at.inv_mul(pose);
     let local = at.inverse_transform_vector(direction);
@@ -128,29 +128,45 @@ pub(super) fn against_mesh(
     let reach = radius + ADVANCE_TOLERANCE * (2.0 + radius);
     let path = RaySegment::new(start.translation, local);
     let tolerance = ADVANCE_TOLERANCE * (1.0 + radius);
-    let best: Cell<Option<CastHit>> = Cell::new(None);
-    // Only a nearer hit than the best so far matters: a node or a triangle whose box, grown by
-    // the reach, the centre's path does not enter before it is passed over (most of a terrain
-    // under a glancing cast).
-    let limit = || best.get().map_or(max, |b| b.distance);
-    mesh.bvh().descend(
-        scratch,
-        |node| {
-            let to_node = node.axes.transpose();
-            let along =
-                RaySegment::new(to_node * (start.translation - node.center), to_node * local);
-            let h = node.half_extents + Vec3::splat(reach);
-            along.entry(&Aabb::new(-h, h), limit()).is_some()
-        },
-        |t| {
-            let Some(tri) = mesh.mesh().triangle(t as usize) else {
-                return ControlFlow::Continue(());
+    // Where the path enters a node's box grown by the reach, before `limit`.
+    let enter = |node: &Obb, limit: f32| {
+        let to_node = node.axes.transpose();
+        let along = RaySegment::new(to_node * (start.translation - node.center), to_node * local);
+        let h = node.half_extents + Vec3::splat(reach);
+        along.entry(&Aabb::new(-h, h), limit)
+    };
+    let (nodes, order) = (mesh.bvh().nodes(), mesh.bvh().triangle_order());
+    let mut best: Option<CastHit> = None;
+    let mut stack: Vec<(u32, f32)> = Vec::with_capacity(64);
+    stack.extend(enter(&nodes[0].bv, max).map(|t| (0, t)));
+    while let Some((index, entry)) = stack.pop() {
+        // Only a nearer hit than the best so far matters.
+        let limit = best.map_or(max, |b| b.distance);
+        if entry > limit {
+            continue;
+        }
+        let node = &nodes[index as usize];
+        if let Some([left, right]) = node.children() {
+            let near = [left, right].map(|c| enter(&nodes[c as usize].bv, limit).map(|t| (c, t)));
+            let [a, b] = near;
+            // The nearer child on top of the stack.
+            let (first, second) = match (a, b) {
+                (Some(x), Some(y)) if y.1 < x.1 => (Some(y), Some(x)),
+                _ => (a, b),
             };
-            let limit = limit();
+            stack.extend(second);
+            stack.extend(first);
+            continue;
+        }
+        for &t in node.triangle_range().map_or(&[][..], |r| &order[r]) {
+            let Some(tri) = mesh.mesh().triangle(t as usize) else {
+                continue;
+            };
+            let limit = best.map_or(max, |b| b.distance);
             let [a, b, c] = tri.vertices();
             let grown = Aabb::new(a.min(b).min(c), a.max(b).max(c)).expanded(reach);
             if path.entry(&grown, limit).is_none() {
-                return ControlFlow::Continue(());
+                continue;
             }
             let triangle = ConvexPart::triangle(&tri);
             let hit = advance_convex(limit, tolerance, local, |t| {
@@ -158,14 +174,13 @@ pub(super) fn against_mesh(
                 triangle_gap(&triangle, shape, &moved, local)
             });
             if let Some(hit) = hit
-                && best.get().is_none_or(|b| hit.distance < b.distance)
+                && best.is_none_or(|b| hit.distance < b.distance)
             {
-                best.set(Some(hit));
+                best = Some(hit);
             }
-            ControlFlow::Continue(())
-        },
-    );
-    best.get().map(|hit| CastHit {
+        }
+    }
+    best.map(|hit| CastHit {
         distance: hit.distance,
         point: at.transform_point(hit.point),
         normal: at.transform_vector(hit.normal),
