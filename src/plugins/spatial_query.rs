@@ -400,16 +400,8 @@ impl SpatialQuery<'_, '_> {
         max_distance: f32,
         filter: &SpatialQueryFilter,
     ) -> Result<Option<RayHit>, QueryError> {
-        let cast = crate::spatial::BoxCast {
-            pose,
-            half_extents,
-            direction: Ray::new(pose.translation, direction)?.direction(),
-            max_distance,
-        };
-        self.with_index(filter, |index, lookup, accept| {
-            let hit = index.cast_box(lookup, &cast, accept)?;
-            Ok(hit.map(|h| to_ray_hit(lookup, h)))
-        })
+        let shape = Shape::cuboid(half_extents);
+        self.cast_shape(&shape, pose, direction, max_distance, filter)
     }
 
     /// The nearest collider a capsule (`half_length`, `radius`, along `pose`'s local z) meets
@@ -423,19 +415,8 @@ impl SpatialQuery<'_, '_> {
         max_distance: f32,
         filter: &SpatialQueryFilter,
     ) -> Result<Option<RayHit>, QueryError> {
-        let cast = crate::spatial::CapsuleCast {
-            pose,
-            capsule: crate::geometry::Capsule {
-                half_length,
-                radius,
-            },
-            direction: Ray::new(pose.translation, direction)?.direction(),
-            max_distance,
-        };
-        self.with_index(filter, |index, lookup, accept| {
-            let hit = index.cast_capsule(lookup, &cast, accept)?;
-            Ok(hit.map(|h| to_ray_hit(lookup, h)))
-        })
+        let shape = Shape::capsule(half_length, radius);
+        self.cast_shape(&shape, pose, direction, max_distance, filter)
     }
 
     /// The nearest collider any convex `shape` (a ball, box, capsule, cylinder, cone,

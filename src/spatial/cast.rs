@@ -33,7 +33,9 @@ pub enum QueryError {
     /// A maximum distance that is negative or NaN.
     BadMaxDistance(f32),
     /// A cast shape's size that is negative, not finite or above the largest supported: a box's
-    /// half extents, or a capsule's `(half_length, radius, 0)`.
+    /// half extents, a capsule's `(half_length, radius, 0)`, a ball's `(radius, 0, 0)`, a
+    /// cylinder's or a cone's `(half_height, radius, 0)`, an ellipsoid's radii, a hull's
+    /// bounding radius on every axis.
     BadSize(Vec3),
     /// A shape that cannot be cast: a half-space (unbounded) or a mesh (not convex; cast its
     /// convex pieces).

@@ -9,8 +9,8 @@
 //! (layers, excluded entities) refuses candidates before any exact test. Results are
 //! deterministic: hits at equal distances are ordered by id.
 
-use super::box_cast::{BoxCast, cast_box};
-use super::capsule_cast::{CapsuleCast, cast_capsule};
+use super::box_cast::BoxCast;
+use super::capsule_cast::CapsuleCast;
 use super::cast::{CastHit, QueryError, Ray, cast_sphere, check_max_distance};
 use super::collider_tree::ColliderTree;
 use super::nearest::{PointHit, nearest_point};
@@ -202,46 +202,46 @@ impl SpatialIndex {
     }
 
     /// The nearest collider `accept`ed that `cast`'s box meets (see
-    /// [`cast_box`]; its direction must be unit); the tree is walked along the
-    /// box's path, its boxes grown by the box's bounding radius.
+    /// [`cast_box`](super::cast_box); its
+    /// direction must be unit): [`Self::cast_shape`] with the box.
     pub fn cast_box<L: ColliderLookup + ?Sized>(
         &mut self,
         colliders: &L,
         cast: &BoxCast,
         accept: impl FnMut(u32) -> bool,
     ) -> Result<Option<QueryHit>, QueryError> {
-        let max = check_max_distance(cast.max_distance)?;
-        let h = cast.half_extents;
-        let shape = Shape::cuboid(h);
-        let (ray, grow) = self.shape_cast_start((&shape, h), &cast.pose, cast.direction, max)?;
-        Ok(self.first_hit(&ray, grow, max, accept, |id, mesh| {
-            let (shape, pose) = colliders.collider(id)?;
-            cast_box(cast, shape, &pose, mesh)
-        }))
+        let shape = Shape::cuboid(cast.half_extents);
+        let cast = ShapeCast {
+            pose: cast.pose,
+            shape: &shape,
+            direction: cast.direction,
+            max_distance: cast.max_distance,
+        };
+        self.cast_shape(colliders, &cast, accept)
     }
 
-    /// The nearest collider `accept`ed that `cast`'s capsule meets (see [`cast_capsule`]; its
-    /// direction must be unit); the tree is walked along the capsule's path, its boxes grown by
-    /// the capsule's bounding radius.
+    /// The nearest collider `accept`ed that `cast`'s capsule meets (see
+    /// [`cast_capsule`](super::cast_capsule); its
+    /// direction must be unit): [`Self::cast_shape`] with the capsule.
     pub fn cast_capsule<L: ColliderLookup + ?Sized>(
         &mut self,
         colliders: &L,
         cast: &CapsuleCast,
         accept: impl FnMut(u32) -> bool,
     ) -> Result<Option<QueryHit>, QueryError> {
-        let max = check_max_distance(cast.max_distance)?;
         let shape = Shape::Capsule(cast.capsule);
-        let size = Vec3::new(cast.capsule.half_length, cast.capsule.radius, 0.0);
-        let (ray, grow) = self.shape_cast_start((&shape, size), &cast.pose, cast.direction, max)?;
-        Ok(self.first_hit(&ray, grow, max, accept, |id, mesh| {
-            let (shape, pose) = colliders.collider(id)?;
-            cast_capsule(cast, shape, &pose, mesh)
-        }))
+        let cast = ShapeCast {
+            pose: cast.pose,
+            shape: &shape,
+            direction: cast.direction,
+            max_distance: cast.max_distance,
+        };
+        self.cast_shape(colliders, &cast, accept)
     }
 
     /// The nearest collider `accept`ed that `cast`'s shape meets (see [`cast_shape`]: any
     /// convex shape; its direction must be unit); the tree is walked along the shape's path,
-    /// its boxes grown by the shape's bounding radius.
+    /// its boxes grown by the shape's bounding radius. A half-space or a mesh is refused.
     pub fn cast_shape<L: ColliderLookup + ?Sized>(
         &mut self,
         colliders: &L,
@@ -252,21 +252,19 @@ impl SpatialIndex {
         if !castable(cast.shape) {
             return Err(QueryError::NotCastable);
         }
-        let size = Vec3::splat(cast.shape.bounding_radius());
-        let (ray, grow) =
-            self.shape_cast_start((cast.shape, size), &cast.pose, cast.direction, max)?;
+        let (ray, grow) = self.shape_cast_start(cast.shape, &cast.pose, cast.direction, max)?;
         Ok(self.first_hit(&ray, grow, max, accept, |id, mesh| {
             let (shape, pose) = colliders.collider(id)?;
             cast_shape(cast, shape, &pose, mesh)
         }))
     }
 
-    /// The checks shared by the shape casts (a finite start, a usable `shape` — reported as
-    /// `size` when not — and a unit direction), then the ray its centre follows and how much
-    /// the tree's boxes grow to hold the shape along it.
+    /// The checks of a shape cast (a finite start, a usable `shape` — reported by its
+    /// numbers when not, see [`QueryError::BadSize`] — and a unit direction), then the ray its
+    /// centre follows and how much the tree's boxes grow to hold the shape along it.
     fn shape_cast_start(
         &self,
-        (shape, size): (&Shape, Vec3),
+        shape: &Shape,
         pose: &Isometry,
         direction: Vec3,
         max: f32,
@@ -275,6 +273,15 @@ impl SpatialIndex {
             return Err(QueryError::NonFiniteOrigin(pose.translation));
         }
         if shape.validate().is_err() {
+            let size = match shape {
+                Shape::Cuboid(c) => c.half_extents,
+                Shape::Capsule(c) => Vec3::new(c.half_length, c.radius, 0.0),
+                Shape::Sphere(s) => Vec3::new(s.radius, 0.0, 0.0),
+                Shape::Cylinder(c) => Vec3::new(c.half_height, c.radius, 0.0),
+                Shape::Cone(c) => Vec3::new(c.half_height, c.radius, 0.0),
+                Shape::Ellipsoid(e) => e.radii,
+                _ => Vec3::splat(shape.bounding_radius()),
+            };
             return Err(QueryError::BadSize(size));
         }
         if !direction.is_normalized() {
