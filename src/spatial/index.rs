@@ -1,8 +1,10 @@
 //! The query index: every collider's box in a [`ColliderTree`] (half-spaces aside, tested
-//! directly), and the queries a game asks — first hit and all hits of a ray, a sphere cast,
-//! the colliders overlapping a shape, the colliders containing a point — answered by visiting
-//! only the boxes the query meets and testing those shapes exactly (the shape tests of
-//! [`crate::ccd`] and [`crate::geometry::contacts`], meshes through their own hierarchies).
+//! directly), in two groups — the moving colliders, read at every update, and the still ones,
+//! read only when the caller says they changed (a level's static scenery) — and the queries a
+//! game asks — first hit and all hits of a ray, a cast of any convex shape, the colliders
+//! overlapping a shape, the colliders containing a point, the nearest one — answered by
+//! visiting only the boxes the query meets and testing those shapes exactly (the shape tests
+//! of [`crate::ccd`] and [`crate::geometry::contacts`], meshes through their own hierarchies).
 //!
 //! The index stores boxes and ids, not shapes: each query reads the shapes it tests through a
 //! [`ColliderLookup`] (the ECS's query, or a slice in the core's tests), and a filter closure
