@@ -7,7 +7,7 @@ use crate::plugins::forces::GatheredForces;
 use crate::plugins::narrow_phase::{Contacts, HierarchyVisits, OverlappingLeaves, SensorOverlaps};
 use crate::plugins::required_resources::{RequireResource, restore_required_resources};
 use crate::plugins::settings_check::check_settings;
-use crate::plugins::settle::{SettledRevision, settle_statics, unsettle_written};
+use crate::plugins::settle::{StillRevision, settle_statics, unsettle_written};
 use crate::plugins::soft_step::SpeculativeMargin;
 use crate::plugins::transform_sync::ReadGameTransforms;
 use crate::schedule::{
@@ -52,7 +52,7 @@ impl Plugin for PhysicsCorePlugin {
             .init_required::<SensorOverlaps>()
             .init_required::<OverlappingLeaves>()
             .init_required::<HierarchyVisits>()
-            .init_required::<SettledRevision>();
+            .init_required::<StillRevision>();
 
         // Single-threaded executors: the step is a strict chain, and one thread keeps runs
         // bit-for-bit reproducible whatever the machine's thread count.

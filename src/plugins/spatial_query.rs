@@ -24,21 +24,22 @@
 //! read at their [`Position`] and [`Rotation`], parts of compound bodies at their
 //! [`GlobalPose`]. Quarantined colliders are never hit.
 //!
-//! Static scenery is not read at each step. A [`Static`] root body nobody wrote to since the
-//! last step is *settled* (the marker the step's change scans leave out, see `settle.rs`), and
-//! settled colliders sit in the index's still group ([`SpatialIndex::update_still`]), read
-//! again only when a body settles or stops being settled (or is despawned): the marker's hooks
-//! give the set a new revision. A level of 100,000 static colliders then costs its queries
-//! nothing per step, where it cost a box and a refit per collider (Avian keeps its static
-//! colliders in a tree of their own for the same reason). A static the game moves leaves the
-//! group at the next step (it is no longer settled) and comes back settled at that step's end.
-//! Index ids tell the groups apart: a moving collider's is twice its stable key, a settled
-//! one's twice plus one.
+//! Static scenery and sleeping bodies are not read at each step. A [`Static`] root body nobody
+//! wrote to since the last step is *settled* (the marker the step's change scans leave out, see
+//! `settle.rs`); settled colliders and the colliders of [`Sleeping`] bodies sit in the index's
+//! still group ([`SpatialIndex::update_still`]), read again only when a body settles, falls
+//! asleep, wakes or stops being settled (or is despawned): the markers' hooks give the set a
+//! new revision. A level of 100,000 static colliders, or a pile of crates asleep, then costs
+//! its queries nothing per step, where it cost a box and a refit per collider (Avian keeps its
+//! static colliders in a tree of their own for the same reason). A static the game moves
+//! leaves the group at the next step (it is no longer settled) and comes back settled at that
+//! step's end; a sleeper the game moves wakes at the next step. Index ids tell the groups
+//! apart: a moving collider's is twice its stable key, a still one's twice plus one.
 
 use crate::components::*;
 use crate::geometry::{Isometry, Shape};
 use crate::plugins::required_resources::RequireResource;
-use crate::plugins::settle::{Settled, SettledRevision};
+use crate::plugins::settle::{Settled, StillRevision};
 use crate::spatial::{
     ColliderLookup, IndexUpdate, LayerMask, QueryError, Ray, SpatialIndex, StableIds,
 };
@@ -71,11 +72,12 @@ struct IndexState {
     /// The key of each moving collider entity, stable while others come and go (so that a
     /// change of a few colliders keeps the index's tree); its index id is `2 key`.
     ids: StableIds<Entity>,
-    /// The key of each settled one, in the index's still group; its index id is `2 key + 1`.
+    /// The key of each still one (settled or asleep), in the index's still group; its index id
+    /// is `2 key + 1`.
     still_ids: StableIds<Entity>,
     /// The physics step of the last refresh.
     step: Option<u64>,
-    /// The settled bodies' revision when the still group was last read.
+    /// The still bodies' revision when the still group was last read.
     still_seen: Option<u64>,
     refreshes: IndexRefreshes,
 }
@@ -89,8 +91,8 @@ pub struct IndexRefreshes {
     pub updates: u64,
     /// The same colliders: the boxes refitted.
     pub refits: u64,
-    /// The settled static bodies read again (some settled, or stopped being settled): their
-    /// tree is otherwise kept as it is, unread (see the [module](self)).
+    /// The still colliders (settled statics, sleeping bodies) read again because their set
+    /// changed: their tree is otherwise kept as it is, unread (see the [module](self)).
     pub still_reads: u64,
 }
 
@@ -179,16 +181,10 @@ type QueryCollider = (
     Option<&'static CollisionLayers>,
 );
 
-/// A settled static body's collider: a root, at its position.
-type StillCollider = (
-    Entity,
-    &'static Collider,
-    &'static Position,
-    &'static Rotation,
-    Option<&'static CollisionLayers>,
-);
-type Moving = (Without<Quarantined>, Without<Settled>);
-type Still = (Without<Quarantined>, With<Settled>);
+/// The colliders read at every refresh: neither settled statics nor sleeping bodies.
+type Moving = (Without<Quarantined>, Without<Settled>, Without<Sleeping>);
+/// The still ones: settled statics and sleeping bodies, read when their set changes.
+type Still = (Without<Quarantined>, Or<(With<Settled>, With<Sleeping>)>);
 
 /// Ray casts, sphere casts, overlap and point queries against the colliders (see the
 /// [module](self)).
@@ -197,18 +193,18 @@ pub struct SpatialQuery<'w, 's> {
     shared: Option<Res<'w, SpatialQueryIndex>>,
     own: Local<'s, SpatialQueryIndex>,
     colliders: Query<'w, 's, QueryCollider, Moving>,
-    still: Query<'w, 's, StillCollider, Still>,
-    settled: Option<Res<'w, SettledRevision>>,
+    still: Query<'w, 's, QueryCollider, Still>,
+    revision: Option<Res<'w, StillRevision>>,
     stats: Option<Res<'w, PhysicsStats>>,
 }
 
-/// The ECS colliders by index id: even ids are moving colliders' keys, odd ones settled
+/// The ECS colliders by index id: even ids are moving colliders' keys, odd ones still
 /// colliders' (see [`IndexState`]).
 struct Lookup<'a, 'w, 's> {
     ids: &'a StableIds<Entity>,
     still_ids: &'a StableIds<Entity>,
     colliders: &'a Query<'w, 's, QueryCollider, Moving>,
-    still: &'a Query<'w, 's, StillCollider, Still>,
+    still: &'a Query<'w, 's, QueryCollider, Still>,
 }
 
 impl Lookup<'_, '_, '_> {
@@ -227,32 +223,30 @@ impl Lookup<'_, '_, '_> {
         self.key(id).unwrap_or(Entity::PLACEHOLDER)
     }
 
+    /// The collider `id`'s row, if it is there.
+    fn row(&self, id: u32) -> Option<QueryItemOf<'_>> {
+        let e = self.key(id)?;
+        if id & 1 == 0 {
+            self.colliders.get(e).ok()
+        } else {
+            self.still.get(e).ok()
+        }
+    }
+
     /// Whether the collider `id` is there and passes `filter`.
     fn accepts(&self, id: u32, filter: &SpatialQueryFilter) -> bool {
-        let Some(e) = self.key(id) else {
+        let Some(row) = self.row(id) else {
             return false;
         };
-        let layers = if id & 1 == 0 {
-            self.colliders.get(e).ok().map(|row| row.6)
-        } else {
-            self.still.get(e).ok().map(|row| row.4)
-        };
-        let member =
-            |l: Option<&CollisionLayers>| l.map_or(LayerMask::DEFAULT, |l| l.0.memberships);
-        layers.is_some_and(|l| member(l).intersects(filter.mask)) && !filter.excluded.contains(&e)
+        let member = row.6.map_or(LayerMask::DEFAULT, |l| l.0.memberships);
+        member.intersects(filter.mask) && !filter.excluded.contains(&row.0)
     }
 }
 
 impl ColliderLookup for Lookup<'_, '_, '_> {
     fn collider(&self, id: u32) -> Option<(&Shape, Isometry)> {
-        let e = self.key(id)?;
-        if id & 1 == 0 {
-            let row = self.colliders.get(e).ok()?;
-            Some((&row.1.shape, pose_of(&row)))
-        } else {
-            let (_, collider, position, rotation, _) = self.still.get(e).ok()?;
-            Some((&collider.shape, Isometry::new(position.0, rotation.0)))
-        }
+        let row = self.row(id)?;
+        Some((&row.1.shape, pose_of(&row)))
     }
 }
 
@@ -280,7 +274,7 @@ impl SpatialQuery<'_, '_> {
     }
 
     /// The index, refreshed if a step ran since (or `force`): the moving colliders read
-    /// whole, the settled ones only if their set changed (or `force`).
+    /// whole, the still ones only if their set changed (or `force`).
     fn fresh(&self, force: bool) -> MutexGuard<'_, IndexState> {
         let mut state = self.index().lock();
         let step = self.stats.as_ref().map(|s| s.step);
@@ -300,7 +294,7 @@ impl SpatialQuery<'_, '_> {
                 IndexUpdate::Updated => counts.updates += 1,
                 IndexUpdate::Rebuilt => counts.rebuilds += 1,
             }
-            let seen = self.settled_set();
+            let seen = self.still_set();
             if force || seen.is_none() || state.still_seen != seen {
                 self.read_still(state);
                 state.still_seen = seen;
@@ -310,24 +304,23 @@ impl SpatialQuery<'_, '_> {
         state
     }
 
-    /// The settled bodies' revision: unchanged, no body settled or stopped being settled (or
-    /// was despawned) since the still group was read. `None` without it (removed by game code
-    /// until the next step puts it back, or no core plugin): the group is read each time.
-    fn settled_set(&self) -> Option<u64> {
-        self.settled.as_ref().map(|r| r.0)
+    /// The still bodies' revision: unchanged, no body settled, slept, woke or stopped being
+    /// settled (or was despawned) since the still group was read. `None` without it (removed by
+    /// game code until the next step puts it back, or no core plugin): the group is read each
+    /// time.
+    fn still_set(&self) -> Option<u64> {
+        self.revision.as_ref().map(|r| r.0)
     }
 
-    /// Reads the settled colliders into the index's still group.
+    /// Reads the still colliders (settled statics, sleeping bodies) into the index's still
+    /// group.
     fn read_still(&self, state: &mut IndexState) {
         let ids = &mut state.still_ids;
         ids.begin();
         let colliders = self
             .still
             .iter()
-            .map(|(e, collider, position, rotation, _)| {
-                let pose = Isometry::new(position.0, rotation.0);
-                ((ids.id(e) << 1) | 1, &collider.shape, pose)
-            });
+            .map(|row| ((ids.id(row.0) << 1) | 1, &row.1.shape, pose_of(&row)));
         state.index.update_still(colliders);
         state.still_ids.finish();
         state.refreshes.still_reads += 1;

@@ -38,7 +38,7 @@ fn settled_statics_moved_while_their_revision_is_removed_are_hit_where_they_are_
     for (i, &block) in blocks.iter().enumerate() {
         let x = 3.0 * i as f32;
         let world = app.world_mut();
-        assert!(world.remove_resource::<SettledRevision>().is_some());
+        assert!(world.remove_resource::<StillRevision>().is_some());
         // Still settled: moved between steps and seen after a refresh.
         world
             .entity_mut(block)

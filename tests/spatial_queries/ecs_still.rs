@@ -227,3 +227,85 @@ fn settled_statics_edited_for_40_steps_answer_as_a_fresh_index_and_30_quiet_step
     let refreshes = app.world().resource::<SpatialQueryIndex>().refreshes();
     assert!(refreshes.refits >= 30, "{refreshes:?}");
 }
+
+/// 120 balls dropped on a ground fall asleep and sit in the still group: 30 quiet steps read
+/// them not once, and after every step — while they sleep, while a few the game kicks wake,
+/// fly and fall asleep again — the answers equal a fresh index's over the world.
+#[test]
+fn sleeping_balls_answer_as_a_fresh_index_through_waking_and_30_quiet_steps_read_them_0_times() {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    let mut rng = Rng::new(48);
+    let world = app.world_mut();
+    world.spawn((Collider::half_space(Vec3::Z), Static));
+    let balls: Vec<Entity> = (0..120)
+        .map(|i| {
+            let at = Vec3::new((i % 12) as f32 * 1.5, (i / 12) as f32 * 1.5, 0.6);
+            world
+                .spawn((
+                    Collider::sphere(0.5),
+                    Position(at),
+                    Velocity::default(),
+                    RollingResistance(0.02),
+                ))
+                .id()
+        })
+        .collect();
+    urto::step(app.world_mut(), 240).unwrap();
+    let asleep = |app: &App| {
+        let world = app.world();
+        balls
+            .iter()
+            .filter(|&&b| world.get::<Sleeping>(b).is_some())
+            .count()
+    };
+    assert_eq!(asleep(&app), balls.len(), "all asleep");
+    // Rays down onto the balls and through the rows.
+    let rays: Vec<Ray> = (0..40)
+        .map(|i| {
+            let from = Vec3::new(rng.range(-1.0, 18.0), rng.range(-1.0, 16.0), 5.0);
+            let to = if i % 2 == 0 {
+                from - Vec3::Z
+            } else {
+                Vec3::new(rng.range(-1.0, 18.0), rng.range(-1.0, 16.0), 0.4)
+            };
+            Ray::new(from, to - from).unwrap()
+        })
+        .collect();
+    ecs_answers(&mut app, &rays, &[], false);
+    let reads = still_reads(&app);
+    for _ in 0..30 {
+        urto::step(app.world_mut(), 1).unwrap();
+        let ours = canonical(ecs_answers(&mut app, &rays, &[], false));
+        assert_eq!(ours, canonical(fresh_answers(app.world_mut(), &rays, &[])));
+    }
+    assert_eq!(still_reads(&app), reads, "quiet steps read no sleeper");
+    let kicked: Vec<Entity> = balls.iter().step_by(17).copied().collect();
+    for &b in &kicked {
+        let kick = Velocity(Vec3::new(0.0, 0.5, 4.0));
+        app.world_mut().entity_mut(b).insert(kick);
+    }
+    let mut woke = 0;
+    for step in 0..600 {
+        urto::step(app.world_mut(), 1).unwrap();
+        woke = woke.max(balls.len() - asleep(&app));
+        // The rays, and one down onto each kicked ball where it is now.
+        let mut aimed = rays.clone();
+        for &b in &kicked {
+            let at = app.world().get::<Position>(b).unwrap().0;
+            aimed.push(Ray::new(at + Vec3::new(0.1, 0.0, 5.0), -Vec3::Z).unwrap());
+        }
+        let ours = canonical(ecs_answers(&mut app, &aimed, &[], false));
+        let fresh = canonical(fresh_answers(app.world_mut(), &aimed, &[]));
+        assert_eq!(ours, fresh, "step {step} after the kicks");
+        if step > 60 && asleep(&app) == balls.len() {
+            break;
+        }
+    }
+    assert!(woke >= kicked.len(), "{woke} woke");
+    assert_eq!(asleep(&app), balls.len(), "all asleep again");
+    assert!(
+        still_reads(&app) > reads,
+        "the still group followed the wakes"
+    );
+}
