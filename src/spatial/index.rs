@@ -212,31 +212,36 @@ impl SpatialIndex {
         cast: &BoxCast,
         accept: impl FnMut(u32) -> bool,
     ) -> Result<Option<QueryHit>, QueryError> {
-        let shape = Shape::cuboid(cast.half_extents);
-        let cast = ShapeCast {
-            pose: cast.pose,
-            shape: &shape,
-            direction: cast.direction,
-            max_distance: cast.max_distance,
-        };
-        self.cast_shape(colliders, &cast, accept)
+        let motion = (cast.pose, cast.direction, cast.max_distance);
+        self.cast_as(colliders, &Shape::cuboid(cast.half_extents), motion, accept)
     }
 
     /// The nearest collider `accept`ed that `cast`'s capsule meets (see
-    /// [`cast_capsule`](super::cast_capsule); its
-    /// direction must be unit): [`Self::cast_shape`] with the capsule.
+    /// [`cast_capsule`](super::cast_capsule); its direction must be unit): [`Self::cast_shape`]
+    /// with the capsule.
     pub fn cast_capsule<L: ColliderLookup + ?Sized>(
         &mut self,
         colliders: &L,
         cast: &CapsuleCast,
         accept: impl FnMut(u32) -> bool,
     ) -> Result<Option<QueryHit>, QueryError> {
-        let shape = Shape::Capsule(cast.capsule);
+        let motion = (cast.pose, cast.direction, cast.max_distance);
+        self.cast_as(colliders, &Shape::Capsule(cast.capsule), motion, accept)
+    }
+
+    /// [`Self::cast_shape`] of `shape` from `pose` along `direction` for at most `max_distance`.
+    fn cast_as<L: ColliderLookup + ?Sized>(
+        &mut self,
+        colliders: &L,
+        shape: &Shape,
+        (pose, direction, max_distance): (Isometry, Vec3, f32),
+        accept: impl FnMut(u32) -> bool,
+    ) -> Result<Option<QueryHit>, QueryError> {
         let cast = ShapeCast {
-            pose: cast.pose,
-            shape: &shape,
-            direction: cast.direction,
-            max_distance: cast.max_distance,
+            pose,
+            shape,
+            direction,
+            max_distance,
         };
         self.cast_shape(colliders, &cast, accept)
     }

@@ -116,6 +116,19 @@ fn random_static(rng: &mut Rng) -> (Collider, Position, Rotation, Static) {
     )
 }
 
+/// Steps `n` times, the answers to `rays` equal to a fresh index's after each; returns how
+/// many times the still group was read in those steps.
+fn quiet_steps(app: &mut App, rays: &[Ray], n: usize) -> u64 {
+    ecs_answers(app, rays, &[], false);
+    let reads = still_reads(app);
+    for _ in 0..n {
+        urto::step(app.world_mut(), 1).unwrap();
+        let ours = canonical(ecs_answers(app, rays, &[], false));
+        assert_eq!(ours, canonical(fresh_answers(app.world_mut(), rays, &[])));
+    }
+    still_reads(app) - reads
+}
+
 fn still_reads(app: &App) -> u64 {
     app.world()
         .resource::<SpatialQueryIndex>()
@@ -212,18 +225,8 @@ fn settled_statics_edited_for_40_steps_answer_as_a_fresh_index_and_30_quiet_step
     }
     urto::step(app.world_mut(), 2).unwrap();
     let rays: Vec<Ray> = (0..20).map(|_| random_ray(&mut rng)).collect();
-    ecs_answers(&mut app, &rays, &[], false);
-    let reads = still_reads(&app);
-    for _ in 0..30 {
-        urto::step(app.world_mut(), 1).unwrap();
-        let ours = canonical(ecs_answers(&mut app, &rays, &[], false));
-        assert_eq!(ours, canonical(fresh_answers(app.world_mut(), &rays, &[])));
-    }
-    assert_eq!(
-        still_reads(&app),
-        reads,
-        "quiet steps read no settled static"
-    );
+    let reads = quiet_steps(&mut app, &rays, 30);
+    assert_eq!(reads, 0, "quiet steps read no settled static");
     let refreshes = app.world().resource::<SpatialQueryIndex>().refreshes();
     assert!(refreshes.refits >= 30, "{refreshes:?}");
 }
@@ -272,14 +275,12 @@ fn sleeping_balls_answer_as_a_fresh_index_through_waking_and_30_quiet_steps_read
             Ray::new(from, to - from).unwrap()
         })
         .collect();
-    ecs_answers(&mut app, &rays, &[], false);
+    assert_eq!(
+        quiet_steps(&mut app, &rays, 30),
+        0,
+        "quiet steps read no sleeper"
+    );
     let reads = still_reads(&app);
-    for _ in 0..30 {
-        urto::step(app.world_mut(), 1).unwrap();
-        let ours = canonical(ecs_answers(&mut app, &rays, &[], false));
-        assert_eq!(ours, canonical(fresh_answers(app.world_mut(), &rays, &[])));
-    }
-    assert_eq!(still_reads(&app), reads, "quiet steps read no sleeper");
     let kicked: Vec<Entity> = balls.iter().step_by(17).copied().collect();
     for &b in &kicked {
         let kick = Velocity(Vec3::new(0.0, 0.5, 4.0));
