@@ -273,12 +273,17 @@ impl SpatialQuery<'_, '_> {
         self.shared.as_deref().unwrap_or(&self.own)
     }
 
-    /// The index, refreshed if a step ran since (or `force`): the moving colliders read
-    /// whole, the still ones only if their set changed (or `force`).
+    /// The index, refreshed if a step ran since, or the set of still bodies changed (or
+    /// `force`): the moving colliders read whole, the still ones only if their set changed (or
+    /// `force`).
     fn fresh(&self, force: bool) -> MutexGuard<'_, IndexState> {
         let mut state = self.index().lock();
         let step = self.stats.as_ref().map(|s| s.step);
-        if force || step.is_none() || state.step != step {
+        let seen = self.still_set();
+        // A body that left the still group between steps (game code woke it) belongs to the
+        // moving group at once, or it would be in neither until the next step.
+        let left_still = seen.is_some() && state.still_seen != seen;
+        if force || step.is_none() || state.step != step || left_still {
             let state = &mut *state;
             let ids = &mut state.ids;
             ids.begin();
@@ -294,7 +299,6 @@ impl SpatialQuery<'_, '_> {
                 IndexUpdate::Updated => counts.updates += 1,
                 IndexUpdate::Rebuilt => counts.rebuilds += 1,
             }
-            let seen = self.still_set();
             if force || seen.is_none() || state.still_seen != seen {
                 self.read_still(state);
                 state.still_seen = seen;

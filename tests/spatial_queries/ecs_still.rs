@@ -281,6 +281,14 @@ fn sleeping_balls_answer_as_a_fresh_index_through_waking_and_30_quiet_steps_read
         "quiet steps read no sleeper"
     );
     let reads = still_reads(&app);
+    // Woken by game code between steps (the marker taken off): hit at once, where it sleeps.
+    let woken = balls[5];
+    app.world_mut().entity_mut(woken).remove::<Sleeping>();
+    let at = app.world().get::<Position>(woken).unwrap().0;
+    let down = [Ray::new(at + Vec3::new(0.1, 0.0, 5.0), -Vec3::Z).unwrap()];
+    let ours = canonical(ecs_answers(&mut app, &down, &[], false));
+    assert_eq!(ours.0[0].first().map(|h| h.0), Some(woken));
+    assert_eq!(ours, canonical(fresh_answers(app.world_mut(), &down, &[])));
     let kicked: Vec<Entity> = balls.iter().step_by(17).copied().collect();
     for &b in &kicked {
         let kick = Velocity(Vec3::new(0.0, 0.5, 4.0));
