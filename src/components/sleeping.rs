@@ -116,5 +116,4 @@ fn note(mut world: DeferredWorld, e: Entity, asleep: bool) {
     if let Some(mut transitions) = world.get_resource_mut::<SleepTransitions>() {
         transitions.0.push((e, asleep));
     }
-    crate::plugins::settle::note_still_change(&mut world);
 }

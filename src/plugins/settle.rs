@@ -33,11 +33,11 @@ use std::sync::atomic::{AtomicU64, Ordering};
 #[component(on_add = note_settling, on_remove = note_settling)]
 pub(crate) struct Settled;
 
-/// Names the set of still bodies — settled statics and sleeping bodies: a new value whenever a
-/// body gains or loses [`Settled`] or [`Sleeping`] (despawns included), so that a reader keeping
-/// something per still body (the spatial queries' still group) knows the set is unchanged
-/// without reading it. Values come from one counter for every world, so a resource put back
-/// after game code removed it never repeats a value a reader kept.
+/// Names the set of settled bodies: a new value whenever a body gains or loses [`Settled`]
+/// (despawns included), so that a reader keeping something per settled body (the spatial
+/// queries' still group) knows the set is unchanged without reading it. Values come from one
+/// counter for every world, so a resource put back after game code removed it never repeats a
+/// value a reader kept.
 #[derive(Resource, Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct StillRevision(pub(crate) u64);
 
@@ -49,8 +49,8 @@ impl Default for StillRevision {
 
 static NEXT_STILL_REVISION: AtomicU64 = AtomicU64::new(1);
 
-/// The set of still bodies changed (a body settled, slept, woke or stopped being settled).
-pub(crate) fn note_still_change(world: &mut DeferredWorld) {
+/// The set of settled bodies changed.
+fn note_still_change(world: &mut DeferredWorld) {
     if let Some(mut revision) = world.get_resource_mut::<StillRevision>() {
         *revision = StillRevision::default();
     }

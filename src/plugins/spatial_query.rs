@@ -24,17 +24,17 @@
 //! read at their [`Position`] and [`Rotation`], parts of compound bodies at their
 //! [`GlobalPose`]. Quarantined colliders are never hit.
 //!
-//! Static scenery and sleeping bodies are not read at each step. A [`Static`] root body nobody
-//! wrote to since the last step is *settled* (the marker the step's change scans leave out, see
-//! `settle.rs`); settled colliders and the colliders of [`Sleeping`] bodies sit in the index's
-//! still group ([`SpatialIndex::update_still`]), read again only when a body settles, falls
-//! asleep, wakes or stops being settled (or is despawned): the markers' hooks give the set a
-//! new revision. A level of 100,000 static colliders, or a pile of crates asleep, then costs
-//! its queries nothing per step, where it cost a box and a refit per collider (Avian keeps its
-//! static colliders in a tree of their own for the same reason). A static the game moves
-//! leaves the group at the next step (it is no longer settled) and comes back settled at that
-//! step's end; a sleeper the game moves wakes at the next step. Index ids tell the groups
-//! apart: a moving collider's is twice its stable key, a still one's twice plus one.
+//! Static scenery is not read at each step. A [`Static`] root body nobody wrote to since the
+//! last step is *settled* (the marker the step's change scans leave out, see `settle.rs`), and
+//! settled colliders sit in the index's still group ([`SpatialIndex::update_still`]), read
+//! again only when a body settles or stops being settled (or is despawned): the marker's hooks
+//! give the set a new revision. A level of 100,000 static colliders then costs its queries
+//! nothing per step, where it cost a box and a refit per collider (Avian keeps its static
+//! colliders in a tree of their own for the same reason). A static the game moves leaves the
+//! group at the next step (it is no longer settled) and comes back settled at that step's end.
+//! Sleeping bodies stay in the moving group: in the still group, each body falling asleep or
+//! waking would have every static read again. Index ids tell the groups apart: a moving
+//! collider's is twice its stable key, a settled one's twice plus one.
 
 use crate::components::*;
 use crate::geometry::{Isometry, Shape};
@@ -72,12 +72,11 @@ struct IndexState {
     /// The key of each moving collider entity, stable while others come and go (so that a
     /// change of a few colliders keeps the index's tree); its index id is `2 key`.
     ids: StableIds<Entity>,
-    /// The key of each still one (settled or asleep), in the index's still group; its index id
-    /// is `2 key + 1`.
+    /// The key of each settled one, in the index's still group; its index id is `2 key + 1`.
     still_ids: StableIds<Entity>,
     /// The physics step of the last refresh.
     step: Option<u64>,
-    /// The still bodies' revision when the still group was last read.
+    /// The settled bodies' revision when the still group was last read.
     still_seen: Option<u64>,
     refreshes: IndexRefreshes,
 }
@@ -91,8 +90,8 @@ pub struct IndexRefreshes {
     pub updates: u64,
     /// The same colliders: the boxes refitted.
     pub refits: u64,
-    /// The still colliders (settled statics, sleeping bodies) read again because their set
-    /// changed: their tree is otherwise kept as it is, unread (see the [module](self)).
+    /// The settled statics read again because their set changed: their tree is otherwise kept
+    /// as it is, unread (see the [module](self)).
     pub still_reads: u64,
 }
 
@@ -181,10 +180,10 @@ type QueryCollider = (
     Option<&'static CollisionLayers>,
 );
 
-/// The colliders read at every refresh: neither settled statics nor sleeping bodies.
-type Moving = (Without<Quarantined>, Without<Settled>, Without<Sleeping>);
-/// The still ones: settled statics and sleeping bodies, read when their set changes.
-type Still = (Without<Quarantined>, Or<(With<Settled>, With<Sleeping>)>);
+/// The colliders read at every refresh: all but the settled statics.
+type Moving = (Without<Quarantined>, Without<Settled>);
+/// The still ones: settled statics, read when their set changes.
+type Still = (Without<Quarantined>, With<Settled>);
 
 /// Ray casts, sphere casts, overlap and point queries against the colliders (see the
 /// [module](self)).
@@ -273,17 +272,12 @@ impl SpatialQuery<'_, '_> {
         self.shared.as_deref().unwrap_or(&self.own)
     }
 
-    /// The index, refreshed if a step ran since, or the set of still bodies changed (or
-    /// `force`): the moving colliders read whole, the still ones only if their set changed (or
-    /// `force`).
+    /// The index, refreshed if a step ran since (or `force`): the moving colliders read
+    /// whole, the settled ones only if their set changed (or `force`).
     fn fresh(&self, force: bool) -> MutexGuard<'_, IndexState> {
         let mut state = self.index().lock();
         let step = self.stats.as_ref().map(|s| s.step);
-        let seen = self.still_set();
-        // A body that left the still group between steps (game code woke it) belongs to the
-        // moving group at once, or it would be in neither until the next step.
-        let left_still = seen.is_some() && state.still_seen != seen;
-        if force || step.is_none() || state.step != step || left_still {
+        if force || step.is_none() || state.step != step {
             let state = &mut *state;
             let ids = &mut state.ids;
             ids.begin();
@@ -299,6 +293,7 @@ impl SpatialQuery<'_, '_> {
                 IndexUpdate::Updated => counts.updates += 1,
                 IndexUpdate::Rebuilt => counts.rebuilds += 1,
             }
+            let seen = self.still_set();
             if force || seen.is_none() || state.still_seen != seen {
                 self.read_still(state);
                 state.still_seen = seen;
@@ -308,16 +303,15 @@ impl SpatialQuery<'_, '_> {
         state
     }
 
-    /// The still bodies' revision: unchanged, no body settled, slept, woke or stopped being
-    /// settled (or was despawned) since the still group was read. `None` without it (removed by
+    /// The settled bodies' revision: unchanged, no body settled or stopped being settled (or
+    /// was despawned) since the still group was read. `None` without it (removed by
     /// game code until the next step puts it back, or no core plugin): the group is read each
     /// time.
     fn still_set(&self) -> Option<u64> {
         self.revision.as_ref().map(|r| r.0)
     }
 
-    /// Reads the still colliders (settled statics, sleeping bodies) into the index's still
-    /// group.
+    /// Reads the settled colliders into the index's still group.
     fn read_still(&self, state: &mut IndexState) {
         let ids = &mut state.still_ids;
         ids.begin();
