@@ -21,6 +21,8 @@ pub struct QueryScratch {
     pub(crate) fifo: VecDeque<NodePair>,
     pub(crate) ranked: RankedQueue,
     pub(crate) nodes: Vec<u32>,
+    /// A walk along a path, nearest node first: each node and where the path enters it.
+    pub(crate) along: Vec<(u32, f32)>,
 }
 
 impl QueryScratch {

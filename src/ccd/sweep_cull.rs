@@ -15,6 +15,20 @@ pub trait SweepCull {
     /// False only if the sphere of `radius` whose centre moves along `origin + t·displacement`,
     /// `t ∈ [0, t_max]`, cannot touch anything inside the BV (all in the BV's frame).
     fn may_touch_sweep(&self, origin: Vec3, displacement: Vec3, radius: f32, t_max: f32) -> bool;
+
+    /// Where along `[0, t_max]` that sphere may first touch what the BV holds (a lower bound), or
+    /// `None` where [`Self::may_touch_sweep`] is false: what a walk that visits the nearest
+    /// nodes first orders them by. Boxes give their slab entry; other kinds say 0.
+    fn sweep_entry(
+        &self,
+        origin: Vec3,
+        displacement: Vec3,
+        radius: f32,
+        t_max: f32,
+    ) -> Option<f32> {
+        self.may_touch_sweep(origin, displacement, radius, t_max)
+            .then_some(0.0)
+    }
 }
 
 /// Narrows `[t0, t1]` to the times when `start + t·rate` lies in `[low, high]`; false when
@@ -31,11 +45,17 @@ fn clip_slab(start: f32, rate: f32, low: f32, high: f32, t0: &mut f32, t1: &mut 
     *t0 <= *t1
 }
 
-/// The segment against the box `[low, high]` of the given frame coordinates.
+/// Where the segment enters the box `[low, high]` of the given frame coordinates, if it does.
 #[inline]
-fn segment_meets_box(origin: Vec3, displacement: Vec3, low: Vec3, high: Vec3, t_max: f32) -> bool {
+fn segment_box_entry(
+    origin: Vec3,
+    displacement: Vec3,
+    low: Vec3,
+    high: Vec3,
+    t_max: f32,
+) -> Option<f32> {
     let (mut t0, mut t1) = (0.0f32, t_max);
-    (0..3).all(|i| {
+    let meets = (0..3).all(|i| {
         clip_slab(
             origin[i],
             displacement[i],
@@ -44,14 +64,27 @@ fn segment_meets_box(origin: Vec3, displacement: Vec3, low: Vec3, high: Vec3, t_
             &mut t0,
             &mut t1,
         )
-    })
+    });
+    meets.then_some(t0)
 }
 
 impl SweepCull for Aabb {
     #[inline]
     fn may_touch_sweep(&self, origin: Vec3, displacement: Vec3, radius: f32, t_max: f32) -> bool {
+        self.sweep_entry(origin, displacement, radius, t_max)
+            .is_some()
+    }
+
+    #[inline]
+    fn sweep_entry(
+        &self,
+        origin: Vec3,
+        displacement: Vec3,
+        radius: f32,
+        t_max: f32,
+    ) -> Option<f32> {
         let grow = Vec3::splat(radius);
-        segment_meets_box(
+        segment_box_entry(
             origin,
             displacement,
             self.min - grow,
@@ -64,11 +97,23 @@ impl SweepCull for Aabb {
 impl SweepCull for Obb {
     #[inline]
     fn may_touch_sweep(&self, origin: Vec3, displacement: Vec3, radius: f32, t_max: f32) -> bool {
+        self.sweep_entry(origin, displacement, radius, t_max)
+            .is_some()
+    }
+
+    #[inline]
+    fn sweep_entry(
+        &self,
+        origin: Vec3,
+        displacement: Vec3,
+        radius: f32,
+        t_max: f32,
+    ) -> Option<f32> {
         let to_box = self.axes.transpose();
         let o = to_box * (origin - self.center);
         let d = to_box * displacement;
         let half = self.half_extents + Vec3::splat(radius);
-        segment_meets_box(o, d, -half, half, t_max)
+        segment_box_entry(o, d, -half, half, t_max)
     }
 }
 

@@ -49,16 +49,11 @@ impl Default for StillRevision {
 
 static NEXT_STILL_REVISION: AtomicU64 = AtomicU64::new(1);
 
-/// The set of settled bodies changed.
-fn note_still_change(world: &mut DeferredWorld) {
+/// The [`Settled`] marker's hooks: the set of settled bodies changed.
+fn note_settling(mut world: DeferredWorld, _: HookContext) {
     if let Some(mut revision) = world.get_resource_mut::<StillRevision>() {
         *revision = StillRevision::default();
     }
-}
-
-/// The [`Settled`] marker's hooks.
-fn note_settling(mut world: DeferredWorld, _: HookContext) {
-    note_still_change(&mut world);
 }
 
 /// Change scans leave settled bodies out.

@@ -114,7 +114,7 @@ pub fn cast_capsule(
         Shape::TriMesh(m) => {
             let me = Shape::Capsule(cast.capsule);
             let motion = (cast.direction, cast.max_distance);
-            against_mesh((&me, &cast.pose), motion, target, m)
+            against_mesh((&me, &cast.pose), motion, target, m, scratch)
         }
     }
 }

@@ -27,9 +27,8 @@ use super::box_cast::{
 };
 use super::capsule_cast::{CapsuleCast, cast_capsule};
 use super::cast::{CastHit, Ray, cast_sphere};
-use super::tree::RaySegment;
-use crate::bounding::{Aabb, Obb};
 use crate::bvh::QueryScratch;
+use crate::ccd::SweepCull;
 use crate::geometry::convex::core_distance;
 use crate::geometry::convex::support::ConvexPart;
 use crate::geometry::{Isometry, MeshCollider, Shape};
@@ -106,19 +105,21 @@ fn convex_cast(
             let inward = -at.transform_vector(h.normal);
             against_plane(part.support(inward), part.rounding, motion, at, h)
         }
-        Shape::TriMesh(m) => against_mesh((shape, pose), motion, at, m),
+        Shape::TriMesh(m) => against_mesh((shape, pose), motion, at, m, scratch),
         _ => against_convex((shape, pose), motion, (target, at)),
     }
 }
 
 /// A convex caster against a mesh's triangles, in the mesh's frame (see the [module](self)):
-/// the hierarchy walked nearest node first along the caster's path, as the query index walks
-/// its tree for a ray, so that the first hits found bound the rest of the walk.
+/// the hierarchy walked nearest node first along the caster's path (by the nodes' swept-sphere
+/// entries, [`SweepCull::sweep_entry`]), so that the first hits found bound the rest of the
+/// walk.
 pub(super) fn against_mesh(
     (shape, pose): (&Shape, &Isometry),
     (direction, max): (Vec3, f32),
     at: &Isometry,
     mesh: &MeshCollider,
+    scratch: &mut QueryScratch,
 ) -> Option<CastHit> {
     let start = at.inv_mul(pose);
     let local = at.inverse_transform_vector(direction);
@@ -126,29 +127,23 @@ pub(super) fn against_mesh(
     // advancement's tolerance).
     let radius = shape.bounding_radius();
     let reach = radius + ADVANCE_TOLERANCE * (2.0 + radius);
-    let path = RaySegment::new(start.translation, local);
     let tolerance = ADVANCE_TOLERANCE * (1.0 + radius);
-    // Where the path enters a node's box grown by the reach, before `limit`.
-    let enter = |node: &Obb, limit: f32| {
-        let to_node = node.axes.transpose();
-        let along = RaySegment::new(to_node * (start.translation - node.center), to_node * local);
-        let h = node.half_extents + Vec3::splat(reach);
-        along.entry(&Aabb::new(-h, h), limit)
-    };
+    let entry =
+        |bv: &dyn SweepCull, limit: f32| bv.sweep_entry(start.translation, local, reach, limit);
     let (nodes, order) = (mesh.bvh().nodes(), mesh.bvh().triangle_order());
     let mut best: Option<CastHit> = None;
-    let mut stack: Vec<(u32, f32)> = Vec::with_capacity(64);
-    stack.extend(enter(&nodes[0].bv, max).map(|t| (0, t)));
-    while let Some((index, entry)) = stack.pop() {
+    let stack = &mut scratch.along;
+    stack.clear();
+    stack.extend(entry(&nodes[0].bv, max).map(|t| (0, t)));
+    while let Some((index, at_entry)) = stack.pop() {
         // Only a nearer hit than the best so far matters.
         let limit = best.map_or(max, |b| b.distance);
-        if entry > limit {
+        if at_entry > limit {
             continue;
         }
         let node = &nodes[index as usize];
-        if let Some([left, right]) = node.children() {
-            let near = [left, right].map(|c| enter(&nodes[c as usize].bv, limit).map(|t| (c, t)));
-            let [a, b] = near;
+        if let Some(children) = node.children() {
+            let [a, b] = children.map(|c| entry(&nodes[c as usize].bv, limit).map(|t| (c, t)));
             // The nearer child on top of the stack.
             let (first, second) = match (a, b) {
                 (Some(x), Some(y)) if y.1 < x.1 => (Some(y), Some(x)),
@@ -163,9 +158,7 @@ pub(super) fn against_mesh(
                 continue;
             };
             let limit = best.map_or(max, |b| b.distance);
-            let [a, b, c] = tri.vertices();
-            let grown = Aabb::new(a.min(b).min(c), a.max(b).max(c)).expanded(reach);
-            if path.entry(&grown, limit).is_none() {
+            if entry(&tri.aabb(), limit).is_none() {
                 continue;
             }
             let triangle = ConvexPart::triangle(&tri);
