@@ -116,4 +116,5 @@ fn note(mut world: DeferredWorld, e: Entity, asleep: bool) {
     if let Some(mut transitions) = world.get_resource_mut::<SleepTransitions>() {
         transitions.0.push((e, asleep));
     }
+    crate::plugins::settle::note_sleeping_change(&mut world);
 }

@@ -29,7 +29,7 @@ mod required_resources;
 pub mod response;
 pub mod rotation;
 mod settings_check;
-mod settle;
+pub(crate) mod settle;
 pub mod sleep;
 pub mod soft_step;
 pub mod spatial_query;

@@ -33,18 +33,31 @@ use std::sync::atomic::{AtomicU64, Ordering};
 #[component(on_add = note_settling, on_remove = note_settling)]
 pub(crate) struct Settled;
 
-/// Names the set of settled bodies: a new value whenever a body gains or loses [`Settled`]
-/// (despawns included), so that a reader keeping something per settled body (the spatial
-/// queries' still group) knows the set is unchanged without reading it. Values come from one
-/// counter for every world, so a resource put back after game code removed it never repeats a
-/// value a reader kept.
+/// Names the sets of *still* bodies, the settled statics and the sleeping bodies: a new value
+/// for a set whenever a body joins or leaves it ([`Settled`] or [`Sleeping`] added or removed,
+/// despawns included), so that a reader keeping something per still body (the spatial
+/// queries' still and sleeping groups) knows a set is unchanged without reading it. Values come
+/// from one counter for every world, so a resource put back after game code removed it never
+/// repeats a value a reader kept.
 #[derive(Resource, Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct StillRevision(pub(crate) u64);
+pub(crate) struct StillRevision {
+    /// The set of settled statics.
+    pub(crate) settled: u64,
+    /// The set of sleeping bodies.
+    pub(crate) sleeping: u64,
+}
 
 impl Default for StillRevision {
     fn default() -> Self {
-        Self(NEXT_STILL_REVISION.fetch_add(1, Ordering::Relaxed))
+        Self {
+            settled: next_revision(),
+            sleeping: next_revision(),
+        }
     }
+}
+
+fn next_revision() -> u64 {
+    NEXT_STILL_REVISION.fetch_add(1, Ordering::Relaxed)
 }
 
 static NEXT_STILL_REVISION: AtomicU64 = AtomicU64::new(1);
@@ -52,7 +65,14 @@ static NEXT_STILL_REVISION: AtomicU64 = AtomicU64::new(1);
 /// The [`Settled`] marker's hooks: the set of settled bodies changed.
 fn note_settling(mut world: DeferredWorld, _: HookContext) {
     if let Some(mut revision) = world.get_resource_mut::<StillRevision>() {
-        *revision = StillRevision::default();
+        revision.settled = next_revision();
+    }
+}
+
+/// The set of sleeping bodies changed (the [`Sleeping`] marker's hooks call it).
+pub(crate) fn note_sleeping_change(world: &mut DeferredWorld) {
+    if let Some(mut revision) = world.get_resource_mut::<StillRevision>() {
+        revision.sleeping = next_revision();
     }
 }
 

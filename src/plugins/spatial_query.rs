@@ -32,9 +32,12 @@
 //! nothing per step, where it cost a box and a refit per collider (Avian keeps its static
 //! colliders in a tree of their own for the same reason). A static the game moves leaves the
 //! group at the next step (it is no longer settled) and comes back settled at that step's end.
-//! Sleeping bodies stay in the moving group: in the still group, each body falling asleep or
-//! waking would have every static read again. Index ids tell the groups apart: a moving
-//! collider's is twice its stable key, a settled one's twice plus one.
+//! Sleeping bodies sit in a group of their own ([`SpatialIndex::update_sleeping`]), read again
+//! only when a body falls asleep or wakes (the [`Sleeping`] marker's hooks renew that set's
+//! revision): a pile of sleeping debris costs its queries nothing per step, and a body falling
+//! asleep or waking reads the sleepers again, never the level's statics. Index ids tell the
+//! groups apart: a collider's is four times its stable key in its group, plus 0 (moving),
+//! 1 (settled) or 2 (sleeping).
 
 use crate::components::*;
 use crate::geometry::{Isometry, Shape};
@@ -46,6 +49,7 @@ use crate::spatial::{
 use crate::stats::PhysicsStats;
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
+use bevy_ecs::query::QueryFilter;
 use bevy_ecs::system::SystemParam;
 use glam::Vec3;
 use std::sync::{Mutex, MutexGuard};
@@ -69,15 +73,14 @@ pub struct SpatialQueryIndex {
 #[derive(Default)]
 struct IndexState {
     index: SpatialIndex,
-    /// The key of each moving collider entity, stable while others come and go (so that a
-    /// change of a few colliders keeps the index's tree); its index id is `2 key`.
-    ids: StableIds<Entity>,
-    /// The key of each settled one, in the index's still group; its index id is `2 key + 1`.
-    still_ids: StableIds<Entity>,
+    /// The key of each collider entity in its group (moving, settled, sleeping), stable while
+    /// others come and go (so that a change of a few colliders keeps the group's tree); its
+    /// index id is `4 key + group`.
+    ids: [StableIds<Entity>; 3],
     /// The physics step of the last refresh.
     step: Option<u64>,
-    /// The settled bodies' revision when the still group was last read.
-    still_seen: Option<u64>,
+    /// The revisions of the settled and sleeping sets when their groups were last read.
+    seen: [Option<u64>; 2],
     refreshes: IndexRefreshes,
 }
 
@@ -93,6 +96,8 @@ pub struct IndexRefreshes {
     /// The settled statics read again because their set changed: their tree is otherwise kept
     /// as it is, unread (see the [module](self)).
     pub still_reads: u64,
+    /// The sleeping bodies read again because their set changed (a body fell asleep or woke).
+    pub sleeping_reads: u64,
 }
 
 impl SpatialQueryIndex {
@@ -180,10 +185,12 @@ type QueryCollider = (
     Option<&'static CollisionLayers>,
 );
 
-/// The colliders read at every refresh: all but the settled statics.
-type Moving = (Without<Quarantined>, Without<Settled>);
+/// The colliders read at every refresh: all but the settled statics and the sleepers.
+type Moving = (Without<Quarantined>, Without<Settled>, Without<Sleeping>);
 /// The still ones: settled statics, read when their set changes.
 type Still = (Without<Quarantined>, With<Settled>);
+/// The sleeping bodies, read when their set changes (no static sleeps).
+type Asleep = (Without<Quarantined>, Without<Settled>, With<Sleeping>);
 
 /// Ray casts, sphere casts, overlap and point queries against the colliders (see the
 /// [module](self)).
@@ -193,27 +200,28 @@ pub struct SpatialQuery<'w, 's> {
     own: Local<'s, SpatialQueryIndex>,
     colliders: Query<'w, 's, QueryCollider, Moving>,
     still: Query<'w, 's, QueryCollider, Still>,
+    asleep: Query<'w, 's, QueryCollider, Asleep>,
     revision: Option<Res<'w, StillRevision>>,
     stats: Option<Res<'w, PhysicsStats>>,
 }
 
-/// The ECS colliders by index id: even ids are moving colliders' keys, odd ones still
-/// colliders' (see [`IndexState`]).
+/// The ECS colliders by index id: its two low bits name the group (see [`IndexState`]).
 struct Lookup<'a, 'w, 's> {
-    ids: &'a StableIds<Entity>,
-    still_ids: &'a StableIds<Entity>,
+    ids: &'a [StableIds<Entity>; 3],
     colliders: &'a Query<'w, 's, QueryCollider, Moving>,
     still: &'a Query<'w, 's, QueryCollider, Still>,
+    asleep: &'a Query<'w, 's, QueryCollider, Asleep>,
 }
+
+/// The groups' numbers in the index ids' two low bits.
+const MOVING: u32 = 0;
+const SETTLED: u32 = 1;
+const SLEEPING: u32 = 2;
 
 impl Lookup<'_, '_, '_> {
     /// The entity of `id`, if it has one.
     fn key(&self, id: u32) -> Option<Entity> {
-        if id & 1 == 0 {
-            self.ids.key(id >> 1)
-        } else {
-            self.still_ids.key(id >> 1)
-        }
+        self.ids.get((id & 3) as usize)?.key(id >> 2)
     }
 
     /// The entity of `id`. The index reports only ids its filter accepted and the look-up
@@ -222,13 +230,13 @@ impl Lookup<'_, '_, '_> {
         self.key(id).unwrap_or(Entity::PLACEHOLDER)
     }
 
-    /// The collider `id`'s row, if it is there.
+    /// The collider `id`'s row, if it is there (still in the group it was indexed in).
     fn row(&self, id: u32) -> Option<QueryItemOf<'_>> {
         let e = self.key(id)?;
-        if id & 1 == 0 {
-            self.colliders.get(e).ok()
-        } else {
-            self.still.get(e).ok()
+        match id & 3 {
+            MOVING => self.colliders.get(e).ok(),
+            SETTLED => self.still.get(e).ok(),
+            _ => self.asleep.get(e).ok(),
         }
     }
 
@@ -272,56 +280,46 @@ impl SpatialQuery<'_, '_> {
         self.shared.as_deref().unwrap_or(&self.own)
     }
 
-    /// The index, refreshed if a step ran since (or `force`): the moving colliders read
-    /// whole, the settled ones only if their set changed (or `force`).
+    /// The index, refreshed if a step ran since, if the settled or the sleeping set changed
+    /// (a body woken or despawned between steps moves to the moving group or out), or if
+    /// `force`d: the moving colliders read whole, the settled and the sleeping ones only if
+    /// their set changed (or `force`).
     fn fresh(&self, force: bool) -> MutexGuard<'_, IndexState> {
         let mut state = self.index().lock();
         let step = self.stats.as_ref().map(|s| s.step);
-        if force || step.is_none() || state.step != step {
-            let state = &mut *state;
-            let ids = &mut state.ids;
-            ids.begin();
-            let colliders = self
-                .colliders
-                .iter()
-                .map(|row| (ids.id(row.0) << 1, &row.1.shape, pose_of(&row)));
-            let update = state.index.update(colliders);
-            state.ids.finish();
-            let counts = &mut state.refreshes;
-            match update {
-                IndexUpdate::Refitted => counts.refits += 1,
-                IndexUpdate::Updated => counts.updates += 1,
-                IndexUpdate::Rebuilt => counts.rebuilds += 1,
-            }
-            let seen = self.still_set();
-            if force || seen.is_none() || state.still_seen != seen {
-                self.read_still(state);
-                state.still_seen = seen;
-            }
+        let new_step = step.is_none() || state.step != step;
+        // `None` without the revisions (removed by game code until the next step puts them
+        // back, or no core plugin): the kept groups are then read at each step.
+        let seen = self.revision.as_ref().map(|r| [r.settled, r.sleeping]);
+        let seen = seen.map_or([None; 2], |s| s.map(Some));
+        let stale =
+            [0, 1].map(|k| force || state.seen[k] != seen[k] || (seen[k].is_none() && new_step));
+        if force || new_step || stale.contains(&true) {
+            self.read_groups(&mut state, stale);
+            state.seen = seen;
             state.step = step;
         }
         state
     }
 
-    /// The settled bodies' revision: unchanged, no body settled or stopped being settled (or
-    /// was despawned) since the still group was read. `None` without it (removed by
-    /// game code until the next step puts it back, or no core plugin): the group is read each
-    /// time.
-    fn still_set(&self) -> Option<u64> {
-        self.revision.as_ref().map(|r| r.0)
-    }
-
-    /// Reads the settled colliders into the index's still group.
-    fn read_still(&self, state: &mut IndexState) {
-        let ids = &mut state.still_ids;
-        ids.begin();
-        let colliders = self
-            .still
-            .iter()
-            .map(|row| ((ids.id(row.0) << 1) | 1, &row.1.shape, pose_of(&row)));
-        state.index.update_still(colliders);
-        state.still_ids.finish();
-        state.refreshes.still_reads += 1;
+    /// Reads the moving colliders into the index, and the settled and sleeping ones where
+    /// `stale` says.
+    fn read_groups(&self, state: &mut IndexState, stale: [bool; 2]) {
+        let (index, ids) = (&mut state.index, &mut state.ids);
+        let counts = &mut state.refreshes;
+        match read_group(index, &mut ids[0], &self.colliders, MOVING) {
+            IndexUpdate::Refitted => counts.refits += 1,
+            IndexUpdate::Updated => counts.updates += 1,
+            IndexUpdate::Rebuilt => counts.rebuilds += 1,
+        }
+        if stale[0] {
+            read_group(index, &mut ids[1], &self.still, SETTLED);
+            counts.still_reads += 1;
+        }
+        if stale[1] {
+            read_group(index, &mut ids[2], &self.asleep, SLEEPING);
+            counts.sleeping_reads += 1;
+        }
     }
 
     /// Re-reads every collider's pose now (after a game moved or spawned bodies between steps).
@@ -336,17 +334,12 @@ impl SpatialQuery<'_, '_> {
         query: impl FnOnce(&mut SpatialIndex, &Lookup, &dyn Fn(u32) -> bool) -> R,
     ) -> R {
         let mut state = self.fresh(false);
-        let IndexState {
-            index,
-            ids,
-            still_ids,
-            ..
-        } = &mut *state;
+        let IndexState { index, ids, .. } = &mut *state;
         let lookup = Lookup {
             ids,
-            still_ids,
             colliders: &self.colliders,
             still: &self.still,
+            asleep: &self.asleep,
         };
         query(index, &lookup, &|id| lookup.accepts(id, filter))
     }
@@ -499,6 +492,27 @@ impl SpatialQuery<'_, '_> {
             filter,
         )
     }
+}
+
+/// Reads `query`'s colliders into the index's `group`, each keyed in `ids` (index id
+/// `4 key + group`).
+fn read_group<F: QueryFilter>(
+    index: &mut SpatialIndex,
+    ids: &mut StableIds<Entity>,
+    query: &Query<QueryCollider, F>,
+    group: u32,
+) -> IndexUpdate {
+    ids.begin();
+    let colliders = query
+        .iter()
+        .map(|row| ((ids.id(row.0) << 2) | group, &row.1.shape, pose_of(&row)));
+    let update = match group {
+        MOVING => index.update(colliders),
+        SETTLED => index.update_still(colliders),
+        _ => index.update_sleeping(colliders),
+    };
+    ids.finish();
+    update
 }
 
 fn to_ray_hit(lookup: &Lookup, h: crate::spatial::QueryHit) -> RayHit {

@@ -1,6 +1,7 @@
 //! The query index: every collider's box in a [`ColliderTree`] (half-spaces aside, tested
-//! directly), in two groups — the moving colliders, read at every update, and the still ones,
-//! read only when the caller says they changed (a level's static scenery) — and the queries a
+//! directly), in three groups — the moving colliders, read at every update, and two groups read
+//! only when the caller says they changed (a level's static scenery, sleeping bodies) — and
+//! the queries a
 //! game asks — first hit and all hits of a ray, a cast of any convex shape, the colliders
 //! overlapping a shape, the colliders containing a point, the nearest one — answered by
 //! visiting only the boxes the query meets and testing those shapes exactly (the shape tests
@@ -58,18 +59,21 @@ pub enum IndexUpdate {
     Rebuilt,
 }
 
-/// The colliders' boxes, in two groups, and the buffers of the queries.
+/// The colliders' boxes, in three groups, and the buffers of the queries.
 ///
 /// The *moving* group is read whole at every [`Self::update`]; the *still* group only when
-/// [`Self::update_still`] is called, which a caller does when it knows a still collider
-/// changed: the ECS puts the static bodies nobody wrote to since the last step there (its
-/// settled statics), so that a level's scenery costs nothing per step (Avian keeps static
-/// colliders in a tree of their own for the same reason). Queries search both groups, so ids
-/// must be unique across them.
+/// [`Self::update_still`] is called and the *sleeping* group only when [`Self::update_sleeping`]
+/// is, which a caller does when it knows a collider of the group changed: the ECS puts the
+/// static bodies nobody wrote to since the last step in the still group (its settled statics),
+/// so that a level's scenery costs nothing per step (Avian keeps static colliders in a tree of
+/// their own for the same reason), and sleeping bodies in the sleeping group, read when a body
+/// falls asleep or wakes. Two kept groups, not one: bodies fall asleep and wake far more often
+/// than a level's scenery changes, and each time only the sleepers are read again. Queries
+/// search every group, so ids must be unique across them.
 #[derive(Debug, Default)]
 pub struct SpatialIndex {
-    moving: Group,
-    still: Group,
+    /// The moving, still and sleeping groups, searched in that order.
+    groups: [Group; 3],
     items: Vec<(u32, Aabb)>,
     node_stack: Vec<u32>,
     ray_stack: Vec<(u32, f32)>,
@@ -77,6 +81,11 @@ pub struct SpatialIndex {
     mesh: QueryScratch,
     contact: ContactScratch,
 }
+
+/// The groups' places in [`SpatialIndex::groups`].
+const MOVING: usize = 0;
+const STILL: usize = 1;
+const SLEEPING: usize = 2;
 
 /// One group of colliders: a tree over the bounded ones and the list of the others.
 #[derive(Debug, Default)]
@@ -130,23 +139,32 @@ impl Group {
 }
 
 impl SpatialIndex {
-    /// Indexes the moving group's `colliders` (`id`, shape, world pose), keeping the still
-    /// group as it is. Ids that stay with their colliders (the ECS's stable ids) let a change
+    /// Indexes the moving group's `colliders` (`id`, shape, world pose), keeping the other
+    /// groups as they are. Ids that stay with their colliders (the ECS's stable ids) let a change
     /// of a few colliders keep the tree: see [`ColliderTree::update`].
     pub fn update<'a>(
         &mut self,
         colliders: impl IntoIterator<Item = (u32, &'a Shape, Isometry)>,
     ) -> IndexUpdate {
-        self.moving.update(colliders, &mut self.items)
+        self.groups[MOVING].update(colliders, &mut self.items)
     }
 
     /// Indexes the still group's `colliders` as [`Self::update`] does the moving group's;
-    /// their ids must differ from the moving group's.
+    /// their ids must differ from the other groups'.
     pub fn update_still<'a>(
         &mut self,
         colliders: impl IntoIterator<Item = (u32, &'a Shape, Isometry)>,
     ) -> IndexUpdate {
-        self.still.update(colliders, &mut self.items)
+        self.groups[STILL].update(colliders, &mut self.items)
+    }
+
+    /// Indexes the sleeping group's `colliders` as [`Self::update`] does the moving group's;
+    /// their ids must differ from the other groups'.
+    pub fn update_sleeping<'a>(
+        &mut self,
+        colliders: impl IntoIterator<Item = (u32, &'a Shape, Isometry)>,
+    ) -> IndexUpdate {
+        self.groups[SLEEPING].update(colliders, &mut self.items)
     }
 
     /// How much the boxes are grown for a cast: the exact tests accept hits within
@@ -154,7 +172,7 @@ impl SpatialIndex {
     /// the sweep's length, which is at most the distance across the tree's boxes; grown by it,
     /// no box culls a shape the exact test would hit.
     fn slack(&self, ray: &Ray, radius: f32, max: f32) -> f32 {
-        let bounds = self.moving.tree.bounds().union(&self.still.tree.bounds());
+        let bounds = (self.groups.iter()).fold(Aabb::EMPTY, |b, g| b.union(&g.tree.bounds()));
         let across = (ray.origin() - bounds.center()).length() + bounds.half_extents().length();
         let length = if across.is_finite() {
             across.min(max)
@@ -166,7 +184,7 @@ impl SpatialIndex {
 
     /// Colliders indexed (bounded and unbounded, both groups).
     pub fn len(&self) -> usize {
-        self.moving.len() + self.still.len()
+        self.groups.iter().map(Group::len).sum()
     }
 
     /// Whether nothing is indexed.
@@ -329,12 +347,12 @@ impl SpatialIndex {
             // Boxes entered beyond the nearest hit so far cannot hold a nearer one.
             best.map(|b| b.hit.distance)
         };
-        let (groups, mesh) = ([&self.moving, &self.still], &mut self.mesh);
+        let (groups, mesh) = (&self.groups, &mut self.mesh);
         for &id in groups.iter().flat_map(|g| &g.unbounded) {
             consider(id, mesh);
         }
         let segment = RaySegment::new(ray.origin(), ray.direction());
-        // The still tree's walk starts from the nearest hit the moving one found.
+        // Each tree's walk starts from the nearest hit the walks before it found.
         let mut limit = max;
         for group in groups {
             limit = group
@@ -366,7 +384,7 @@ impl SpatialIndex {
             }
         };
         let grow = self.slack(ray, 0.0, max);
-        let (groups, mesh) = ([&self.moving, &self.still], &mut self.mesh);
+        let (groups, mesh) = (&self.groups, &mut self.mesh);
         for &id in groups.iter().flat_map(|g| &g.unbounded) {
             consider(id, mesh);
         }
@@ -401,7 +419,7 @@ impl SpatialIndex {
         out.clear();
         self.candidates.clear();
         let query_box = shape.world_aabb(pose);
-        for group in [&self.moving, &self.still] {
+        for group in &self.groups {
             let candidates = &mut self.candidates;
             candidates.extend_from_slice(&group.unbounded);
             group
@@ -477,7 +495,7 @@ impl SpatialIndex {
             None
         };
         let mut max2 = max_distance * max_distance;
-        let groups = [&self.moving, &self.still];
+        let groups = &self.groups;
         for &id in groups.iter().flat_map(|g| &g.unbounded) {
             if let Some(d2) = consider(id) {
                 max2 = max2.min(d2);

@@ -136,6 +136,13 @@ fn still_reads(app: &App) -> u64 {
         .still_reads
 }
 
+fn sleeping_reads(app: &App) -> u64 {
+    app.world()
+        .resource::<SpatialQueryIndex>()
+        .refreshes()
+        .sleeping_reads
+}
+
 /// 300 statics, a wall and 60 balls flying in zero gravity; for 40 steps the game edits a few
 /// statics each step (moves, turns, reshapes, despawns, spawns, quarantines and releases,
 /// takes `Static` away or gives it), and the queries after each step (and after edits made
@@ -231,12 +238,13 @@ fn settled_statics_edited_for_40_steps_answer_as_a_fresh_index_and_30_quiet_step
     assert!(refreshes.refits >= 30, "{refreshes:?}");
 }
 
-/// 120 balls dropped on a ground fall asleep (they stay in the moving group): after every step —
-/// while they sleep, while a few the game kicks wake, fly and fall asleep again, and for one
-/// the game wakes between steps — the answers equal a fresh index's over the world, and
-/// neither sleeping nor waking reads the settled ground again.
+/// 120 balls dropped on a ground fall asleep (into the index's sleeping group): after every
+/// step — while they sleep, while a few the game kicks wake, fly and fall asleep again, and for
+/// one the game wakes between steps — the answers equal a fresh index's over the world; 30
+/// quiet steps read the sleepers 0 times, and neither sleeping nor waking reads the settled
+/// ground again.
 #[test]
-fn sleeping_balls_answer_as_a_fresh_index_through_waking_and_their_sleep_reads_no_static() {
+fn sleeping_balls_answer_as_a_fresh_index_through_waking_and_30_quiet_steps_read_them_0_times() {
     let mut app = common::app();
     app.insert_resource(Gravity::EARTH_Z_UP);
     let mut rng = Rng::new(48);
@@ -276,11 +284,14 @@ fn sleeping_balls_answer_as_a_fresh_index_through_waking_and_their_sleep_reads_n
             Ray::new(from, to - from).unwrap()
         })
         .collect();
+    ecs_answers(&mut app, &rays, &[], false);
+    let sleepers_read = sleeping_reads(&app);
     assert_eq!(
         quiet_steps(&mut app, &rays, 30),
         0,
         "quiet steps read no static"
     );
+    assert_eq!(sleeping_reads(&app), sleepers_read, "nor a sleeper");
     let reads = still_reads(&app);
     // Woken by game code between steps (the marker taken off): hit at once, where it sleeps.
     let woken = balls[5];
@@ -315,4 +326,7 @@ fn sleeping_balls_answer_as_a_fresh_index_through_waking_and_their_sleep_reads_n
     assert!(woke >= kicked.len(), "{woke} woke");
     assert_eq!(asleep(&app), balls.len(), "all asleep again");
     assert_eq!(still_reads(&app), reads, "sleep and wakes read no static");
+    // They read the sleepers again, at most once a step.
+    let sleepers_read = sleeping_reads(&app) - sleepers_read;
+    assert!((2..=601).contains(&sleepers_read), "{sleepers_read} reads");
 }

@@ -1,26 +1,27 @@
-//! The index's still group: colliders split between the group re-read at every update and the
-//! one re-read only when asked answer every query as one index over all of them, and a still
-//! group left alone keeps answering with the poses it was given.
+//! The index's kept groups: colliders split between the group re-read at every update and the
+//! two re-read only when asked (still and sleeping) answer every query as one index over all of
+//! them, and a still group left alone keeps answering with the poses it was given.
 
 use super::{indexed, random_ray, scene};
 use crate::common::rng::Rng;
 use urto::geometry::{Capsule, Isometry, Shape};
 use urto::spatial::{BoxCast, CapsuleCast, IndexUpdate, SpatialIndex};
 
-/// The index with the colliders `still` picks in the still group and the others moving; ids
-/// are the colliders' positions in the slice, as [`indexed`] gives them.
-fn split(colliders: &[(Shape, Isometry)], still: impl Fn(usize) -> bool) -> SpatialIndex {
+/// The index with each collider in the group `group_of` names (0 moving, 1 still, 2
+/// sleeping); ids are the colliders' positions in the slice, as [`indexed`] gives them.
+fn split(colliders: &[(Shape, Isometry)], group_of: impl Fn(usize) -> usize) -> SpatialIndex {
     let mut index = SpatialIndex::default();
-    let group = |keep: bool| {
-        let still = &still;
+    let group = |g: usize| {
+        let group_of = &group_of;
         colliders
             .iter()
             .enumerate()
-            .filter(move |(i, _)| still(*i) == keep)
+            .filter(move |(i, _)| group_of(*i) == g)
             .map(|(i, (s, p))| (i as u32, s, *p))
     };
-    index.update(group(false));
-    index.update_still(group(true));
+    index.update(group(0));
+    index.update_still(group(1));
+    index.update_sleeping(group(2));
     index
 }
 
@@ -92,20 +93,23 @@ fn a_split_index_answers_as_one_index_on_400_queries_of_each_kind_over_302_colli
     let mut rng = Rng::new(41);
     let colliders = scene(&mut rng, 300);
     let mut one = indexed(&colliders);
-    // Half-spaces in both groups, meshes too: every third collider and one wall still.
-    let mut split = split(&colliders, |i| i % 3 == 0 || i == 300);
-    assert_eq!(split.len(), one.len());
-    let found = same_answers(&mut rng, &colliders, (&mut split, &mut one), 400);
+    // Half-spaces in two groups, meshes too: a third of the colliders in each group, one wall
+    // still and the other sleeping.
+    let mut thirds = split(&colliders, |i| match i {
+        300 => 1,
+        301 => 2,
+        _ => i % 3,
+    });
+    assert_eq!(thirds.len(), one.len());
+    let found = same_answers(&mut rng, &colliders, (&mut thirds, &mut one), 400);
     assert!(found > 100, "{found} rays hit");
-    // All moving or all still: the same answers too.
-    let mut moving = split_all(&colliders, false);
-    let mut still = split_all(&colliders, true);
+    // All in one group, whichever: the same answers too.
+    let mut moving = split(&colliders, |_| 0);
+    let mut still = split(&colliders, |_| 1);
+    let mut sleeping = split(&colliders, |_| 2);
     same_answers(&mut rng, &colliders, (&mut moving, &mut still), 100);
     same_answers(&mut rng, &colliders, (&mut still, &mut one), 100);
-}
-
-fn split_all(colliders: &[(Shape, Isometry)], still: bool) -> SpatialIndex {
-    split(colliders, |_| still)
+    same_answers(&mut rng, &colliders, (&mut sleeping, &mut one), 100);
 }
 
 #[test]
@@ -113,7 +117,7 @@ fn a_still_group_keeps_its_poses_through_40_moving_updates_until_it_is_updated()
     let mut rng = Rng::new(42);
     let mut colliders = scene(&mut rng, 200);
     let is_still = |i: usize| i.is_multiple_of(2);
-    let mut index = split(&colliders, is_still);
+    let mut index = split(&colliders, |i| usize::from(is_still(i)));
     let first_poses = colliders.clone();
     for round in 0..40 {
         for (_, pose) in colliders.iter_mut() {
