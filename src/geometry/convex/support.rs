@@ -166,7 +166,13 @@ impl<'a> ConvexPart<'a> {
     }
 
     /// The core's point farthest along `dir` (in the query's frame).
-    #[inline]
+    ///
+    /// Always inlined into its one caller, GJK's support of the pair: called, `dir` went
+    /// through memory as a 12-byte `Vec3` and the first 8-byte load of it straddled the
+    /// caller's two stores (a failed store-to-load forwarding; `perf annotate` put the samples
+    /// there). Inlined, a capsule cast at a mesh (a GJK advancement per triangle) runs 12 %
+    /// faster for 1.7 % fewer instructions.
+    #[inline(always)]
     pub fn support(&self, dir: Vec3) -> Vec3 {
         if !dir.is_finite() {
             // Never walk a hull along a NaN direction; any point of the core answers.
