@@ -275,8 +275,13 @@ impl ContactConstraint {
                 anchor_b: rb,
                 base_separation: p.separation - (rb - ra).dot(n),
                 normal_row: RowPart::new(pa, pb, ra, rb, normal).into(),
+                // Written out, not `sides.map(..)`: the map's closure was not inlined and read
+                // its side back through memory, stalled on the stores that wrote it.
                 tangent_rows: if per_point {
-                    sides.map(|t| RowPart::new(pa, pb, ra, rb, t).into())
+                    [
+                        RowPart::new(pa, pb, ra, rb, sides[0]).into(),
+                        RowPart::new(pa, pb, ra, rb, sides[1]).into(),
+                    ]
                 } else {
                     [PointRow::default(); 2]
                 },
