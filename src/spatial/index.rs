@@ -1,9 +1,8 @@
 //! The query index: every collider's box in a [`ColliderTree`] (half-spaces aside, tested
 //! directly), in three groups — the moving colliders, read at every update, and two groups read
-//! only when the caller says they changed (a level's static scenery, sleeping bodies) — and
-//! the queries a
-//! game asks — first hit and all hits of a ray, a cast of any convex shape, the colliders
-//! overlapping a shape, the colliders containing a point, the nearest one — answered by
+//! only when the caller says they changed (a level's static scenery, sleeping bodies) — and the
+//! queries a game asks — first hit and all hits of a ray, a cast of any convex shape, the
+//! colliders overlapping a shape, the colliders containing a point, the nearest one — answered by
 //! visiting only the boxes the query meets and testing those shapes exactly (the shape tests
 //! of [`crate::ccd`] and [`crate::geometry::contacts`], meshes through their own hierarchies).
 //!
@@ -185,7 +184,7 @@ impl SpatialIndex {
         2.0 * CONTACT_TOLERANCE_RELATIVE * (radius + length + 1.0)
     }
 
-    /// Colliders indexed (bounded and unbounded, both groups).
+    /// Colliders indexed (bounded and unbounded, every group).
     pub fn len(&self) -> usize {
         self.groups.iter().map(Group::len).sum()
     }
