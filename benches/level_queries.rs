@@ -14,6 +14,7 @@
 //! Quick run: `URTO_BENCH_STATICS=10000 cargo bench --bench level_queries -- --quick`.
 
 use bevy_app::App;
+use bevy_ecs::bundle::Bundle;
 use bevy_ecs::system::SystemId;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use glam::Vec3;
@@ -25,41 +26,33 @@ const BALLS: usize = 1_000;
 
 /// A lattice of `statics` unit boxes 3 m apart on a ground, and the drifting balls.
 fn level(statics: usize) -> App {
-    let mut app = App::new();
-    app.add_plugins(UrtoPlugins::default());
-    let world = app.world_mut();
-    world.spawn((Collider::half_space(Vec3::Z), Static));
-    let side = (statics as f64).sqrt().ceil() as usize;
-    for i in 0..statics {
-        let at = Vec3::new((i % side) as f32 * 3.0, (i / side) as f32 * 3.0, 0.5);
-        world.spawn((Collider::cuboid(0.5, 0.5, 0.5), Position(at), Static));
-    }
-    spawn_balls(world, side as f32 * 3.0);
-    urto::step(app.world_mut(), 5).expect("the level steps");
-    app
+    lattice(statics, |at| (Position(at), Static), 5)
 }
 
 /// `sleepers` unit boxes at rest 3 m apart on a ground, asleep, and the drifting balls.
 fn sleeping_debris(sleepers: usize) -> App {
-    let mut app = App::new();
-    app.add_plugins(UrtoPlugins::default());
-    let world = app.world_mut();
-    world.spawn((Collider::half_space(Vec3::Z), Static));
-    let side = (sleepers as f64).sqrt().ceil() as usize;
-    for i in 0..sleepers {
-        let at = Vec3::new((i % side) as f32 * 3.0, (i / side) as f32 * 3.0, 0.5);
-        world.spawn((
-            Collider::cuboid(0.5, 0.5, 0.5),
-            Position(at),
-            Velocity::default(),
-        ));
-    }
-    spawn_balls(world, side as f32 * 3.0);
-    urto::step(app.world_mut(), 60).expect("the debris steps");
+    let mut app = lattice(sleepers, |at| (Position(at), Velocity::default()), 60);
     let world = app.world_mut();
     let asleep = world.query::<&Sleeping>().iter(world).count();
     // The debris, and the few balls drifting slower than the sleep speed.
     assert!(asleep >= sleepers, "the debris sleeps: {asleep} asleep");
+    app
+}
+
+/// A ground, `boxes` unit boxes 3 m apart on it (each a collider and `body(centre)`) and the
+/// drifting balls, stepped `steps` times.
+fn lattice<B: Bundle>(boxes: usize, body: impl Fn(Vec3) -> B, steps: u32) -> App {
+    let mut app = App::new();
+    app.add_plugins(UrtoPlugins::default());
+    let world = app.world_mut();
+    world.spawn((Collider::half_space(Vec3::Z), Static));
+    let side = (boxes as f64).sqrt().ceil() as usize;
+    for i in 0..boxes {
+        let at = Vec3::new((i % side) as f32 * 3.0, (i / side) as f32 * 3.0, 0.5);
+        world.spawn((Collider::cuboid(0.5, 0.5, 0.5), body(at)));
+    }
+    spawn_balls(world, side as f32 * 3.0);
+    urto::step(app.world_mut(), steps).expect("the scene steps");
     app
 }
 
