@@ -12,22 +12,18 @@ use glam::Vec3;
 
 /// A bounding volume that can be culled against a swept sphere.
 pub trait SweepCull {
-    /// False only if the sphere of `radius` whose centre moves along `origin + t·displacement`,
-    /// `t ∈ [0, t_max]`, cannot touch anything inside the BV (all in the BV's frame).
-    fn may_touch_sweep(&self, origin: Vec3, displacement: Vec3, radius: f32, t_max: f32) -> bool;
+    /// Where along `[0, t_max]` the sphere of `radius` whose centre moves along
+    /// `origin + t·displacement` may first touch anything inside the BV (a lower bound; all in
+    /// the BV's frame), or `None` only if it cannot touch it at all: what a walk that visits the
+    /// nearest nodes first orders them by. Boxes give their slab entry; other kinds say 0.
+    fn sweep_entry(&self, origin: Vec3, displacement: Vec3, radius: f32, t_max: f32)
+    -> Option<f32>;
 
-    /// Where along `[0, t_max]` that sphere may first touch what the BV holds (a lower bound), or
-    /// `None` where [`Self::may_touch_sweep`] is false: what a walk that visits the nearest
-    /// nodes first orders them by. Boxes give their slab entry; other kinds say 0.
-    fn sweep_entry(
-        &self,
-        origin: Vec3,
-        displacement: Vec3,
-        radius: f32,
-        t_max: f32,
-    ) -> Option<f32> {
-        self.may_touch_sweep(origin, displacement, radius, t_max)
-            .then_some(0.0)
+    /// False only if that sphere, over `t ∈ [0, t_max]`, cannot touch anything inside the BV.
+    #[inline]
+    fn may_touch_sweep(&self, origin: Vec3, displacement: Vec3, radius: f32, t_max: f32) -> bool {
+        self.sweep_entry(origin, displacement, radius, t_max)
+            .is_some()
     }
 }
 
@@ -70,12 +66,6 @@ fn segment_box_entry(
 
 impl SweepCull for Aabb {
     #[inline]
-    fn may_touch_sweep(&self, origin: Vec3, displacement: Vec3, radius: f32, t_max: f32) -> bool {
-        self.sweep_entry(origin, displacement, radius, t_max)
-            .is_some()
-    }
-
-    #[inline]
     fn sweep_entry(
         &self,
         origin: Vec3,
@@ -96,12 +86,6 @@ impl SweepCull for Aabb {
 
 impl SweepCull for Obb {
     #[inline]
-    fn may_touch_sweep(&self, origin: Vec3, displacement: Vec3, radius: f32, t_max: f32) -> bool {
-        self.sweep_entry(origin, displacement, radius, t_max)
-            .is_some()
-    }
-
-    #[inline]
     fn sweep_entry(
         &self,
         origin: Vec3,
@@ -119,7 +103,13 @@ impl SweepCull for Obb {
 
 impl SweepCull for BoundingSphere {
     #[inline]
-    fn may_touch_sweep(&self, origin: Vec3, displacement: Vec3, radius: f32, t_max: f32) -> bool {
+    fn sweep_entry(
+        &self,
+        origin: Vec3,
+        displacement: Vec3,
+        radius: f32,
+        t_max: f32,
+    ) -> Option<f32> {
         // Closest point of the segment to the centre, then one distance comparison.
         let m = origin - self.center;
         let along = displacement.length_squared();
@@ -129,17 +119,23 @@ impl SweepCull for BoundingSphere {
             0.0
         };
         let reach = self.radius + radius;
-        (m + displacement * t).length_squared() <= reach * reach
+        ((m + displacement * t).length_squared() <= reach * reach).then_some(0.0)
     }
 }
 
 impl<const AXES: usize> SweepCull for Kdop<AXES> {
     #[inline]
-    fn may_touch_sweep(&self, origin: Vec3, displacement: Vec3, radius: f32, t_max: f32) -> bool {
+    fn sweep_entry(
+        &self,
+        origin: Vec3,
+        displacement: Vec3,
+        radius: f32,
+        t_max: f32,
+    ) -> Option<f32> {
         // Slab i holds `min ≤ dir·x ≤ max` with an unnormalised `dir`: a ball of radius r
         // widens it by r·|dir| on each side.
         let (mut t0, mut t1) = (0.0f32, t_max);
-        Self::DIRECTIONS.iter().enumerate().all(|(i, dir)| {
+        let meets = Self::DIRECTIONS.iter().enumerate().all(|(i, dir)| {
             let grow = radius * dir.length();
             clip_slab(
                 dir.dot(origin),
@@ -149,7 +145,9 @@ impl<const AXES: usize> SweepCull for Kdop<AXES> {
                 &mut t0,
                 &mut t1,
             )
-        })
+        });
+        // Entry 0, as the trait says of kinds other than boxes.
+        meets.then_some(0.0)
     }
 }
 
