@@ -19,7 +19,9 @@ use urto::bvh::QueryScratch;
 use urto::geometry::contacts::contact;
 use urto::geometry::{Isometry, MeshCollider, Shape, TriMesh};
 use urto::prelude::*;
-use urto::spatial::{IndexUpdate, QueryError, QueryHit, Ray, SpatialIndex, StableIds, cast_sphere};
+use urto::spatial::{
+    CastHit, IndexUpdate, QueryError, QueryHit, Ray, SpatialIndex, StableIds, cast_sphere,
+};
 
 /// `n` colliders in a 40 m cube — balls, turned boxes, two meshes (a ball and a torus) — and
 /// two half-spaces: a ground below everything and a tilted wall.
@@ -100,6 +102,31 @@ fn brute_force_casts(
     hits
 }
 
+/// A target pose within 2 m of the origin, and a cast at it: a start within 6 m of it and the
+/// unit direction from there to a point within 1.5 m of it (`None` where the two coincide).
+fn random_target_and_cast(rng: &mut Rng) -> (Isometry, Option<(Vec3, Vec3)>) {
+    let target = Isometry::new(rng.in_ball(2.0), rng.rotation());
+    let start = target.translation + rng.in_ball(6.0);
+    let aim = target.translation + rng.in_ball(1.5) - start;
+    (
+        target,
+        aim.try_normalize().map(|direction| (start, direction)),
+    )
+}
+
+/// The first hit of a cast over every collider by brute force (`cast` on each), ties to the
+/// lower id: what the index's first-hit casts must answer.
+fn brute_force_first(
+    colliders: &[(Shape, Isometry)],
+    mut cast: impl FnMut(&Shape, &Isometry) -> Option<CastHit>,
+) -> Option<(u32, CastHit)> {
+    colliders
+        .iter()
+        .enumerate()
+        .filter_map(|(i, (s, p))| cast(s, p).map(|h| (i as u32, h)))
+        .min_by(|a, b| a.1.distance.total_cmp(&b.1.distance).then(a.0.cmp(&b.0)))
+}
+
 #[test]
 fn first_and_all_ray_hits_equal_brute_force_on_1000_rays_over_402_colliders() {
     let mut rng = Rng::new(11);
@@ -164,11 +191,7 @@ fn box_and_capsule_casts_equal_brute_force_on_300_casts_over_302_colliders() {
             direction: ray.direction(),
             max_distance: 40.0,
         };
-        let expected = colliders
-            .iter()
-            .enumerate()
-            .filter_map(|(i, (s, p))| cast_box(&cast, s, p, &mut scratch).map(|h| (i as u32, h)))
-            .min_by(|a, b| a.1.distance.total_cmp(&b.1.distance).then(a.0.cmp(&b.0)));
+        let expected = brute_force_first(&colliders, |s, p| cast_box(&cast, s, p, &mut scratch));
         let first = index.cast_box(&*colliders, &cast, |_| true).unwrap();
         assert_eq!(first.map(|h| (h.id, h.hit)), expected, "cast {k}");
         found += usize::from(first.is_some());
@@ -181,13 +204,9 @@ fn box_and_capsule_casts_equal_brute_force_on_300_casts_over_302_colliders() {
             direction: cast.direction,
             max_distance: 40.0,
         };
-        let expected = colliders
-            .iter()
-            .enumerate()
-            .filter_map(|(i, (s, p))| {
-                cast_capsule(&capsule, s, p, &mut scratch).map(|h| (i as u32, h))
-            })
-            .min_by(|a, b| a.1.distance.total_cmp(&b.1.distance).then(a.0.cmp(&b.0)));
+        let expected = brute_force_first(&colliders, |s, p| {
+            cast_capsule(&capsule, s, p, &mut scratch)
+        });
         let first = index.cast_capsule(&*colliders, &capsule, |_| true).unwrap();
         assert_eq!(first.map(|h| (h.id, h.hit)), expected, "capsule cast {k}");
         if k == 0 {

@@ -114,10 +114,8 @@ fn box_casts_touch_within_1e_4_and_agree_with_parry3d_within_1e_3_of_gap_on_2500
     for (shape, parry_shape, _) in &shapes {
         let (mut hits, mut misses, mut worst) = (0, 0, 0.0f32);
         for _ in 0..500 {
-            let target = Isometry::new(rng.in_ball(2.0), rng.rotation());
-            let start = target.translation + rng.in_ball(6.0);
-            let aim = target.translation + rng.in_ball(1.5) - start;
-            let Some(direction) = aim.try_normalize() else {
+            let (target, aimed) = random_target_and_cast(&mut rng);
+            let Some((start, direction)) = aimed else {
                 continue;
             };
             let cast = BoxCast {
@@ -196,10 +194,8 @@ fn capsule_casts_touch_within_1e_4_and_agree_with_parry3d_within_1e_2_of_gap_on_
     for (shape, parry_shape, _) in &shapes_with_parry_twins() {
         let (mut hits, mut misses, mut worst) = (0, 0, 0.0f32);
         for _ in 0..500 {
-            let target = Isometry::new(rng.in_ball(2.0), rng.rotation());
-            let start = target.translation + rng.in_ball(6.0);
-            let aim = target.translation + rng.in_ball(1.5) - start;
-            let Some(direction) = aim.try_normalize() else {
+            let (target, aimed) = random_target_and_cast(&mut rng);
+            let Some((start, direction)) = aimed else {
                 continue;
             };
             let capsule = Capsule {

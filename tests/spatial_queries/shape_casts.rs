@@ -87,10 +87,8 @@ fn convex_casts_touch_within_2e_4_and_agree_with_parry3d_within_2e_3_of_gap_on_8
             let (mut hits, mut misses) = (0, 0);
             for _ in 0..400 {
                 let caster = random_caster(&mut rng, kind);
-                let at = Isometry::new(rng.in_ball(2.0), rng.rotation());
-                let start = at.translation + rng.in_ball(6.0);
-                let aim = at.translation + rng.in_ball(1.5) - start;
-                let Some(direction) = aim.try_normalize() else {
+                let (at, aimed) = random_target_and_cast(&mut rng);
+                let Some((start, direction)) = aimed else {
                     continue;
                 };
                 let cast = ShapeCast {
@@ -220,11 +218,7 @@ fn index_shape_casts_equal_brute_force_on_400_casts_over_302_colliders_and_refus
             direction: ray.direction(),
             max_distance: 40.0,
         };
-        let expected = colliders
-            .iter()
-            .enumerate()
-            .filter_map(|(i, (s, p))| cast_shape(&cast, s, p, &mut scratch).map(|h| (i as u32, h)))
-            .min_by(|a, b| a.1.distance.total_cmp(&b.1.distance).then(a.0.cmp(&b.0)));
+        let expected = brute_force_first(&colliders, |s, p| cast_shape(&cast, s, p, &mut scratch));
         let first = index.cast_shape(&*colliders, &cast, |_| true).unwrap();
         assert_eq!(first.map(|h| (h.id, h.hit)), expected, "cast {k}");
         found += usize::from(first.is_some());
