@@ -65,28 +65,32 @@ impl JointBatch {
         self.writes =
             [0, 1].map(|k| std::array::from_fn(|l| lanes[l].is_some_and(|j| j.masses.dynamic[k])));
         // Gathers through `fn` items the compiler inlines, not `&dyn Fn` readers per field and
-        // lane: they cut the packing of a joint step by two thirds.
-        let vectors =
-            |f: fn(&JointConstraint) -> Vec3| gather(&lanes, Vec3::ZERO, f, Vec3x4::gather);
-        let matrices =
-            |f: fn(&JointConstraint) -> Mat3| gather(&lanes, Mat3::ZERO, f, Mat3x4::gather);
+        // lane: they cut the packing of a joint step by two thirds. They pass references, read
+        // in place: copies of a `Mat3` through `Option`s and closures went through the stack
+        // and stalled on their own stores.
+        let vectors = |f: fn(&JointConstraint) -> &Vec3| {
+            Vec3x4::gather_refs(in_lanes(&lanes, &Vec3::ZERO, f))
+        };
+        let matrices = |f: fn(&JointConstraint) -> &Mat3| {
+            Mat3x4::gather_refs(in_lanes(&lanes, &Mat3::ZERO, f))
+        };
         self.inverse_mass = [
-            vectors(|j| j.masses.inverse_mass[0]),
-            vectors(|j| j.masses.inverse_mass[1]),
+            vectors(|j| &j.masses.inverse_mass[0]),
+            vectors(|j| &j.masses.inverse_mass[1]),
         ];
         self.inverse_inertia = [
-            matrices(|j| j.masses.inverse_inertia[0]),
-            matrices(|j| j.masses.inverse_inertia[1]),
+            matrices(|j| &j.masses.inverse_inertia[0]),
+            matrices(|j| &j.masses.inverse_inertia[1]),
         ];
-        self.anchors = [vectors(|j| j.anchors[0]), vectors(|j| j.anchors[1])];
-        self.delta_center = vectors(|j| j.delta_center);
+        self.anchors = [vectors(|j| &j.anchors[0]), vectors(|j| &j.anchors[1])];
+        self.delta_center = vectors(|j| &j.delta_center);
         self.arms = [
-            vectors(|j| j.point.anchors.0),
-            vectors(|j| j.point.anchors.1),
+            vectors(|j| &j.point.anchors.0),
+            vectors(|j| &j.point.anchors.1),
         ];
-        self.separation = vectors(|j| j.point.separation);
+        self.separation = vectors(|j| &j.point.separation);
         self.take_point_mass();
-        self.impulse = vectors(|j| j.impulses.point);
+        self.impulse = vectors(|j| &j.impulses.point);
         true
     }
 
@@ -174,16 +178,14 @@ fn per_axis(p: Vec3x4, w: Vec3x4) -> Vec3x4 {
     }
 }
 
-/// A value `f` reads from each lane's joint (`zero` in padding lanes), laid out in lanes by
-/// `wide`.
+/// Where `f` finds a value in each lane's joint (`zero` in padding lanes).
 #[inline(always)]
-fn gather<T: Copy, W>(
-    lanes: &[Option<&JointConstraint>; LANES],
-    zero: T,
-    f: impl Fn(&JointConstraint) -> T,
-    wide: impl Fn([T; LANES]) -> W,
-) -> W {
-    wide(lanes.map(|j| j.map_or(zero, &f)))
+fn in_lanes<'a, T>(
+    lanes: &[Option<&'a JointConstraint>; LANES],
+    zero: &'a T,
+    f: impl Fn(&'a JointConstraint) -> &'a T,
+) -> [&'a T; LANES] {
+    lanes.map(|j| j.map_or(zero, &f))
 }
 
 #[cfg(test)]
