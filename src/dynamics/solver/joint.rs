@@ -170,6 +170,22 @@ impl Default for PointRows {
     }
 }
 
+/// The arms `r_a`, `r_b` and the separation of a joint whose step-start anchors (from the
+/// centres of mass, world) are `anchors` and centres `delta_center` apart, where bodies `sa`,
+/// `sb` are now.
+#[inline]
+fn placed(
+    anchors: [Vec3; 2],
+    delta_center: Vec3,
+    sa: &BodyState,
+    sb: &BodyState,
+) -> ((Vec3, Vec3), Vec3) {
+    let r_a = sa.delta_rotation * anchors[0];
+    let r_b = sb.delta_rotation * anchors[1];
+    let separation = delta_center + sb.delta_position - sa.delta_position + r_b - r_a;
+    ((r_a, r_b), separation)
+}
+
 impl JointConstraint {
     /// The part of `joint` every pass reads, over `bodies` at the step's start (the caller
     /// checked its slots; its extra rows are the list's).
@@ -181,7 +197,7 @@ impl JointConstraint {
             extra: None,
             holds_point: false,
             turns: false,
-            masses: PairMasses::of(&bodies.params, joint.a as usize, joint.b as usize),
+            masses: PairMasses::default(),
             anchors: [Vec3::ZERO; 2],
             delta_center: Vec3::ZERO,
             point: PointRows::default(),
@@ -205,14 +221,19 @@ impl JointConstraint {
             joint.kind,
             JointKind::Revolute { .. } | JointKind::Spherical { .. }
         );
-        self.masses = PairMasses::of(&bodies.params, a, b);
-        self.anchors = [qa * joint.frame_a.anchor, qb * joint.frame_b.anchor];
-        self.delta_center = bodies.centers[b] - bodies.centers[a];
-        self.point = PointRows::default();
+        self.masses.fill(&bodies.params, a, b);
+        let anchors = [qa * joint.frame_a.anchor, qb * joint.frame_b.anchor];
+        let delta_center = bodies.centers[b] - bodies.centers[a];
+        self.anchors = anchors;
+        self.delta_center = delta_center;
         // The bodies have not moved yet. The point rows' `K⁻¹` waits for the packing: a
         // joint in lanes takes it there, four at a time (`take_point_mass` for the others).
+        // The rows are placed from the values just computed, not read back from `self`: a
+        // 16-byte load of a `Vec3` just stored in two pieces waits for both stores to land,
+        // and did, a sixth of a joint net's refills.
         let start = BodyState::default();
-        self.move_rows(&start, &start);
+        self.point = PointRows::default();
+        (self.point.anchors, self.point.separation) = placed(anchors, delta_center, &start, &start);
     }
 
     /// Whether the joint is nothing but its point rows (a ball joint without limits): the
@@ -235,11 +256,8 @@ impl JointConstraint {
 
     /// The anchors and the separation where bodies `sa`, `sb` are now.
     fn move_rows(&mut self, sa: &BodyState, sb: &BodyState) {
-        let r_a = sa.delta_rotation * self.anchors[0];
-        let r_b = sb.delta_rotation * self.anchors[1];
-        self.point.anchors = (r_a, r_b);
-        self.point.separation =
-            self.delta_center + sb.delta_position - sa.delta_position + r_b - r_a;
+        (self.point.anchors, self.point.separation) =
+            placed(self.anchors, self.delta_center, sa, sb);
     }
 
     /// The point rows' `K⁻¹` at the anchors as they are.
