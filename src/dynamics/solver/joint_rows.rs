@@ -54,8 +54,9 @@ impl PairMasses {
 
     /// Applies the impulse `λ` of a row, linear part `l λ`, angular parts `u_a λ`, `u_b λ`:
     /// `v_a −= W_a l λ` (`W` the per-axis `1/m`), `ω_a −= I_a⁻¹ u_a λ`, and the opposite
-    /// signs for B.
-    #[inline]
+    /// signs for B. Always inlined, for the reason [`inverse_mass`] is: its `Vec3`
+    /// arguments went through memory, and their loads waited on the caller's stores.
+    #[inline(always)]
     pub fn apply(
         &self,
         states: &mut [BodyState],
@@ -342,7 +343,10 @@ pub fn solve_point(
 
 /// `K⁻¹` for a symmetric positive semi-definite `K`: the inverse when it is well
 /// conditioned, else row by row (a body turning about some axes only, or two immovable
-/// bodies: those rows take no impulse).
+/// bodies: those rows take no impulse). Always inlined: a `K` handed over through memory
+/// to a call was read back in wider loads than it was stored in, and the reads waited for the
+/// stores (no store-to-load forwarding; a tenth of a ragdoll pile's point-mass work).
+#[inline(always)]
 pub fn inverse_mass(k: Mat3) -> Mat3 {
     let det = k.determinant();
     let scale = k.x_axis.x * k.y_axis.y * k.z_axis.z;
