@@ -6,9 +6,13 @@
 //! never paired it with (two 10 cm balls closing at 20 m/s, a bullet and a plank). Rapier's CCD
 //! finds those pairs in its broad phase by growing a CCD body's box by its predicted motion;
 //! here the fast bodies are few and change every substep, so they get a sweep of their own:
-//! the fast bodies' swept boxes against every moving body's box, by sort and sweep along x (the
+//! the fast bodies' swept boxes against every moving body's box, by sort and sweep (the
 //! slides' algorithm, from scratch: the set is rebuilt each substep), after dropping the boxes
 //! that miss the union of the swept ones (in a game, most bodies are far from every bullet).
+//! The sweep runs along the axis on which the swept boxes are shortest against the union's
+//! extent ([`sweep_axis`]): bullets fired side by side along x are all open together along x,
+//! and every box they pass was tested against each of them; across the volley each bullet
+//! keeps to its own lane.
 //! Only pairs with at least one fast body are reported: two slow bodies are the speculative
 //! contacts' business.
 
@@ -41,15 +45,16 @@ pub fn pairs_with_a_fast_body(
     let reach = boxes[..fast]
         .iter()
         .fold(Aabb::EMPTY, |union, b| union.union(b));
-    // Sorted by the start along x (as integer keys, the box's index below), boxes that can
-    // meet no swept one and boxes with a NaN left out. Box indices fit in u32: callers index
-    // bodies by u32 (the broad phase's proxy ids).
+    let axis = sweep_axis(&boxes[..fast], &reach);
+    // Sorted by the start along the axis (as integer keys, the box's index below), boxes that
+    // can meet no swept one and boxes with a NaN left out. Box indices fit in u32: callers
+    // index bodies by u32 (the broad phase's proxy ids).
     let order = &mut scratch.order;
     order.clear();
     order.extend((0..boxes.len() as u32).filter_map(|i| {
         let b = &boxes[i as usize];
         let kept = b.is_valid() && ((i as usize) < fast || b.intersects(&reach));
-        kept.then(|| u64::from(float_order_key(b.min.x)) << 32 | u64::from(i))
+        kept.then(|| u64::from(float_order_key(b.min[axis])) << 32 | u64::from(i))
     }));
     order.sort_unstable();
     // The boxes whose x interval is still open, fast and slow apart: a slow box is tested
@@ -66,8 +71,8 @@ pub fn pairs_with_a_fast_body(
                 out.push([i.min(j), i.max(j)]);
             }
         };
-        // Boxes whose x interval ended before this one starts can meet nothing later.
-        let open = |j: &u32| boxes[*j as usize].max.x >= b.min.x;
+        // Boxes whose interval ended before this one starts can meet nothing later.
+        let open = |j: &u32| boxes[*j as usize].max[axis] >= b.min[axis];
         fast_open.retain(open);
         fast_open.iter().for_each(|&j| meet(j));
         if (i as usize) < fast {
@@ -79,6 +84,25 @@ pub fn pairs_with_a_fast_body(
         }
     }
     out.sort_unstable();
+}
+
+/// The axis along which the `swept` boxes (whose union is `reach`) are open over the least of
+/// the union: per axis, the sum of their extents over the union's, the number of swept boxes
+/// a box inside the union finds open on average. Ties (one swept box, a cube of them) keep the
+/// lowest axis; an axis on which the union is flat counts every swept box as open.
+fn sweep_axis(swept: &[Aabb], reach: &Aabb) -> usize {
+    let spread = reach.max - reach.min;
+    let open = |axis: usize| -> f32 {
+        let total: f32 = swept.iter().map(|b| b.max[axis] - b.min[axis]).sum();
+        if spread[axis] > 0.0 {
+            total / spread[axis]
+        } else {
+            swept.len() as f32
+        }
+    };
+    let costs = [open(0), open(1), open(2)];
+    // `<` keeps the lower axis on a tie and never picks a NaN cost.
+    (1..3).fold(0, |best, a| if costs[a] < costs[best] { a } else { best })
 }
 
 #[cfg(test)]
@@ -130,6 +154,43 @@ mod tests {
             }
             pairs_with_a_fast_body(&boxes, fast, &mut scratch, &mut out);
             assert_eq!(out, brute_force(&boxes, fast.min(n)), "round {round}");
+        }
+    }
+
+    /// A volley of 25 bullets fired along x side by side, each swept 5 m through a lane of
+    /// boxes, sweeps across the volley (not along x, where all 25 are open together), and
+    /// finds exactly brute force's pairs; fired along z, it sweeps across too.
+    #[test]
+    fn a_volley_sweeps_across_its_lanes_and_finds_exactly_brute_forces_pairs() {
+        let (mut scratch, mut out) = (MoverPairScratch::default(), Vec::new());
+        for along in [0usize, 2] {
+            let lane = |k: usize, t: f32| {
+                let mut v = Vec3::ZERO;
+                v[along] = t;
+                v[(along + 1) % 3] = (k % 5) as f32;
+                v[(along + 2) % 3] = (k / 5) as f32;
+                v
+            };
+            let (mut boxes, half) = (Vec::new(), Vec3::splat(0.2));
+            for k in 0..25 {
+                let (start, end) = (lane(k, 0.0), lane(k, 5.0));
+                boxes.push(Aabb::new(start.min(end) - 0.01, start.max(end) + 0.01));
+            }
+            for k in 0..25 {
+                for t in 0..8 {
+                    let c = lane(k, 1.0 + t as f32);
+                    boxes.push(Aabb::new(c - half, c + half));
+                }
+            }
+            let axis = sweep_axis(
+                &boxes[..25],
+                &boxes[..25].iter().fold(Aabb::EMPTY, |u, b| u.union(b)),
+            );
+            assert_ne!(axis, along);
+            pairs_with_a_fast_body(&boxes, 25, &mut scratch, &mut out);
+            let expected = brute_force(&boxes, 25);
+            assert_eq!(out, expected);
+            assert!(expected.len() >= 25 * 5, "{} pairs", expected.len());
         }
     }
 
