@@ -183,6 +183,13 @@ impl SolverBodies {
 
     /// Adds a body; returns its slot.
     pub fn push(&mut self, b: BodyInput) -> u32 {
+        self.push_input(&b)
+    }
+
+    /// [`Self::push`] reading the input where it lies: a `BodyInput` (about 170 bytes) handed
+    /// over by value is copied first, and the copy's wide loads wait on the narrower stores
+    /// that just wrote it (the ECS gather's inputs were copied twice a body, a step).
+    pub fn push_input(&mut self, b: &BodyInput) -> u32 {
         let slot = self.states.len() as u32;
         let dynamic = b.inverse_mass > 0.0;
         let inverse_inertia = if dynamic {

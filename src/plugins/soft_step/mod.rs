@@ -230,14 +230,21 @@ fn solve_soft_step(
     s.local_centers.clear();
     let lone = movers.p0();
     for (&e, found) in s.slots.entities().iter().zip(&s.inputs) {
-        let (input, local_center) = match found {
-            Some(found) => *found,
-            None => match lone.get(e) {
-                Ok(m) if !held(m.10, e, &s.waking) => body_input(m, &gathered, gyroscopic),
-                _ => (immovable_input(poses.get(e).ok().map(|p| p.0)), Vec3::ZERO),
-            },
+        // An awake mover's input is read where the pass above left it, not copied out.
+        let local_center = match found {
+            Some((input, local_center)) => {
+                s.bodies.push_input(input);
+                *local_center
+            }
+            None => {
+                let (input, local_center) = match lone.get(e) {
+                    Ok(m) if !held(m.10, e, &s.waking) => body_input(m, &gathered, gyroscopic),
+                    _ => (immovable_input(poses.get(e).ok().map(|p| p.0)), Vec3::ZERO),
+                };
+                s.bodies.push_input(&input);
+                local_center
+            }
         };
-        s.bodies.push(input);
         s.local_centers.push(local_center);
     }
     s.joints.clear();
