@@ -287,20 +287,25 @@ fn compute_contacts(
     let jointed = jointed.as_deref().filter(|j| !j.is_empty());
     let mut bodies = std::mem::take(&mut scratch.bodies);
     bodies.clear();
+    // A body's facts are returned as computed, not read back from the map: a copy loaded
+    // from an entry just written in pieces waited for those stores to land.
     let mut facts = |e: Entity| {
-        *bodies.entry(e).or_insert_with(|| {
-            let (margin, dormant) = motion_of(e);
-            BodyFacts {
-                margin,
-                dormant: sleeping && dormant,
-                compound: matches!(nodes.get(e), Ok((.., Some(_)))),
-                layers: if any_layers {
-                    layers_of_entity(e)
-                } else {
-                    CollisionLayers::default()
-                },
-            }
-        })
+        if let Some(known) = bodies.get(&e) {
+            return *known;
+        }
+        let (margin, dormant) = motion_of(e);
+        let facts = BodyFacts {
+            margin,
+            dormant: sleeping && dormant,
+            compound: matches!(nodes.get(e), Ok((.., Some(_)))),
+            layers: if any_layers {
+                layers_of_entity(e)
+            } else {
+                CollisionLayers::default()
+            },
+        };
+        bodies.insert(e, facts);
+        facts
     };
     for &(a, b) in &pairs.pairs {
         let (fa, fb) = (facts(a), facts(b));
