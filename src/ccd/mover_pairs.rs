@@ -57,9 +57,9 @@ pub fn pairs_with_a_fast_body(
         kept.then(|| u64::from(float_order_key(b.min[axis])) << 32 | u64::from(i))
     }));
     order.sort_unstable();
-    // The boxes whose x interval is still open, fast and slow apart: a slow box is tested
+    // The boxes whose interval is still open, fast and slow apart: a slow box is tested
     // against the fast ones only, and the slow list is pruned and read only when a fast box
-    // comes (in a dense pile a slow box overlaps a hundred others along x).
+    // comes (in a dense pile a slow box overlaps a hundred others along the axis).
     let (fast_open, slow_open) = (&mut scratch.fast_open, &mut scratch.slow_open);
     fast_open.clear();
     slow_open.clear();
