@@ -193,7 +193,7 @@ impl SolverBodies {
         let slot = self.states.len() as u32;
         let dynamic = b.inverse_mass > 0.0;
         let inverse_inertia = if dynamic {
-            world_inverse_inertia(&b)
+            world_inverse_inertia(b)
         } else {
             Mat3::ZERO
         };
