@@ -6,7 +6,8 @@
 //!
 //! A joint holds each body at a frame (an anchor and a basis in the body's frame, the anchor
 //! measured from the centre of mass). The joint's *axis* is its frames' x axis: the hinge's
-//! axis, the slider's direction. What each kind keeps, from the rows of [`joint_rows`]:
+//! axis, the slider's direction. What each kind keeps, from the rows of [`joint_rows`] and
+//! [`point_rows`]:
 //!
 //! | kind | point rows | angular rows | axis coordinate (limit, motor) |
 //! | --- | --- | --- | --- |
@@ -34,9 +35,11 @@
 //! the step. Free ball joints are solved four at a time in SIMD lanes (`joint_batch.rs`).
 //!
 //! [`joint_rows`]: super::joint_rows
+//! [`point_rows`]: super::point_rows
 
 use super::body::{BodyState, SolverBodies};
-use super::joint_rows::{PairMasses, inverse_mass, point_mass, solve_point};
+use super::joint_rows::PairMasses;
+use super::point_rows::{inverse_mass, point_mass, solve_point};
 use super::softness::Softness;
 use glam::{Mat3, Vec3};
 

@@ -7,7 +7,7 @@
 //! common body ([`OrderedBatches`](super::ordered_batches::OrderedBatches), so the batches in
 //! order give the scalar sweep over these joints in their order; the other joints are solved
 //! one at a time after the batches), so no two lanes write the same velocities: a batch gathers its bodies' velocities, runs the scalar arithmetic of
-//! [`joint_rows`](super::joint_rows) (`point_mass`, `inverse_mass`, `solve_point`) in every
+//! [`point_rows`](super::point_rows) (`point_mass`, `inverse_mass`, `solve_point`) in every
 //! lane, and scatters them back. Padding lanes hold zero masses and impulses: their `K⁻¹` is
 //! zero and their impulses stay zero.
 
@@ -144,7 +144,7 @@ impl JointBatch {
     }
 
     /// The point rows' `K⁻¹` at the arms as they are (`point_mass` and `inverse_mass` of
-    /// [`joint_rows`](super::joint_rows) in every lane).
+    /// [`point_rows`](super::point_rows) in every lane).
     fn take_point_mass(&mut self) {
         let [r_a, r_b] = self.arms;
         let [ia, ib] = &self.inverse_inertia;

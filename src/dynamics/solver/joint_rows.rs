@@ -13,16 +13,15 @@
 //!
 //! * [`AxisRow`]: one scalar row `J = [−lᵀ, −u_aᵀ, lᵀ, u_bᵀ]` (a hinge's angle `l = 0`,
 //!   `u_a = u_b = axis`; a slider's travel and a rope's length, see the joints).
-//! * [`point_mass`]: the three rows keeping two anchors together (a ball joint). With
-//!   `C = c_b + r_b − c_a − r_a`, `Ċ = v_b + ω_b × r_b − v_a − ω_a × r_a`; as
-//!   `ω × r = −[r]× ω`, `J = [−1, [r_a]×, 1, −[r_b]×]` and
-//!   `K = (m_a⁻¹ + m_b⁻¹) 1 − [r_a]× I_a⁻¹ [r_a]× − [r_b]× I_b⁻¹ [r_b]×` (3×3, symmetric).
+//! * The three point rows keeping two anchors together (a ball joint): in
+//!   [`point_rows`](super::point_rows).
 //! * [`AngularRows`]: two or three rows on the relative angular velocity alone,
 //!   `Ċ_i = u_i · (ω_b − ω_a)`, `J_i = [0, −u_iᵀ, 0, u_iᵀ]`, `K_ij = u_i · (I_a⁻¹ + I_b⁻¹) u_j`
 //!   (a weld's lock: `u` the world axes; a hinge's alignment: two directions, see
 //!   [`hinge_directions`]).
 
 use super::body::{BodyParams, BodyState, same_on_every_axis};
+use super::point_rows::inverse_mass;
 use super::softness::Softness;
 use glam::{Mat3, Vec3};
 
@@ -95,7 +94,7 @@ pub struct AxisRow {
 /// the point rows' answer folded in. A unit impulse along the row alone turns the bodies by
 /// `w_a = −I_a⁻¹ u_a`, `w_b = I_b⁻¹ u_b`, which moves the anchors apart at
 /// `d = w_b × r_b − w_a × r_a`; the point rows answer with `P = −K_p⁻¹ d` (see
-/// [`point_mass`]). The row's impulse and that answer together change the velocities by
+/// [`point_mass`](super::point_rows::point_mass)). The row's impulse and that answer together change the velocities by
 /// `Δv_a = −m_a⁻¹ P`, `Δω_a = w_a − I_a⁻¹ (r_a × P)`, `Δv_b = m_b⁻¹ P`,
 /// `Δω_b = w_b + I_b⁻¹ (r_b × P)`, and the row's velocity by `K = u_b·Δω_b − u_a·Δω_a`: the
 /// effective mass of the row with the anchors held (the Schur complement of the point rows).
@@ -113,7 +112,7 @@ pub struct Pivot {
 impl Pivot {
     /// The pivot of the angular row `(u_a, u_b)` between bodies with masses `m` held together
     /// at anchors `r_a`, `r_b` by point rows of effective mass `point_k_inverse` (the joint's
-    /// own, taken once per substep: [`point_mass`] inverted by [`inverse_mass`]).
+    /// own, taken once per substep: [`point_mass`](super::point_rows::point_mass) inverted by [`inverse_mass`]).
     pub fn new(
         m: &PairMasses,
         (u_a, u_b): (Vec3, Vec3),
@@ -275,88 +274,6 @@ impl AxisRow {
     }
 }
 
-/// `[v]×`, the matrix of `x ↦ v × x`.
-pub fn skew(v: Vec3) -> Mat3 {
-    Mat3::from_cols(
-        Vec3::new(0.0, v.z, -v.y),
-        Vec3::new(-v.z, 0.0, v.x),
-        Vec3::new(v.y, -v.x, 0.0),
-    )
-}
-
-/// The point rows' `K` for anchors `r_a`, `r_b` (see the module doc).
-#[inline]
-pub fn point_mass(m: &PairMasses, r_a: Vec3, r_b: Vec3) -> Mat3 {
-    let [ia, ib] = m.inverse_inertia;
-    Mat3::from_diagonal(m.inverse_mass[0] + m.inverse_mass[1])
-        - skew_sandwich(r_a, ia)
-        - skew_sandwich(r_b, ib)
-}
-
-/// `[r]× I [r]×` in 36 multiplications instead of two matrix products' 54 (it is taken for
-/// every joint in every substep): the columns of `[r]× I` are `r` crossed with `I`'s columns,
-/// and multiplying by `[r]×` combines them with `[r]×`'s entries, a third of which are zero.
-#[inline]
-fn skew_sandwich(r: Vec3, i: Mat3) -> Mat3 {
-    let c = [r.cross(i.x_axis), r.cross(i.y_axis), r.cross(i.z_axis)];
-    Mat3::from_cols(
-        c[1] * r.z - c[2] * r.y,
-        c[2] * r.x - c[0] * r.z,
-        c[0] * r.y - c[1] * r.x,
-    )
-}
-
-/// Solves the point rows: anchors `r_a`, `r_b` (world, now), position error `c` (`None` in a
-/// relax pass), `k_inverse` the rows' effective mass ([`point_mass`] inverted by
-/// [`inverse_mass`]); `accumulated` is the world impulse on B. Returns the impulse applied.
-#[allow(clippy::too_many_arguments)]
-#[inline]
-pub fn solve_point(
-    m: &PairMasses,
-    states: &mut [BodyState],
-    (a, b): (usize, usize),
-    (r_a, r_b): (Vec3, Vec3),
-    error: Option<Vec3>,
-    soft: Softness,
-    k_inverse: &Mat3,
-    accumulated: &mut Vec3,
-) -> Vec3 {
-    let (sa, sb) = (&states[a], &states[b]);
-    let cdot = sb.linear_velocity + sb.angular_velocity.cross(r_b)
-        - sa.linear_velocity
-        - sa.angular_velocity.cross(r_a);
-    let (bias, soft) = match error {
-        Some(c) => (c * soft.bias_rate, soft),
-        None => (Vec3::ZERO, Softness::RIGID),
-    };
-    let impulse =
-        -soft.mass_scale * (*k_inverse * (cdot + bias)) - soft.impulse_scale * *accumulated;
-    *accumulated += impulse;
-    m.apply(
-        states,
-        (a, b),
-        impulse,
-        [r_a.cross(impulse), r_b.cross(impulse)],
-    );
-    impulse
-}
-
-/// `K⁻¹` for a symmetric positive semi-definite `K`: the inverse when it is well
-/// conditioned, else row by row (a body turning about some axes only, or two immovable
-/// bodies: those rows take no impulse). Always inlined: a `K` handed over through memory
-/// to a call was read back in wider loads than it was stored in, and the reads waited for the
-/// stores (no store-to-load forwarding; a tenth of a ragdoll pile's point-mass work).
-#[inline(always)]
-pub fn inverse_mass(k: Mat3) -> Mat3 {
-    let det = k.determinant();
-    let scale = k.x_axis.x * k.y_axis.y * k.z_axis.z;
-    if det.is_finite() && det > 1e-6 * scale && scale > 0.0 {
-        return k.inverse();
-    }
-    let inv = |d: f32| if d > 0.0 { 1.0 / d } else { 0.0 };
-    Mat3::from_diagonal(Vec3::new(inv(k.x_axis.x), inv(k.y_axis.y), inv(k.z_axis.z)))
-}
-
 /// Two or three rows on the relative angular velocity (see the module doc); the directions
 /// are world axes at the step's start.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -443,10 +360,12 @@ pub fn hinge_directions(axis_a: Vec3, perp_b: [Vec3; 2]) -> ([Vec3; 2], [f32; 2]
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
+    use super::super::point_rows::point_mass;
     use super::*;
 
-    fn masses(ma: f32, mb: f32) -> PairMasses {
+    /// Two bodies of masses `ma`, `mb` with unequal diagonal inverse inertias.
+    pub(in crate::dynamics::solver) fn masses(ma: f32, mb: f32) -> PairMasses {
         PairMasses {
             inverse_mass: [Vec3::splat(1.0 / ma), Vec3::splat(1.0 / mb)],
             inverse_inertia: [
@@ -463,33 +382,6 @@ mod tests {
         let free = (f32::NEG_INFINITY, f32::INFINITY);
         row.solve(m, states, (0, 1), 0.0, Softness::RIGID, &mut acc, free);
         acc
-    }
-
-    #[test]
-    fn the_point_rows_stop_the_anchors_relative_velocity_within_1e_5() {
-        let m = masses(2.0, 3.0);
-        let mut states = [BodyState::default(); 2];
-        states[0].linear_velocity = Vec3::new(1.0, -2.0, 0.5);
-        states[0].angular_velocity = Vec3::new(0.3, 1.0, -2.0);
-        states[1].angular_velocity = Vec3::new(-1.0, 0.2, 0.7);
-        let (ra, rb) = (Vec3::new(0.5, 0.2, -0.1), Vec3::new(-0.3, 0.4, 0.6));
-        let mut acc = Vec3::ZERO;
-        let k_inverse = inverse_mass(point_mass(&m, ra, rb));
-        solve_point(
-            &m,
-            &mut states,
-            (0, 1),
-            (ra, rb),
-            None,
-            Softness::RIGID,
-            &k_inverse,
-            &mut acc,
-        );
-        let (sa, sb) = (states[0], states[1]);
-        let rel = sb.linear_velocity + sb.angular_velocity.cross(rb)
-            - sa.linear_velocity
-            - sa.angular_velocity.cross(ra);
-        assert!(rel.length() < 1e-5, "{rel}");
     }
 
     #[test]
@@ -558,27 +450,6 @@ mod tests {
     }
 
     #[test]
-    fn the_skew_sandwich_equals_the_two_matrix_products_within_1e_5() {
-        let mut rng = crate::test_rng::TestRng::new(7);
-        for _ in 0..1000 {
-            let r = rng.vec3(-2.0, 2.0);
-            let i = Mat3::from_cols_array(&std::array::from_fn(|_| rng.range(-2.0, 2.0)));
-            let expected = skew(r) * i * skew(r);
-            let got = skew_sandwich(r, i);
-            let scale = 1.0
-                + expected
-                    .abs()
-                    .to_cols_array()
-                    .iter()
-                    .fold(0.0f32, |a, &b| a.max(b));
-            assert!(
-                got.abs_diff_eq(expected, 1e-5 * scale),
-                "{got} vs {expected}"
-            );
-        }
-    }
-
-    #[test]
     fn a_nan_velocity_leaves_a_one_sided_row_carrying_nothing_instead_of_nan() {
         let m = masses(1.0, 2.0);
         let mut states = [BodyState::default(); 2];
@@ -591,11 +462,5 @@ mod tests {
         assert_eq!(acc, 0.0);
         // The good body takes back the row's impulse, a finite change.
         assert!(states[0].linear_velocity.is_finite());
-    }
-
-    #[test]
-    fn a_singular_mass_takes_no_impulse_on_its_empty_rows() {
-        let k = Mat3::from_diagonal(Vec3::new(2.0, 0.0, 0.0));
-        assert_eq!(inverse_mass(k) * Vec3::ONE, Vec3::new(0.5, 0.0, 0.0));
     }
 }

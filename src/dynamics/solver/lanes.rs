@@ -304,7 +304,7 @@ impl Mat3x4 {
         x * v.x + y * v.y + z * v.z
     }
 
-    /// `[r]× M [r]×` per lane, as [`skew_sandwich`](super::joint_rows) computes it.
+    /// `[r]× M [r]×` per lane, as [`point_rows`](super::point_rows)'s `skew_sandwich` computes it.
     pub fn skew_sandwich(&self, r: Vec3x4) -> Self {
         let c = self.cols.map(|col| r.cross(col));
         Self {
@@ -324,7 +324,7 @@ impl Mat3x4 {
     }
 
     /// The inverse of a symmetric positive semi-definite matrix per lane, as
-    /// [`inverse_mass`](super::joint_rows::inverse_mass) takes it: the inverse where it is well
+    /// [`inverse_mass`](super::point_rows::inverse_mass) takes it: the inverse where it is well
     /// conditioned, else the inverse of the diagonal (0 for a non-positive entry).
     pub fn inverse_mass(&self) -> Self {
         let [x, y, z] = self.cols;
@@ -405,7 +405,7 @@ mod tests {
     /// zero one (a padding lane) and a badly scaled one, against the scalar rule.
     #[test]
     fn lanes_invert_effective_masses_as_the_scalar_rule_within_1e_5_relative() {
-        use crate::dynamics::solver::joint_rows::inverse_mass;
+        use crate::dynamics::solver::point_rows::inverse_mass;
         let m = [
             Mat3::from_cols_array(&[2.0, 0.3, -0.1, 0.3, 1.5, 0.2, -0.1, 0.2, 1.0]),
             Mat3::from_diagonal(Vec3::new(1.0, 0.0, 0.0)),

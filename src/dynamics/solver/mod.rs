@@ -75,6 +75,7 @@ pub mod joint_rows;
 pub mod lanes;
 pub mod ordered_batches;
 pub mod patch_friction;
+pub mod point_rows;
 pub mod rolling;
 pub mod row;
 pub mod softness;
