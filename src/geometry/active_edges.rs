@@ -25,7 +25,7 @@ pub const COPLANAR_DEGREES: f32 = 5.0;
 pub const ALL_EDGES_ACTIVE: u8 = 0b111;
 
 /// Neighbours closer than this to coplanar share a *flat* edge (bit `3 + k` of
-/// [`active_edges`]'s byte): the surface continues past it without a fold worth a contact of
+/// `active_edges`'s byte): the surface continues past it without a fold worth a contact of
 /// its own, so a convex part beside it is its neighbour's alone (`trimesh_convex.rs`).
 pub const FLAT_DEGREES: f32 = 0.5;
 

@@ -71,7 +71,7 @@ impl ColliderTree {
     /// in the same order are refitted, a few ids changed update the trees incrementally, and a
     /// change too large for that (or ids too sparse to index) rebuilds, as does a tree worn
     /// by its refits (its relative cost grown by half since its build, checked every
-    /// [`CHECK_EVERY`] updates).
+    /// `CHECK_EVERY` updates).
     pub fn update(&mut self, items: &[(u32, Aabb)]) -> IndexUpdate {
         match self.sync(items) {
             Some(kind) if !self.rebuild_due && !self.worn() => kind,

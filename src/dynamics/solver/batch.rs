@@ -15,7 +15,7 @@
 //! batches' shared rows, then their points one after another (as many as each batch has, not
 //! room for the most), their friction rows per point in a list of their own (only the relax
 //! passes read them), or their friction per patch. What a lane holds, and why a point keeps no
-//! lever arms, is in [`batch_rows`](super::batch_rows).
+//! lever arms, is in `batch_rows.rs`.
 //!
 //! The batches are packed from the prepared constraints once per step and their impulses
 //! unpacked into them after the substeps, so restitution, warm-start storage and contact

@@ -103,7 +103,7 @@ pub struct ConstraintPoint {
 
 impl ConstraintPoint {
     /// `row` (along `dir`) with its lever arms `r_a × d`, `r_b × d`, taken from the anchors
-    /// (the bits [`RowPart::new`] stored: a point keeps no arms, see [`PointRow`]).
+    /// (the bits `RowPart::new` stored: a point keeps no arms, see [`PointRow`]).
     #[inline(always)]
     pub fn row(&self, row: &PointRow, dir: Vec3) -> RowPart {
         row.with_arms(self.anchor_a, self.anchor_b, dir)

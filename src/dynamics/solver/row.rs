@@ -51,7 +51,7 @@ impl RowPart {
 
 /// A point's row as a contact keeps it: [`RowPart`] without the lever arms (`From<RowPart>`),
 /// which [`Self::with_arms`] takes from the point's anchors (the same arithmetic as
-/// [`RowPart::new`], so the same bits).
+/// `RowPart::new`, so the same bits).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PointRow {
     /// `I_a⁻¹ (r_a × d)`, `I_b⁻¹ (r_b × d)`.
