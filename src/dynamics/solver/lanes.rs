@@ -266,13 +266,6 @@ pub struct Mat3x4 {
 }
 
 impl Mat3x4 {
-    /// Lane `i` holds `m[i]`.
-    pub fn gather(m: [Mat3; LANES]) -> Self {
-        Self {
-            cols: [0, 1, 2].map(|c| Vec3x4::gather(m.map(|m| m.col(c)))),
-        }
-    }
-
     /// Lane `i` holds `*m[i]`, read in place (see [`Vec3x4::gather_refs`]).
     #[inline]
     pub fn gather_refs(m: [&Mat3; LANES]) -> Self {
@@ -412,7 +405,7 @@ mod tests {
             Mat3::ZERO,
             Mat3::from_diagonal(Vec3::new(1e4, 2e-3, 7.0)),
         ];
-        let wide = Mat3x4::gather(m).inverse_mass();
+        let wide = Mat3x4::gather_refs(m.each_ref()).inverse_mass();
         for (lane, m) in m.iter().enumerate() {
             let expected = inverse_mass(*m);
             for c in 0..3 {
