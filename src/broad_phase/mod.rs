@@ -47,6 +47,7 @@ mod sort_sweep;
 pub use adaptive::AdaptiveSweep;
 pub use brute_force::BruteForce;
 pub use grid::{GridError, GridQueryCache, GridQueryStats, StaticGrid, StaticGridConfig};
+pub(crate) use pair_diff::diff_sorted_by_key;
 pub use pair_tracking::{AxisBits, AxisTests, PairTracking};
 pub use regions::RegionSweep;
 pub use sap::IncrementalSap;

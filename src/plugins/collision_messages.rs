@@ -10,6 +10,7 @@
 //! asleep ends no collision.
 
 pub use super::collision_data::ContactData;
+use crate::broad_phase::diff_sorted_by_key;
 use crate::components::*;
 use crate::plugins::narrow_phase::{ContactPair, Contacts, SensorOverlaps};
 use crate::plugins::required_resources::RequireResource;
@@ -136,6 +137,7 @@ pub(crate) fn report_collisions(
     overlaps: Option<Res<SensorOverlaps>>,
     mut fresh: Local<Vec<Touch>>,
     mut previous: Local<Vec<Pair>>,
+    mut changes: Local<(Vec<Pair>, Vec<Touch>)>,
     mut sensed: Local<Vec<Pair>>,
     mut started: MessageWriter<CollisionStarted>,
     mut ended: MessageWriter<CollisionEnded>,
@@ -147,7 +149,6 @@ pub(crate) fn report_collisions(
     let is_dormant = |e: Entity, bodies: &Query<(Dormancy, Option<&mut SleepState>)>| {
         dormant(bodies.get(e).ok().map(|(d, _)| d))
     };
-    let is_fresh = |pair: &Pair, fresh: &[Touch]| fresh.binary_search_by_key(pair, |t| t.0);
     // Dormant pairs come back into play only after something woke or went.
     let stirred = woke.read().count() + unfixed.read().count() + despawned.read().count() > 0;
     previous.clear();
@@ -165,12 +166,14 @@ pub(crate) fn report_collisions(
             previous.sort_unstable();
         }
     }
-    // Each pair touching before is touching still, newly dormant (not tested now), or ended.
+    // The pairs of only one of the two sorted lists, in one merge pass.
+    let (gone, came) = &mut *changes;
+    gone.clear();
+    came.clear();
+    diff_sorted_by_key(&previous, &fresh, |p| *p, |t| t.0, came, gone);
+    // Each pair touching before and not now is newly dormant (not tested now) or ended.
     let mut newly_dormant = false;
-    for &(a, b) in previous.iter() {
-        if is_fresh(&(a, b), &fresh).is_ok() {
-            continue;
-        }
+    for &(a, b) in gone.iter() {
         if is_dormant(a, &bodies) && is_dormant(b, &bodies) {
             touching.dormant.push((a, b));
             newly_dormant = true;
@@ -187,10 +190,8 @@ pub(crate) fn report_collisions(
         touching.dormant.sort_unstable();
     }
     let mut resumed = false;
-    for &(pair, contact) in fresh.iter() {
-        if previous.binary_search(&pair).is_ok() {
-            continue;
-        }
+    // Each pair touching now and not before is a new collision, or a dormant pair tested again.
+    for &(pair, contact) in came.iter() {
         if let Ok(at) = touching.dormant.binary_search(&pair) {
             // Tested again (a body of it woke): active from now on, not a new collision.
             touching.dormant[at].0 = Entity::PLACEHOLDER;
