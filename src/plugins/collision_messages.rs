@@ -10,7 +10,7 @@
 //! asleep ends no collision.
 
 pub use super::collision_data::ContactData;
-use crate::broad_phase::diff_sorted_by_key;
+use crate::broad_phase::pair_diff::diff_sorted_by_key;
 use crate::components::*;
 use crate::plugins::narrow_phase::{ContactPair, Contacts, SensorOverlaps};
 use crate::plugins::required_resources::RequireResource;
