@@ -62,17 +62,23 @@ impl SupportLanes {
             let ids = f32x4::from([0.0, 1.0, 2.0, 3.0]) + f32x4::splat(4.0 * g as f32);
             index = higher.select(ids, index);
         }
+        // The lanes merged without branches (a branch per lane on which one is ahead depends
+        // on the data, and the scalar merge took most of this function's samples): the highest
+        // value, then the smallest index holding it.
+        // No lane holds a NaN (`simd_gt` never takes one), so `max` is exact.
         let (best, index) = (best.to_array(), index.to_array());
-        let mut winner = 0;
-        for lane in 1..4 {
-            let ahead = best[lane] > best[winner]
-                || (best[lane] == best[winner] && index[lane] < index[winner]);
-            if ahead {
-                winner = lane;
+        let top = best[0].max(best[1]).max(best[2].max(best[3]));
+        let at = |lane: usize| {
+            if best[lane] == top {
+                index[lane]
+            } else {
+                f32::MAX
             }
-        }
-        // Indices are small whole numbers, exact in f32.
-        index[winner] as usize
+        };
+        let winner = at(0).min(at(1)).min(at(2).min(at(3)));
+        // Indices are small whole numbers, exact in f32; through `i32`, whose saturating
+        // conversion is one instruction and a compare (to `usize` it took five more).
+        winner as i32 as usize
     }
 }
 
