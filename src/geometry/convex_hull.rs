@@ -141,6 +141,14 @@ impl ConvexHull {
     /// while there is one. On a convex polytope's
     /// vertex graph a local maximum of a linear function is global; strict gains cannot cycle.
     pub fn support(&self, dir: Vec3) -> Vec3 {
+        self.vertices[self.support_index(dir)]
+    }
+
+    /// The index of [`support`](Self::support)'s vertex. GJK reads the vertex itself: a `Vec3`
+    /// returned from a call came back through memory in an 8- and a 4-byte store, and the
+    /// caller's first load straddled them (a failed store-to-load forwarding, found with `perf
+    /// annotate`), where an index comes back in a register.
+    pub fn support_index(&self, dir: Vec3) -> usize {
         let v = &self.vertices;
         let mut best = self.lanes.farthest(dir);
         let higher = |b: usize| self.neighbours[b].iter().map(|&n| n as usize);
@@ -150,7 +158,7 @@ impl ConvexHull {
         {
             best = n;
         }
-        v[best]
+        best
     }
 
     /// Index of the face whose normal has the largest dot product with `dir`.

@@ -193,6 +193,9 @@ impl<'a> ConvexPart<'a> {
         self.pose.transform_point(self.local_support(local))
     }
 
+    /// Always inlined into [`support`](Self::support), so that its answer stays in registers
+    /// (called, it came back through memory, as `ConvexHull::support_index` explains).
+    #[inline(always)]
     fn local_support(&self, d: Vec3) -> Vec3 {
         match self.core {
             Core::Point => Vec3::ZERO,
@@ -218,7 +221,7 @@ impl<'a> ConvexPart<'a> {
                     Vec3::ZERO
                 }
             }
-            Core::Hull(h) => h.support(d),
+            Core::Hull(h) => h.vertices()[h.support_index(d)],
             Core::Triangle(v) => farthest(&v, d),
         }
     }
