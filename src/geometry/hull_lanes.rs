@@ -64,8 +64,8 @@ impl SupportLanes {
         }
         // The lanes merged without branches (a branch per lane on which one is ahead depends
         // on the data, and the scalar merge took most of this function's samples): the highest
-        // value, then the smallest index holding it.
-        // No lane holds a NaN (`simd_gt` never takes one), so `max` is exact.
+        // value, then the smallest index holding it. No lane holds a NaN (`simd_gt` never
+        // takes one), so `max` is exact.
         let (best, index) = (best.to_array(), index.to_array());
         let top = best[0].max(best[1]).max(best[2].max(best[3]));
         let at = |lane: usize| {
