@@ -163,13 +163,8 @@ mod tests {
 
     #[test]
     fn keyed_diff_keeps_each_side_s_items_and_matches_binary_searches_on_random_lists() {
-        let mut seed = 11u64;
-        let mut next = move || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 40) as u32 % 300
-        };
+        let mut rng = crate::test_rng::TestRng::new(11);
+        let mut next = || rng.below(300);
         for _ in 0..50 {
             let mut old: Vec<u32> = (0..next() % 120).map(|_| next()).collect();
             // The new list carries a payload beside its key, as the collision messages do.
