@@ -120,6 +120,16 @@ pub(crate) struct TouchingPairs {
 /// Whether the bodies of a pair are both static or asleep.
 use crate::plugins::narrow_phase::Dormancy;
 
+/// The pairs found in only one of two substeps' sorted lists (scratch, kept between substeps
+/// for its capacity): touching pairs that ended and that started (with their contact), and
+/// sensor overlaps that started; `gone` serves the sensors' ended overlaps after the contacts'.
+#[derive(Default)]
+pub(crate) struct Changes {
+    gone: Vec<Pair>,
+    came: Vec<Touch>,
+    came_sensing: Vec<Pair>,
+}
+
 /// A pair touching in this substep, with the index of its strongest contact in [`Contacts`]
 /// (of the pair's collider contacts, the one the solver pushed hardest; the first on a tie).
 type Touch = (Pair, u32);
@@ -137,7 +147,7 @@ pub(crate) fn report_collisions(
     overlaps: Option<Res<SensorOverlaps>>,
     mut fresh: Local<Vec<Touch>>,
     mut previous: Local<Vec<Pair>>,
-    mut changes: Local<(Vec<Pair>, Vec<Touch>)>,
+    mut changes: Local<Changes>,
     mut sensed: Local<Vec<Pair>>,
     mut started: MessageWriter<CollisionStarted>,
     mut ended: MessageWriter<CollisionEnded>,
@@ -151,8 +161,8 @@ pub(crate) fn report_collisions(
     };
     // Dormant pairs come back into play only after something woke or went.
     let stirred = woke.read().count() + unfixed.read().count() + despawned.read().count() > 0;
-    previous.clear();
-    previous.extend_from_slice(&touching.active);
+    // The last substep's list is moved out, not copied: `active` is refilled below.
+    std::mem::swap(&mut *previous, &mut touching.active);
     if stirred {
         let before = previous.len();
         touching.dormant.retain(|&(a, b)| {
@@ -167,7 +177,11 @@ pub(crate) fn report_collisions(
         }
     }
     // The pairs of only one of the two sorted lists, in one merge pass.
-    let (gone, came) = &mut *changes;
+    let Changes {
+        gone,
+        came,
+        came_sensing,
+    } = &mut *changes;
     gone.clear();
     came.clear();
     diff_sorted_by_key(&previous, &fresh, |p| *p, |t| t.0, came, gone);
@@ -217,6 +231,7 @@ pub(crate) fn report_collisions(
         report_sensors(
             &mut sensed,
             &mut touching.sensing,
+            (gone, came_sensing),
             dormant_pair,
             &mut started,
             &mut ended,
@@ -260,17 +275,18 @@ fn touching_now(contacts: &Contacts, fresh: &mut Vec<Touch>) {
 fn report_sensors(
     fresh: &mut Vec<Pair>,
     sensing: &mut Vec<Pair>,
+    (gone, came): (&mut Vec<Pair>, &mut Vec<Pair>),
     dormant: impl Fn(Pair) -> bool,
     started: &mut MessageWriter<CollisionStarted>,
     ended: &mut MessageWriter<CollisionEnded>,
 ) {
     fresh.sort_unstable();
     fresh.dedup();
+    gone.clear();
+    came.clear();
+    diff_sorted_by_key(sensing, fresh, |p| *p, |p| *p, came, gone);
     let mut kept = false;
-    for &(a, b) in sensing.iter() {
-        if fresh.binary_search(&(a, b)).is_ok() {
-            continue;
-        }
+    for &(a, b) in gone.iter() {
         if dormant((a, b)) {
             fresh.push((a, b));
             kept = true;
@@ -278,14 +294,12 @@ fn report_sensors(
             ended.write(CollisionEnded { a, b });
         }
     }
-    for &(a, b) in fresh.iter() {
-        if sensing.binary_search(&(a, b)).is_err() {
-            started.write(CollisionStarted {
-                a,
-                b,
-                contact: None,
-            });
-        }
+    for &(a, b) in came.iter() {
+        started.write(CollisionStarted {
+            a,
+            b,
+            contact: None,
+        });
     }
     if kept {
         fresh.sort_unstable();
