@@ -260,9 +260,14 @@ impl ContactBatches {
                 _ => &zero,
             })
         };
+        let still = lanes.map(|c| c.map_or([false; 2], |c| c.still));
         for k in 0..count {
             let points = lane_points(k);
-            put(&mut self.points, filled.points + k, PointX4::gather(points));
+            put(
+                &mut self.points,
+                filled.points + k,
+                PointX4::gather(points, still),
+            );
             if !patched {
                 put(
                     &mut self.frictions,

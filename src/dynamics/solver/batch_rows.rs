@@ -11,7 +11,7 @@
 //! the pace (a 3D pyramid of boxes, awake: 1.13× rapier's time at 204 boxes but 1.37× at
 //! 1,015, where it ran 1.11× rapier's instructions, when a point took 816 bytes in one piece).
 
-use super::contact::{ConstraintPoint, PointRow, RowPart};
+use super::contact::{ConstraintPoint, PointRow, RowPart, on_moving};
 use super::lanes::{LANES, Lanes, PairVelocities, Vec3x4};
 use super::patch_friction::PatchFriction;
 use crate::geometry::MAX_MANIFOLD_POINTS;
@@ -69,11 +69,18 @@ pub(super) struct PointX4 {
 }
 
 impl PointX4 {
-    pub fn gather(points: [&ConstraintPoint; LANES]) -> Self {
+    /// The points of four lanes, whose bodies are still as `still` says per lane (A, B): a
+    /// still body's anchor is taken as zero ([`on_moving`]).
+    pub fn gather(points: [&ConstraintPoint; LANES], still: [[bool; 2]; LANES]) -> Self {
         let each = |f: fn(&ConstraintPoint) -> f32| Lanes::new(points.map(f));
+        let anchors = |side: usize, r: fn(&ConstraintPoint) -> Vec3| {
+            Vec3x4::gather(std::array::from_fn(|l| {
+                on_moving(still[l][side], r(points[l]))
+            }))
+        };
         Self {
-            anchor_a: Vec3x4::gather(points.map(|p| p.anchor_a)),
-            anchor_b: Vec3x4::gather(points.map(|p| p.anchor_b)),
+            anchor_a: anchors(0, |p| p.anchor_a),
+            anchor_b: anchors(1, |p| p.anchor_b),
             base_separation: each(|p| p.base_separation),
             normal_row: PointRowX4::gather(points.map(|p| &p.normal_row)),
             normal_impulse: each(|p| p.normal_impulse),

@@ -20,7 +20,8 @@
 //! Contacts are found once per step. Within it each body has moved by `dp` and turned by `dq`
 //! since the start, so the separation is updated without new detection (Box2D v3):
 //! `s = s₀ + (dp_b − dp_a + dq_b r_b − dq_a r_a − (r_b − r_a))·n`; `s₀ − (r_b − r_a)·n` is kept
-//! as the point's base separation.
+//! as the point's base separation, with the `r` of a body that stays still taken as zero
+//! (`on_moving`: from a ground's centre it would round the separation to the ground's size).
 //!
 //! # Speculative and soft
 //! A point still apart (`s > 0`) may close exactly its gap this substep (bias `s/h`): contacts
@@ -81,7 +82,7 @@ pub struct ConstraintPoint {
     pub anchor_a: Vec3,
     /// Anchor from B's centre of mass.
     pub anchor_b: Vec3,
-    /// `s₀ − (r_b − r_a)·n` (see the module doc).
+    /// `s₀ − (r_b − r_a)·n`, a still side's `r` zero (see the module doc).
     pub base_separation: f32,
     /// The normal row (its lever arms from the anchors: [`Self::row`]).
     pub normal_row: PointRow,
@@ -158,6 +159,23 @@ pub struct ContactConstraint {
     /// `(a_b − a_a)·n` (m/s²), to carry a speculative point's approach speed on to the moment
     /// it touches.
     pub closing_acceleration: f32,
+}
+
+/// A point's anchor `r` as the separation reads it: zero on a still body
+/// ([`ContactConstraint::still`]), `r` on the others.
+///
+/// Why: a still body neither moves nor turns in the step, and its velocities and inverse mass
+/// are zero, so its anchor's only part in a pass is the separation, where `r·n` is taken off
+/// the base separation and added back in every pass. From a ground's centre that number is as
+/// large as the ground, and the small separation went through it: a ball resting on a 1 m
+/// slab, 0.5 m above its centre, read its separation to twice its own float spacing, and the
+/// solver's answer to that rounding moved it by one ulp every step, for ever (0.49998274 and
+/// 0.49998277 m in turn). Taken from the point itself, the still side adds nothing. The rows
+/// may read the zero too (their arm on a still body meets a zero angular velocity and a zero
+/// inverse inertia); the warm start keeps the true anchors.
+#[inline]
+pub(super) fn on_moving(still: bool, r: Vec3) -> Vec3 {
+    if still { Vec3::ZERO } else { r }
 }
 
 /// Whether a body's state is [`BodyState::default`], the rest state, bit for bit (`-0.0` is not
@@ -266,14 +284,16 @@ impl ContactConstraint {
         let (normal, sides) = (along(n), tangents.map(along));
         let count = (input.count as usize).min(MAX_MANIFOLD_POINTS);
         let per_point = model == FrictionModel::PerPoint;
+        let still = [(pa, ia), (pb, ib)].map(|(p, i)| !p.dynamic && at_rest(&states[i]));
         for (cp, p) in self.points.iter_mut().zip(&input.points[..count]) {
             let ra = p.point - centers[ia];
             let rb = p.point - centers[ib];
+            let gap_arms = [on_moving(still[0], ra), on_moving(still[1], rb)];
             let relative = point_velocity(&states[ib], rb) - point_velocity(&states[ia], ra);
             *cp = ConstraintPoint {
                 anchor_a: ra,
                 anchor_b: rb,
-                base_separation: p.separation - (rb - ra).dot(n),
+                base_separation: p.separation - (gap_arms[1] - gap_arms[0]).dot(n),
                 normal_row: RowPart::new(pa, pb, ra, rb, normal).into(),
                 // Written out, not `sides.map(..)`: the map's closure was not inlined and read
                 // its side back through memory, stalled on the stores that wrote it.
@@ -303,7 +323,7 @@ impl ContactConstraint {
         self.translation_locked =
             !same_on_every_axis(pa.inverse_mass) || !same_on_every_axis(pb.inverse_mass);
         self.dynamic = [pa.dynamic, pb.dynamic];
-        self.still = [(pa, ia), (pb, ib)].map(|(p, i)| !p.dynamic && at_rest(&states[i]));
+        self.still = still;
         self.closing_acceleration = (pb.linear_acceleration - pa.linear_acceleration).dot(n);
         self.rolling = RollingRows::new(
             input.rolling_resistance,
@@ -382,7 +402,8 @@ impl ContactConstraint {
             let i = if self.flip { count - 1 - k } else { k };
             let inverse_mass = self.inverse_mass;
             let cp = &mut self.points[i];
-            let (ra, rb) = (cp.anchor_a, cp.anchor_b);
+            let ra = on_moving(self.still[0], cp.anchor_a);
+            let rb = on_moving(self.still[1], cp.anchor_b);
             let s = cp.base_separation + moved + rb.dot(nb) - ra.dot(na);
             let (bias, mass_scale, impulse_scale) = if s > 0.0 {
                 (s * inv_h, 1.0, 0.0)

@@ -21,6 +21,7 @@ mod friction_models;
 mod ghost_edges;
 mod joints;
 mod locked_axes;
+mod resting;
 
 struct Body {
     shape: Shape,
