@@ -41,7 +41,7 @@ use crate::bounding::Aabb;
 use crate::bvh::QueryStats;
 use crate::components::*;
 use crate::geometry::contacts::{
-    ContactScratch, ManifoldCache, NO_TRIANGLE, contact_with_scratch,
+    ContactScratch, ManifoldCache, NO_TRIANGLE, RoundSide, contact_with_scratch,
     speculative_contact_with_scratch,
 };
 use crate::geometry::{ContactManifold, Shape};
@@ -472,7 +472,8 @@ impl NarrowPhaseScratch {
                 };
                 if cacheable {
                     let hits = if debug.enabled { scratch.hits() } else { &[] };
-                    self.cache.insert(key, (pa, pb), margin, m.as_ref(), hits);
+                    let tested = (m.as_ref(), RoundSide::of(sa, sb));
+                    self.cache.insert(key, (pa, pb), margin, tested, hits);
                 }
                 m
             }

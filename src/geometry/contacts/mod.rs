@@ -88,7 +88,7 @@ pub(crate) use closest_segment_points::{
 pub(crate) use convex_convex::{contact_convex_convex, contact_convex_halfspace};
 pub use cuboid_cuboid::contact_cuboid_cuboid;
 pub use cuboid_halfspace::contact_cuboid_halfspace;
-pub use manifold_cache::{MAX_SHIFT, ManifoldCache};
+pub use manifold_cache::{MAX_SHIFT, ManifoldCache, RoundSide};
 pub use mesh_scratch::{ContactScratch, NO_TRIANGLE};
 pub use speculative::{
     motion_bound, raw_motion_bound, speculative_contact, speculative_contact_with_scratch,

@@ -351,7 +351,8 @@ mod tests {
         }
         let mut cache = super::super::ManifoldCache::default();
         cache.begin_step();
-        cache.insert((1, 2), (&at, &sunk), 0.0, touching.as_ref(), &[]);
+        let tested = (touching.as_ref(), super::super::RoundSide::Neither);
+        cache.insert((1, 2), (&at, &sunk), 0.0, tested, &[]);
         assert!(
             cache.get((1, 2), (&at, &nan), 1.0, 0.0).is_none(),
             "a NaN pose is never a hit"
