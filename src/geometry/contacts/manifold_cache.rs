@@ -16,11 +16,11 @@
 //! to the solver: a point apart only bounds the approach) until it moves. Entries not asked for
 //! during a step are dropped at the start of the next.
 //!
-//! A round body rolling on a flat one is followed as it rolls ([`RoundSide`]). An entry kept
-//! in A's frame and points midway between the bodies' turned with whichever body A was: a
-//! capsule or cylinder rolling on a box had its normal tilted forward (A round) or its points
-//! left behind its centre by the angle it rolled since the test, and the floor's push there
-//! spun it on: a log rolling at 2 mm/s on a box reached 2 cm/s in 10 s. Now B's turn in A's
+//! A round body rolling on a flat one is followed as it rolls ([`RoundSide`]). Kept in A's
+//! frame, with its points midway between the two bodies' points, an entry turned with whichever
+//! body was A: a ball, capsule or cylinder rolling on a box had its normal tilted forward (as
+//! A) or its points left behind its centre (as B) by the angle it rolled since the test, and
+//! the floor's push there spun it on: a log rolling at 2 mm/s on a box reached 2 cm/s in 10 s. Now B's turn in A's
 //! frame is split into its twist about the normal and the swing that tilts the normal (the
 //! swing–twist decomposition): the normal turns with the flat body, and the points ride with
 //! the round body's centre and its twist about the normal (a turning capsule carries its ends
@@ -154,7 +154,11 @@ impl ManifoldCache {
         };
         // B's motion in A's frame since the test: `b_in_a ∘ tested⁻¹`, whose turn is `delta`.
         let since = Isometry::new(b_in_a.translation - delta * entry.b_in_a.translation, delta);
-        let (swing, twist) = swing_twist(delta, local.normal);
+        // Two flat bodies (most entries: box pairs) need no split.
+        let (swing, twist) = match entry.round {
+            RoundSide::Neither => (Quat::IDENTITY, Quat::IDENTITY),
+            RoundSide::A | RoundSide::B => swing_twist(delta, local.normal),
+        };
         let normal = match entry.round {
             RoundSide::A => swing * local.normal,
             RoundSide::Neither | RoundSide::B => local.normal,

@@ -143,10 +143,9 @@ mod tests {
     #[test]
     fn the_gap_to_a_face_of_a_box_up_to_80_m_is_within_1e_7_m_of_the_f64_plane_distance() {
         // Spheres over a face of large, turned boxes anywhere within 1 km of the origin (centres
-        // outside, in front of the face): the
-        // gap is read to the sphere's own precision, not to the box's size. An independent
-        // oracle: the face plane's distance `n·(c − t) − h` in f64. Single precision in the
-        // box's frame erred by up to 5.9e-6 m here.
+        // outside, in front of the face): the gap is read to the sphere's own precision, not
+        // to the box's size. An independent oracle: the face plane's distance `n·(c − t) − h`
+        // in f64. Single precision in the box's frame erred by up to 5.9e-6 m here.
         let mut rng = crate::test_rng::TestRng::new(5);
         let mut worst = 0.0f64;
         for _ in 0..2000 {
