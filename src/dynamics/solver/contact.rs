@@ -34,6 +34,7 @@
 //! [`PatchFriction`] (two rows at the points' centre and a twist) takes their place.
 
 use super::body::{BodyParams, BodyState, same_on_every_axis};
+use super::contact_pair::Pair;
 use super::patch_friction::{FrictionModel, PatchFriction};
 use super::rolling::RollingRows;
 pub use super::row::{PointRow, RowPart};
@@ -485,114 +486,6 @@ impl ContactConstraint {
             self.points[i].normal_impulse = total;
         }
         pair.store(self, states);
-    }
-}
-
-/// The velocities of a constraint's two bodies, copied out for one pass (only dynamic bodies
-/// are written back).
-struct Pair {
-    va: Vec3,
-    wa: Vec3,
-    vb: Vec3,
-    wb: Vec3,
-}
-
-impl Pair {
-    fn load(c: &ContactConstraint, states: &[BodyState]) -> Self {
-        let (a, b) = (&states[c.a as usize], &states[c.b as usize]);
-        Self {
-            va: a.linear_velocity,
-            wa: a.angular_velocity,
-            vb: b.linear_velocity,
-            wb: b.angular_velocity,
-        }
-    }
-
-    /// The rate of a row: `d·(v_b − v_a) + (r_b × d)·ω_b − (r_a × d)·ω_a`.
-    fn along(&self, dir: Vec3, row: &RowPart) -> f32 {
-        dir.dot(self.vb - self.va) + row.arm[1].dot(self.wb) - row.arm[0].dot(self.wa)
-    }
-
-    /// An impulse `λ d` on B at its anchor, `−λ d` on A, through the row's angular velocity
-    /// changes per unit impulse `turn` (`I⁻¹ (r × d)`; the lever arms are not needed).
-    fn push(&mut self, c: &ContactConstraint, dir: Vec3, turn: &[Vec3; 2], lambda: f32) {
-        self.push_with(c.inverse_mass, dir, turn, lambda);
-    }
-
-    /// [`Self::push`] with the two per-axis inverse masses given.
-    fn push_with(&mut self, inverse_mass: [Vec3; 2], dir: Vec3, turn: &[Vec3; 2], lambda: f32) {
-        // `d (W λ)` per component: with one `1/m` per body exactly the old `d (λ/m)`.
-        self.va -= dir * (inverse_mass[0] * lambda);
-        self.wa -= turn[0] * lambda;
-        self.vb += dir * (inverse_mass[1] * lambda);
-        self.wb += turn[1] * lambda;
-    }
-
-    /// Two tangent rows clamped together to the disc `|λ| ≤ limit` (Coulomb friction, at a
-    /// point or a patch centre): the new accumulated impulses from the `old` ones.
-    fn solve_disc(
-        &mut self,
-        [r0, r1]: &[RowPart; 2],
-        [t0, t1]: [Vec3; 2],
-        [old0, old1]: [f32; 2],
-        (limit, inverse_mass): (f32, [Vec3; 2]),
-    ) -> [f32; 2] {
-        // Written out, not `[0, 1].map(..)`: the array map's drain was a tenth of the
-        // solver's instructions (callgrind).
-        let w0 = old0 - r0.mass * self.along(t0, r0);
-        let w1 = old1 - r1.mass * self.along(t1, r1);
-        let length = (w0 * w0 + w1 * w1).sqrt();
-        let scale = if length > limit && length > 0.0 {
-            limit / length
-        } else {
-            1.0
-        };
-        let (new0, new1) = (w0 * scale, w1 * scale);
-        self.push_with(inverse_mass, t0, &r0.turn, new0 - old0);
-        self.push_with(inverse_mass, t1, &r1.turn, new1 - old1);
-        [new0, new1]
-    }
-
-    /// A patch's friction ([`PatchFriction`]): the twist about the normal `n`, then the
-    /// tangent disc at the centre, within `(μ Σλ_i, μ Σλ_i d_i)`.
-    fn solve_patch(
-        &mut self,
-        patch: &mut PatchFriction,
-        (limit, twist_limit): (f32, f32),
-        (n, tangents): (Vec3, [Vec3; 2]),
-        inverse_mass: [Vec3; 2],
-    ) {
-        let old = patch.twist_impulse;
-        if limit == 0.0 && old == 0.0 && patch.tangent_impulse == [0.0; 2] {
-            // No normal force, no friction held (a speculative contact still apart).
-            return;
-        }
-        let wanted = old - patch.twist_mass * n.dot(self.wb - self.wa);
-        let twist = wanted.max(-twist_limit).min(twist_limit);
-        self.twist(patch, twist - old);
-        patch.twist_impulse = twist;
-        let rows = &patch.tangent_rows;
-        patch.tangent_impulse =
-            self.solve_disc(rows, tangents, patch.tangent_impulse, (limit, inverse_mass));
-    }
-
-    /// An angular impulse `λ n` on B, `−λ n` on A (the twist row).
-    fn twist(&mut self, patch: &PatchFriction, lambda: f32) {
-        self.wa -= patch.twist_turn[0] * lambda;
-        self.wb += patch.twist_turn[1] * lambda;
-    }
-
-    fn store(self, c: &ContactConstraint, states: &mut [BodyState]) {
-        if c.dynamic[0] {
-            let s = &mut states[c.a as usize];
-            s.linear_velocity = self.va;
-            s.angular_velocity = self.wa;
-        }
-        if c.dynamic[1] {
-            let s = &mut states[c.b as usize];
-            s.linear_velocity = self.vb;
-            s.angular_velocity = self.wb;
-        }
     }
 }
 

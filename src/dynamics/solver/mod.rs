@@ -65,6 +65,7 @@ pub mod batch;
 mod batch_rows;
 pub mod body;
 pub mod contact;
+mod contact_pair;
 mod integrate;
 pub mod joint;
 mod joint_batch;
