@@ -86,6 +86,29 @@ fn swing_twist(q: Quat, axis: Vec3) -> (Quat, Quat) {
     }
 }
 
+/// The manifold `local` (A's frame, at the test) now: its normal `normal` (A's frame), each
+/// point where `point` puts it given its place at the test and the motion since of B's point
+/// there (`since`), each depth less that motion along the test's normal, all in the world by
+/// A's pose.
+fn carried(
+    local: &ContactManifold,
+    since: &Isometry,
+    pose_a: &Isometry,
+    normal: Vec3,
+    point: impl Fn(Vec3, Vec3) -> Vec3,
+) -> ContactManifold {
+    let mut now = ContactManifold::new(pose_a.transform_vector(normal));
+    for p in local.points() {
+        // Where the point of B that was at `p` at the test is now (A's frame).
+        let motion = since.transform_point(p.point) - p.point;
+        now.push(ContactPoint {
+            point: pose_a.transform_point(point(p.point, motion)),
+            depth: p.depth - motion.dot(local.normal),
+        });
+    }
+    now
+}
+
 #[derive(Debug, Clone)]
 struct Entry {
     b_in_a: Isometry,
@@ -154,34 +177,29 @@ impl ManifoldCache {
         };
         // B's motion in A's frame since the test: `b_in_a ∘ tested⁻¹`, whose turn is `delta`.
         let since = Isometry::new(b_in_a.translation - delta * entry.b_in_a.translation, delta);
-        // Two flat bodies (most entries: box pairs) need no split.
-        let (swing, twist) = match entry.round {
-            RoundSide::Neither => (Quat::IDENTITY, Quat::IDENTITY),
-            RoundSide::A | RoundSide::B => swing_twist(delta, local.normal),
+        // One loop per round side (no choice per point); two flat bodies (most entries: box
+        // pairs) need no split of the turn.
+        let now = match entry.round {
+            // Midway between the bodies' points.
+            RoundSide::Neither => carried(local, &since, pose_a, local.normal, |p, motion| {
+                p + motion * 0.5
+            }),
+            // Where round A now faces B's tilted face.
+            RoundSide::A => {
+                let (swing, _) = swing_twist(delta, local.normal);
+                carried(local, &since, pose_a, swing * local.normal, |p, _| {
+                    swing * p
+                })
+            }
+            // Round B's point, carried by its centre and its twist (A's frame).
+            RoundSide::B => {
+                let (_, twist) = swing_twist(delta, local.normal);
+                let (then, centre) = (entry.b_in_a.translation, b_in_a.translation);
+                carried(local, &since, pose_a, local.normal, |p, _| {
+                    centre + twist * (p - then)
+                })
+            }
         };
-        let normal = match entry.round {
-            RoundSide::A => swing * local.normal,
-            RoundSide::Neither | RoundSide::B => local.normal,
-        };
-        let mut now = ContactManifold::new(pose_a.transform_vector(normal));
-        // B's centre then and now (A's frame).
-        let (then, centre) = (entry.b_in_a.translation, b_in_a.translation);
-        for p in local.points() {
-            // Where the point of B that was at `p` at the test is now (A's frame).
-            let motion = since.transform_point(p.point) - p.point;
-            let point = match entry.round {
-                // Midway between the bodies' points.
-                RoundSide::Neither => p.point + motion * 0.5,
-                // Where round A now faces B's tilted face.
-                RoundSide::A => swing * p.point,
-                // Round B's point, carried by its centre and its twist.
-                RoundSide::B => centre + twist * (p.point - then),
-            };
-            now.push(ContactPoint {
-                point: pose_a.transform_point(point),
-                depth: p.depth - motion.dot(local.normal),
-            });
-        }
         Some(Some(now))
     }
 
