@@ -7,6 +7,7 @@ mod common;
 
 mod bounces_and_springs;
 mod games;
+mod platforms;
 mod rolling;
 
 use bevy_app::App;

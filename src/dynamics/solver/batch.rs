@@ -50,6 +50,8 @@ struct ContactBatch {
     /// `mass_scale · bias_rate`, `mass_scale`, `impulse_scale` of each lane's softness.
     softness: [Lanes; 3],
     closing_acceleration: Lanes,
+    /// Which lanes are impacts (all bits set; [`ContactConstraint::impact`]).
+    impacts: Lanes,
     /// The batch's first point in [`ContactBatches::points`].
     first: u32,
     /// The most points any lane has: the batch's points in that list.
@@ -357,6 +359,7 @@ impl ContactBatch {
                 each(|c| c.softness.impulse_scale),
             ],
             closing_acceleration: each(|c| c.closing_acceleration),
+            impacts: each(|c| f32::from(u8::from(c.impact))).simd_gt(Lanes::ZERO),
             first: first_point,
             count,
             rows,
@@ -375,69 +378,6 @@ fn warm_start_patch(batch: &ContactBatch, patch: &PatchX4, pair: &mut PairVeloci
     pair.twist(patch, patch.twist_impulse);
 }
 
-/// The normal rows: speculative points close their gap, penetrating ones are pushed out
-/// softly when the pass is biased.
-fn solve_normals(
-    batch: &ContactBatch,
-    points: &mut [PointX4],
-    pair: &mut PairVelocities,
-    states: &[BodyState],
-    pass: &Pass,
-) {
-    let state = |i: u32| &states[i as usize];
-    // A still side has not moved: the rest state's constants (the same bits as its states).
-    let motion = |k: usize| {
-        if batch.still[k] {
-            return (Vec3x4::ZERO, Quatx4::IDENTITY);
-        }
-        let slots = batch.bodies[k];
-        (
-            Vec3x4::gather(slots.map(|i| state(i).delta_position)),
-            Quatx4::gather(slots.map(|i| state(i).delta_rotation)),
-        )
-    };
-    let ((moved_a, dqa), (moved_b, dqb)) = (motion(0), motion(1));
-    let moved = moved_b - moved_a;
-    let (zero, one) = (Lanes::ZERO, Lanes::ONE);
-    let [bias_rate, soft_mass, soft_impulse] = if pass.use_bias {
-        batch.softness
-    } else {
-        [zero, one, zero]
-    };
-    let (inv_h, most_push) = (Lanes::splat(pass.inv_h), Lanes::splat(-pass.max_push_out));
-    let n = batch.normal;
-    // The normal in each body's rotation since the step's start, once for all points (see
-    // `ContactConstraint::solve`).
-    let (moved, na, nb) = (moved.dot(n), dqa.inverse_rotate(n), dqb.inverse_rotate(n));
-    let count = points.len();
-    for k in 0..count {
-        let i = if pass.flip { count - 1 - k } else { k };
-        let p = &mut points[i];
-        let s = p.base_separation + moved + p.anchor_b.dot(nb) - p.anchor_a.dot(na);
-        let apart = s.simd_gt(zero);
-        let push_out = if pass.use_bias {
-            (bias_rate * s).max(most_push)
-        } else {
-            zero
-        };
-        let bias = apart.select(s * inv_h, push_out);
-        let mass_scale = apart.select(one, soft_mass);
-        let impulse_scale = apart.select(zero, soft_impulse);
-        let row = &p.row(&p.normal_row, n);
-        let vn = pair.along(n, row);
-        let impulse = -row.mass * (mass_scale * vn + bias) - impulse_scale * p.normal_impulse;
-        let total = (p.normal_impulse + impulse).max(zero);
-        pair.push(batch.inverse_mass, n, &row.turn, total - p.normal_impulse);
-        let first = p.max_normal_impulse.simd_eq(zero) & total.simd_gt(zero);
-        if first.any() {
-            let speed = impact_speed(vn, s, batch.closing_acceleration);
-            p.relative_velocity = first.select(speed, p.relative_velocity);
-        }
-        p.normal_impulse = total;
-        p.max_normal_impulse = p.max_normal_impulse.max(total);
-    }
-}
-
 /// Coulomb friction at each point: both tangent rows clamped together to the disc `μ λ_n`.
 fn solve_friction(
     batch: &ContactBatch,
@@ -453,7 +393,11 @@ fn solve_friction(
             continue;
         }
         let limit = batch.friction * p.normal_impulse;
-        let rows = [0, 1].map(|k| p.row(&f.rows[k], batch.tangents[k]));
+        // Written out, not `[0, 1].map(..)` (see `Vec3x4::gather`).
+        let rows = [
+            p.row(&f.rows[0], batch.tangents[0]),
+            p.row(&f.rows[1], batch.tangents[1]),
+        ];
         f.impulse = pair.solve_disc(
             &rows,
             batch.tangents,
@@ -499,15 +443,9 @@ fn solve_patch(
     );
 }
 
-/// [`contact`](super::contact)'s `impact_speed` per lane: a speculative point approaching at
-/// `vn` from `s` away meets the surface at `−√(vn² − 2 a s)`.
-fn impact_speed(vn: Lanes, s: Lanes, closing: Lanes) -> Lanes {
-    let zero = Lanes::ZERO;
-    let squared = vn * vn - Lanes::splat(2.0) * closing * s;
-    let faster =
-        s.simd_gt(zero) & vn.simd_lt(zero) & squared.is_finite() & squared.simd_gt(vn * vn);
-    faster.select(-squared.sqrt(), vn)
-}
+#[path = "batch_normals.rs"]
+mod normals;
+use normals::solve_normals;
 
 #[cfg(test)]
 #[path = "batch_tests.rs"]

@@ -11,6 +11,7 @@ use glam::Vec3;
 
 /// The velocities of a constraint's two bodies, copied out for one pass (only dynamic bodies
 /// are written back).
+#[derive(Clone, Copy)]
 pub(super) struct Pair {
     pub va: Vec3,
     pub wa: Vec3,

@@ -39,7 +39,10 @@ impl Vec3x4 {
     /// Lane `i` holds `v[i]` (by a 4×4 transpose, as [`Self::to_vecs`]).
     #[inline]
     pub fn gather(v: [Vec3; LANES]) -> Self {
-        let [x, y, z, _] = Lanes::transpose(v.map(|v| Lanes::new([v.x, v.y, v.z, 0.0])));
+        // Written out, not `v.map(..)`: an array map's closure may stay out of line in the
+        // passes (the pyramid's solve spent 6 % of its instructions calling one).
+        let lane = |v: Vec3| Lanes::new([v.x, v.y, v.z, 0.0]);
+        let [x, y, z, _] = Lanes::transpose([lane(v[0]), lane(v[1]), lane(v[2]), lane(v[3])]);
         Self { x, y, z }
     }
 
@@ -222,16 +225,27 @@ impl PairVelocities {
     /// moves, see [`ContactConstraint::still`](super::contact::ContactConstraint::still)) is
     /// the zeros its states hold, not gathered.
     pub fn load([a, b]: &Slots, still: [bool; 2], states: &[BodyState]) -> Self {
-        let state = |i: u32| &states[i as usize];
         let side = |slots: &[u32; LANES], still: bool| {
             if still {
-                (Vec3x4::ZERO, Vec3x4::ZERO)
-            } else {
-                (
-                    Vec3x4::gather(slots.map(|i| state(i).linear_velocity)),
-                    Vec3x4::gather(slots.map(|i| state(i).angular_velocity)),
-                )
+                return (Vec3x4::ZERO, Vec3x4::ZERO);
             }
+            // Written out, not `slots.map(..)` (see `Vec3x4::gather`).
+            let at = |l: usize| &states[slots[l] as usize];
+            let (s0, s1, s2, s3) = (at(0), at(1), at(2), at(3));
+            (
+                Vec3x4::gather([
+                    s0.linear_velocity,
+                    s1.linear_velocity,
+                    s2.linear_velocity,
+                    s3.linear_velocity,
+                ]),
+                Vec3x4::gather([
+                    s0.angular_velocity,
+                    s1.angular_velocity,
+                    s2.angular_velocity,
+                    s3.angular_velocity,
+                ]),
+            )
         };
         let ((va, wa), (vb, wb)) = (side(a, still[0]), side(b, still[1]));
         Self { va, wa, vb, wb }

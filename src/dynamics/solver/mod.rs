@@ -20,7 +20,8 @@
 //!       Gauss–Seidel favours none of them);
 //!    3. **solve** — one biased pass, joints before contacts (Box2D's order: the contacts, last,
 //!       win a conflict): penetration pushed out softly, speculative points closed, joint
-//!       errors closed at [`SoftStepSettings::joint_hertz`];
+//!       errors closed at [`SoftStepSettings::joint_hertz`]; an impact's points are swept
+//!       until they agree, in this pass and the relax passes (`contact_normals.rs`);
 //!    4. **integrate positions** — each body's motion since the step's start (`dp`, `dq`),
 //!       a dynamic body's speed at most [`SoftStepSettings::max_linear_speed`] and every
 //!       body's turn at most [`SoftStepSettings::max_rotation_per_substep`]; the joints' rows

@@ -20,6 +20,7 @@ mod convex;
 mod friction_models;
 mod ghost_edges;
 mod joints;
+mod landing;
 mod locked_axes;
 mod resting;
 

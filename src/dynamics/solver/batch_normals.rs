@@ -1,0 +1,191 @@
+//! The normal rows of a contact batch, four contacts side by side: speculative points close
+//! their gap, penetrating ones are pushed out softly when the pass is biased. A lane's points
+//! are swept again, in the other order, while its last sweep changed some point's normal speed
+//! by more than [`SETTLED_SPEED`], at most [`MAX_SWEEPS`] times (why: `contact_normals.rs`).
+//! The other lanes keep what they have, so each lane computes exactly its contact's scalar
+//! solve (the lanes move no common body). The first sweep is the hot path; the rare further
+//! ones are out of line.
+
+use super::*;
+use crate::dynamics::solver::contact::{MAX_SWEEPS, SETTLED_SPEED};
+
+/// What each sweep of one pass over a batch's normal rows reads, taken once per pass.
+struct NormalPass {
+    normal: Vec3x4,
+    /// `(Δp_b − Δp_a)·n` per lane: the bodies' motion since the step's start along the normal.
+    moved: Lanes,
+    /// The normal turned back into A's and B's rotation since the step's start (see
+    /// `ContactConstraint::solve_normals`).
+    turned: [Vec3x4; 2],
+    /// `mass_scale · bias_rate`, `mass_scale`, `impulse_scale` of the pass (the relax passes:
+    /// no bias, rigid).
+    softness: [Lanes; 3],
+    inv_h: Lanes,
+    most_push: Lanes,
+    use_bias: bool,
+    inverse_mass: [Lanes; 2],
+    closing_acceleration: Lanes,
+}
+
+/// One pass over the normal rows of `batch` (module docs). Inlined into the pass: called, it
+/// kept the batch's velocities in memory across the call (10 % more instructions in the pass).
+#[inline(always)]
+pub(super) fn solve_normals(
+    batch: &ContactBatch,
+    points: &mut [PointX4],
+    pair: &mut PairVelocities,
+    states: &[BodyState],
+    pass: &Pass,
+) {
+    let normals = NormalPass::new(batch, states, pass);
+    // The velocities before this pass's impulses, for the impact speeds (see
+    // `ConstraintPoint::relative_velocity`).
+    let before = *pair;
+    // One sweep solves a lone point's row exactly (balls need no second), and only impacts
+    // may need more: the other batches do not even track what a sweep changed.
+    if points.len() > 1 && batch.impacts.any() {
+        let swept = normals.sweep::<false, true>(points, pair, &before, pass.flip, Lanes::ZERO);
+        let unsettled = swept & batch.impacts;
+        if unsettled.any() {
+            normals.sweep_again(points, pair, &before, !pass.flip, unsettled);
+        }
+    } else {
+        normals.sweep::<false, false>(points, pair, &before, pass.flip, Lanes::ZERO);
+    }
+}
+
+impl NormalPass {
+    /// Inlined, as [`solve_normals`]: returned through memory, it was read back by each sweep.
+    #[inline(always)]
+    fn new(batch: &ContactBatch, states: &[BodyState], pass: &Pass) -> Self {
+        // A still side has not moved: the rest state's constants (the same bits as its states).
+        let motion = |k: usize| {
+            if batch.still[k] {
+                return (Vec3x4::ZERO, Quatx4::IDENTITY);
+            }
+            // Written out, not `slots.map(..)` (see `Vec3x4::gather`).
+            let at = |l: usize| &states[batch.bodies[k][l] as usize];
+            let (s0, s1, s2, s3) = (at(0), at(1), at(2), at(3));
+            (
+                Vec3x4::gather([
+                    s0.delta_position,
+                    s1.delta_position,
+                    s2.delta_position,
+                    s3.delta_position,
+                ]),
+                Quatx4::gather([
+                    s0.delta_rotation,
+                    s1.delta_rotation,
+                    s2.delta_rotation,
+                    s3.delta_rotation,
+                ]),
+            )
+        };
+        let ((moved_a, dqa), (moved_b, dqb)) = (motion(0), motion(1));
+        let n = batch.normal;
+        let (zero, one) = (Lanes::ZERO, Lanes::ONE);
+        Self {
+            normal: n,
+            moved: (moved_b - moved_a).dot(n),
+            turned: [dqa.inverse_rotate(n), dqb.inverse_rotate(n)],
+            softness: if pass.use_bias {
+                batch.softness
+            } else {
+                [zero, one, zero]
+            },
+            inv_h: Lanes::splat(pass.inv_h),
+            most_push: Lanes::splat(-pass.max_push_out),
+            use_bias: pass.use_bias,
+            inverse_mass: batch.inverse_mass,
+            closing_acceleration: batch.closing_acceleration,
+        }
+    }
+
+    /// The sweeps after the first, for the lanes still `unsettled` (rare: impacts, or a warm
+    /// start far from the step's answer), each the other way round from the last.
+    #[inline(never)]
+    #[cold]
+    fn sweep_again(
+        &self,
+        points: &mut [PointX4],
+        pair: &mut PairVelocities,
+        before: &PairVelocities,
+        mut backwards: bool,
+        mut unsettled: Lanes,
+    ) {
+        for _ in 1..MAX_SWEEPS {
+            unsettled = self.sweep::<true, true>(points, pair, before, backwards, unsettled);
+            if !unsettled.any() {
+                break;
+            }
+            backwards = !backwards;
+        }
+    }
+
+    /// One sweep over the points of every lane, or (`MASKED`) of the `active` lanes only (the
+    /// others keep their impulses); the lanes in which it changed some point's normal speed by
+    /// more than [`SETTLED_SPEED`] (when `TRACKED`; else none).
+    #[inline(always)]
+    fn sweep<const MASKED: bool, const TRACKED: bool>(
+        &self,
+        points: &mut [PointX4],
+        pair: &mut PairVelocities,
+        before: &PairVelocities,
+        backwards: bool,
+        active: Lanes,
+    ) -> Lanes {
+        let zero = Lanes::ZERO;
+        let [bias_rate, soft_mass, soft_impulse] = self.softness;
+        let [na, nb] = self.turned;
+        let (n, settled) = (self.normal, Lanes::splat(SETTLED_SPEED));
+        let mut unsettled = zero.simd_ne(zero);
+        let count = points.len();
+        for k in 0..count {
+            let i = if backwards { count - 1 - k } else { k };
+            let p = &mut points[i];
+            let s = p.base_separation + self.moved + p.anchor_b.dot(nb) - p.anchor_a.dot(na);
+            let apart = s.simd_gt(zero);
+            let push_out = if self.use_bias {
+                (bias_rate * s).max(self.most_push)
+            } else {
+                zero
+            };
+            let bias = apart.select(s * self.inv_h, push_out);
+            let mass_scale = apart.select(Lanes::ONE, soft_mass);
+            let impulse_scale = apart.select(zero, soft_impulse);
+            let row = &p.row(&p.normal_row, n);
+            let vn = pair.along(n, row);
+            let impulse = -row.mass * (mass_scale * vn + bias) - impulse_scale * p.normal_impulse;
+            let total = (p.normal_impulse + impulse).max(zero);
+            let total = if MASKED {
+                active.select(total, p.normal_impulse)
+            } else {
+                total
+            };
+            let applied = total - p.normal_impulse;
+            // `applied / mass` is the change of the point's normal speed.
+            if TRACKED {
+                unsettled |= applied.abs().simd_gt(settled * row.mass);
+            }
+            pair.push(self.inverse_mass, n, &row.turn, applied);
+            let first = p.max_normal_impulse.simd_eq(zero) & total.simd_gt(zero);
+            if first.any() {
+                let speed = impact_speed(before.along(n, row), s, self.closing_acceleration);
+                p.relative_velocity = first.select(speed, p.relative_velocity);
+            }
+            p.normal_impulse = total;
+            p.max_normal_impulse = p.max_normal_impulse.max(total);
+        }
+        unsettled
+    }
+}
+
+/// [`contact`](super::super::contact)'s `impact_speed` per lane: a speculative point
+/// approaching at `vn` from `s` away meets the surface at `−√(vn² − 2 a s)`.
+fn impact_speed(vn: Lanes, s: Lanes, closing: Lanes) -> Lanes {
+    let zero = Lanes::ZERO;
+    let squared = vn * vn - Lanes::splat(2.0) * closing * s;
+    let faster =
+        s.simd_gt(zero) & vn.simd_lt(zero) & squared.is_finite() & squared.simd_gt(vn * vn);
+    faster.select(-squared.sqrt(), vn)
+}
