@@ -1,10 +1,10 @@
 //! The normal rows of a contact batch, four contacts side by side: speculative points close
-//! their gap, penetrating ones are pushed out softly when the pass is biased. A lane's points
-//! are swept again, in the other order, while its last sweep changed some point's normal speed
-//! by more than [`SETTLED_SPEED`], at most [`MAX_SWEEPS`] times (why: `contact_normals.rs`).
-//! The other lanes keep what they have, so each lane computes exactly its contact's scalar
-//! solve (the lanes move no common body). The first sweep is the hot path; the rare further
-//! ones are out of line.
+//! their gap, penetrating ones are pushed out softly when the pass is biased. The points of a
+//! lane that is an impact (`ContactConstraint::impact`) are swept again, in the other order,
+//! while its last sweep changed some point's normal speed by more than [`SETTLED_SPEED`], at
+//! most [`MAX_SWEEPS`] times (why: `contact_normals.rs`). The other lanes keep what they
+//! have, so each lane computes exactly its contact's scalar solve (the lanes move no common
+//! body). The first sweep is the hot path; the rare further ones are out of line.
 
 use super::*;
 use crate::dynamics::solver::contact::{MAX_SWEEPS, SETTLED_SPEED};
