@@ -9,9 +9,10 @@
 use super::*;
 use crate::dynamics::solver::contact::{MAX_SWEEPS, SETTLED_SPEED};
 
-/// What each sweep of one pass over a batch's normal rows reads, taken once per pass.
-struct NormalPass {
-    normal: Vec3x4,
+/// What each sweep of one pass over a batch's normal rows reads: the batch, and what the
+/// pass adds to it, taken once per pass.
+struct NormalPass<'a> {
+    batch: &'a ContactBatch,
     /// `(Δp_b − Δp_a)·n` per lane: the bodies' motion since the step's start along the normal.
     moved: Lanes,
     /// The normal turned back into A's and B's rotation since the step's start (see
@@ -23,8 +24,6 @@ struct NormalPass {
     inv_h: Lanes,
     most_push: Lanes,
     use_bias: bool,
-    inverse_mass: [Lanes; 2],
-    closing_acceleration: Lanes,
 }
 
 /// One pass over the normal rows of `batch` (module docs). Inlined into the pass: called, it
@@ -54,10 +53,10 @@ pub(super) fn solve_normals(
     }
 }
 
-impl NormalPass {
+impl<'a> NormalPass<'a> {
     /// Inlined, as [`solve_normals`]: returned through memory, it was read back by each sweep.
     #[inline(always)]
-    fn new(batch: &ContactBatch, states: &[BodyState], pass: &Pass) -> Self {
+    fn new(batch: &'a ContactBatch, states: &[BodyState], pass: &Pass) -> Self {
         // A still side has not moved: the rest state's constants (the same bits as its states).
         let motion = |k: usize| {
             if batch.still[k] {
@@ -85,7 +84,7 @@ impl NormalPass {
         let n = batch.normal;
         let (zero, one) = (Lanes::ZERO, Lanes::ONE);
         Self {
-            normal: n,
+            batch,
             moved: (moved_b - moved_a).dot(n),
             turned: [dqa.inverse_rotate(n), dqb.inverse_rotate(n)],
             softness: if pass.use_bias {
@@ -96,13 +95,11 @@ impl NormalPass {
             inv_h: Lanes::splat(pass.inv_h),
             most_push: Lanes::splat(-pass.max_push_out),
             use_bias: pass.use_bias,
-            inverse_mass: batch.inverse_mass,
-            closing_acceleration: batch.closing_acceleration,
         }
     }
 
-    /// The sweeps after the first, for the lanes still `unsettled` (rare: impacts, or a warm
-    /// start far from the step's answer), each the other way round from the last.
+    /// The sweeps after the first, for the impacts' lanes still `unsettled` (rare), each the
+    /// other way round from the last.
     #[inline(never)]
     #[cold]
     fn sweep_again(
@@ -137,7 +134,7 @@ impl NormalPass {
         let zero = Lanes::ZERO;
         let [bias_rate, soft_mass, soft_impulse] = self.softness;
         let [na, nb] = self.turned;
-        let (n, settled) = (self.normal, Lanes::splat(SETTLED_SPEED));
+        let (n, settled) = (self.batch.normal, Lanes::splat(SETTLED_SPEED));
         let mut unsettled = zero.simd_ne(zero);
         let count = points.len();
         for k in 0..count {
@@ -167,10 +164,11 @@ impl NormalPass {
             if TRACKED {
                 unsettled |= applied.abs().simd_gt(settled * row.mass);
             }
-            pair.push(self.inverse_mass, n, &row.turn, applied);
+            pair.push(self.batch.inverse_mass, n, &row.turn, applied);
             let first = p.max_normal_impulse.simd_eq(zero) & total.simd_gt(zero);
             if first.any() {
-                let speed = impact_speed(before.along(n, row), s, self.closing_acceleration);
+                let closing = self.batch.closing_acceleration;
+                let speed = impact_speed(before.along(n, row), s, closing);
                 p.relative_velocity = first.select(speed, p.relative_velocity);
             }
             p.normal_impulse = total;

@@ -333,10 +333,8 @@ impl ContactConstraint {
         self.dynamic = [pa.dynamic, pb.dynamic];
         self.still = still;
         self.closing_acceleration = (pb.linear_acceleration - pa.linear_acceleration).dot(n);
-        let speeds = self.points[..count]
-            .iter()
-            .map(|p| p.relative_velocity.abs());
-        self.impact = speeds.fold(0.0, f32::max) > IMPACT_SPEED;
+        let fast = |p: &ConstraintPoint| p.relative_velocity.abs() > IMPACT_SPEED;
+        self.impact = self.points[..count].iter().any(fast);
         self.rolling = RollingRows::new(
             input.rolling_resistance,
             tangents,
