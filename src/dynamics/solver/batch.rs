@@ -62,6 +62,9 @@ struct ContactBatch {
     rows: FrictionRows,
     /// Whether any lane has friction.
     rubs: bool,
+    /// Whether any lane's friction rows may have a drift target
+    /// ([`ContactConstraint::turning`]): the others solve them without one.
+    turns: bool,
 }
 
 /// Where a batch's friction rows are ([`ContactBatch::rows`]).
@@ -204,7 +207,11 @@ impl ContactBatches {
                 match batch.rows {
                     FrictionRows::PerPoint(from) => {
                         let frictions = &mut self.frictions[batch.range(from)];
-                        solve_friction(batch, points, frictions, &mut pair);
+                        if batch.turns {
+                            solve_friction::<true>(batch, points, frictions, &mut pair);
+                        } else {
+                            solve_friction::<false>(batch, points, frictions, &mut pair);
+                        }
                     }
                     FrictionRows::Patch(at) => {
                         solve_patch(batch, points, &mut self.patches[at as usize], &mut pair);
@@ -364,6 +371,7 @@ impl ContactBatch {
             count,
             rows,
             rubs: lanes.iter().flatten().any(|c| c.friction > 0.0),
+            turns: lanes.iter().flatten().any(|c| c.turning),
         }
     }
 }
@@ -378,8 +386,10 @@ fn warm_start_patch(batch: &ContactBatch, patch: &PatchX4, pair: &mut PairVeloci
     pair.twist(patch, patch.twist_impulse);
 }
 
-/// Coulomb friction at each point: both tangent rows clamped together to the disc `μ λ_n`.
-fn solve_friction(
+/// Coulomb friction at each point: both tangent rows clamped together to the disc `μ λ_n`,
+/// with their drift targets when `DRIFT` (a batch none of whose lanes turns has none, and
+/// does not read them).
+fn solve_friction<const DRIFT: bool>(
     batch: &ContactBatch,
     points: &[PointX4],
     frictions: &mut [FrictionX4],
@@ -398,10 +408,10 @@ fn solve_friction(
             p.row(&f.rows[0], batch.tangents[0]),
             p.row(&f.rows[1], batch.tangents[1]),
         ];
-        f.impulse = pair.solve_disc(
+        f.impulse = pair.solve_disc::<DRIFT>(
             &rows,
             batch.tangents,
-            f.impulse,
+            (f.impulse, f.drift),
             (limit, batch.inverse_mass),
         );
     }
@@ -435,10 +445,10 @@ fn solve_patch(
     pair.twist(patch, twist - old);
     patch.twist_impulse = twist;
     let rows = patch.tangent_rows;
-    patch.tangent_impulse = pair.solve_disc(
+    patch.tangent_impulse = pair.solve_disc::<true>(
         &rows,
         batch.tangents,
-        patch.tangent_impulse,
+        (patch.tangent_impulse, patch.tangent_drift),
         (limit, batch.inverse_mass),
     );
 }

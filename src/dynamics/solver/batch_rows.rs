@@ -113,6 +113,8 @@ impl PointX4 {
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct FrictionX4 {
     pub rows: [PointRowX4; 2],
+    /// [`ConstraintPoint::tangent_drift`].
+    pub drift: [Lanes; 2],
     pub impulse: [Lanes; 2],
 }
 
@@ -124,6 +126,7 @@ impl FrictionX4 {
                 PointRowX4::gather(points.map(|p| &p.tangent_rows[0])),
                 PointRowX4::gather(points.map(|p| &p.tangent_rows[1])),
             ],
+            drift: [each(|p| p.tangent_drift[0]), each(|p| p.tangent_drift[1])],
             impulse: [
                 each(|p| p.tangent_impulse[0]),
                 each(|p| p.tangent_impulse[1]),
@@ -144,6 +147,7 @@ pub(super) struct PatchX4 {
     pub twist_turn: [Vec3x4; 2],
     pub twist_mass: Lanes,
     pub arms: [Lanes; MAX_MANIFOLD_POINTS],
+    pub tangent_drift: [Lanes; 2],
     pub tangent_impulse: [Lanes; 2],
     pub twist_impulse: Lanes,
 }
@@ -160,6 +164,7 @@ impl PatchX4 {
             twist_turn: [side(|p| p.twist_turn[0]), side(|p| p.twist_turn[1])],
             twist_mass: each(|p| p.twist_mass),
             arms: std::array::from_fn(|k| Lanes::new(patches.map(|p| p.arms[k]))),
+            tangent_drift: [each(|p| p.tangent_drift[0]), each(|p| p.tangent_drift[1])],
             tangent_impulse: [
                 each(|p| p.tangent_impulse[0]),
                 each(|p| p.tangent_impulse[1]),
@@ -204,19 +209,24 @@ impl PairVelocities {
         self.wb = self.wb + patch.twist_turn[1] * lambda;
     }
 
-    /// Two tangent rows clamped together to the disc `|λ| ≤ limit`, as the scalar rows: the new
-    /// accumulated impulses from the `old` ones.
+    /// Two tangent rows clamped together to the disc `|λ| ≤ limit`, each solving
+    /// `J V + drift = 0` (`J V = 0`, the drift unread, unless `DRIFT`), as the scalar rows: the
+    /// new accumulated impulses from the `old` ones.
     #[inline(always)]
-    pub(super) fn solve_disc(
+    pub(super) fn solve_disc<const DRIFT: bool>(
         &mut self,
         [r0, r1]: &[RowX4; 2],
         [t0, t1]: [Vec3x4; 2],
-        [old0, old1]: [Lanes; 2],
+        ([old0, old1], [drift0, drift1]): ([Lanes; 2], [Lanes; 2]),
         (limit, inverse_mass): (Lanes, [Lanes; 2]),
     ) -> [Lanes; 2] {
         let (zero, one) = (Lanes::ZERO, Lanes::ONE);
-        let w0 = old0 - r0.mass * self.along(t0, r0);
-        let w1 = old1 - r1.mass * self.along(t1, r1);
+        let (mut v0, mut v1) = (self.along(t0, r0), self.along(t1, r1));
+        if DRIFT {
+            (v0, v1) = (v0 + drift0, v1 + drift1);
+        }
+        let w0 = old0 - r0.mass * v0;
+        let w1 = old1 - r1.mass * v1;
         let length = (w0 * w0 + w1 * w1).sqrt();
         let clamped = length.simd_gt(limit) & length.simd_gt(zero);
         let scale = clamped.select(limit / length, one);

@@ -3,7 +3,7 @@
 use super::*;
 use crate::dynamics::solver::contact::on_moving;
 use crate::dynamics::solver::{
-    BodyInput, ContactInput, ContactPointInput, FrictionModel, Softness, SolverBodies,
+    BodyInput, ContactInput, ContactPointInput, FrictionModel, RowSettings, Softness, SolverBodies,
 };
 use glam::Quat;
 
@@ -82,15 +82,25 @@ fn scene_with(model: FrictionModel, grounds: bool) -> (SolverBodies, Vec<Contact
                 &bodies.centers,
                 &bodies.states,
                 &bodies.params,
-                (softness, model),
+                RowSettings {
+                    softness,
+                    friction: model,
+                    step: 1.0 / 60.0,
+                },
             );
+            // Drift targets (`anchor_drift.rs`) on the first two contacts: their bodies
+            // slide too fast for the targets preparation gives, and the rows solve them.
+            c.turning = k < 2;
+            let drift = if c.turning { 0.05 } else { 0.0 };
             for (j, p) in c.points.iter_mut().enumerate() {
                 p.normal_impulse = 0.1 * j as f32;
                 p.tangent_impulse = [0.02, -0.01 * j as f32];
+                p.tangent_drift = [drift, -drift * j as f32];
             }
             if let Some(patch) = &mut c.patch {
                 patch.tangent_impulse = [0.03, -0.02];
                 patch.twist_impulse = 0.01 * k as f32;
+                patch.tangent_drift = [drift, drift];
             }
             c
         })

@@ -32,7 +32,13 @@
 //! pass only, as Box2D does: friction in the biased pass fights the push-out and lets stacks
 //! creep. Under [`FrictionModel::Patch`] the points carry no friction rows: the contact's
 //! [`PatchFriction`] (two rows at the points' centre and a twist) takes their place.
+//!
+//! A friction row solves `J V + drift = 0`, not `J V = 0`: with the anchors held for the step,
+//! a point sticking on a body that spins about the normal (a turntable) would move along the
+//! step's chord and drift outward; `drift` (`anchor_drift.rs`, zero without such a spin) is
+//! the velocity that keeps it on its arc.
 
+use super::anchor_drift::AnchorDrift;
 use super::body::{BodyParams, BodyState, same_on_every_axis};
 use super::contact_pair::Pair;
 use super::patch_friction::{FrictionModel, PatchFriction};
@@ -89,6 +95,10 @@ pub struct ConstraintPoint {
     pub normal_row: PointRow,
     /// The two friction rows.
     pub tangent_rows: [PointRow; 2],
+    /// What the friction rows add to their relative velocity, `J V + drift = 0`: the drift
+    /// of the anchors as the bodies turn over the step (`anchor_drift.rs`; zero when neither
+    /// turns).
+    pub tangent_drift: [f32; 2],
     /// Accumulated normal impulse of the current substep (N·s).
     pub normal_impulse: f32,
     /// Accumulated friction impulses along the two tangents.
@@ -166,6 +176,21 @@ pub struct ContactConstraint {
     /// Whether a point closes or parts faster than [`IMPACT_SPEED`] at the step's start: only
     /// then are the points swept more than once a pass (`contact_normals.rs`).
     pub impact: bool,
+    /// Whether a body spins about the normal (`anchor_drift.rs`): only then may the friction
+    /// rows have a drift target, and a batch without one solves its rows without it.
+    pub turning: bool,
+}
+
+/// How a step prepares its contacts' rows ([`ContactConstraint::prepare`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RowSettings {
+    /// Softness of the push-out.
+    pub softness: Softness,
+    /// Friction rows per point or per patch.
+    pub friction: FrictionModel,
+    /// The step's duration (s), over which the anchors are held (the friction rows' drift,
+    /// `anchor_drift.rs`).
+    pub step: f32,
 }
 
 /// A point's anchor `r` as the separation reads it: zero on a still body
@@ -230,13 +255,13 @@ fn point_velocity(s: &BodyState, r: Vec3) -> Vec3 {
 
 impl ContactConstraint {
     /// Builds the rows from detection data at the step's start (`centers`: centres of mass),
-    /// with friction rows per point or per patch as `model` says.
+    /// with friction rows per point or per patch as `settings` say.
     pub fn prepare(
         input: &ContactInput,
         centers: &[Vec3],
         states: &[BodyState],
         params: &[BodyParams],
-        (softness, model): (Softness, FrictionModel),
+        settings: RowSettings,
     ) -> Self {
         let mut c = Self {
             a: 0,
@@ -245,7 +270,7 @@ impl ContactConstraint {
             tangents: [Vec3::ZERO; 2],
             friction: 0.0,
             restitution: 0.0,
-            softness,
+            softness: settings.softness,
             points: [ConstraintPoint::default(); MAX_MANIFOLD_POINTS],
             count: 0,
             key: 0,
@@ -258,8 +283,9 @@ impl ContactConstraint {
             patch: None,
             closing_acceleration: 0.0,
             impact: false,
+            turning: false,
         };
-        c.refill(input, centers, states, params, (softness, model));
+        c.refill(input, centers, states, params, settings);
         c
     }
 
@@ -275,8 +301,13 @@ impl ContactConstraint {
         centers: &[Vec3],
         states: &[BodyState],
         params: &[BodyParams],
-        (softness, model): (Softness, FrictionModel),
+        settings: RowSettings,
     ) {
+        let RowSettings {
+            softness,
+            friction: model,
+            step,
+        } = settings;
         let (ia, ib) = (input.a as usize, input.b as usize);
         let (pa, pb) = (&params[ia], &params[ib]);
         let n = input.normal;
@@ -293,6 +324,12 @@ impl ContactConstraint {
         let count = (input.count as usize).min(MAX_MANIFOLD_POINTS);
         let per_point = model == FrictionModel::PerPoint;
         let still = [(pa, ia), (pb, ib)].map(|(p, i)| !p.dynamic && at_rest(&states[i]));
+        let (sa, sb) = (&states[ia], &states[ib]);
+        let velocities = [
+            (sa.linear_velocity, sa.angular_velocity),
+            (sb.linear_velocity, sb.angular_velocity),
+        ];
+        let drift = AnchorDrift::new(velocities, n, tangents, 0.5 * step);
         for (cp, p) in self.points.iter_mut().zip(&input.points[..count]) {
             let ra = p.point - centers[ia];
             let rb = p.point - centers[ib];
@@ -313,6 +350,10 @@ impl ContactConstraint {
                 } else {
                     [PointRow::default(); 2]
                 },
+                tangent_drift: match &drift {
+                    Some(drift) if per_point => drift.at(ra, rb),
+                    _ => [0.0; 2],
+                },
                 relative_velocity: relative.dot(n),
                 ..Default::default()
             };
@@ -332,6 +373,7 @@ impl ContactConstraint {
             !same_on_every_axis(pa.inverse_mass) || !same_on_every_axis(pb.inverse_mass);
         self.dynamic = [pa.dynamic, pb.dynamic];
         self.still = still;
+        self.turning = drift.is_some();
         self.closing_acceleration = (pb.linear_acceleration - pa.linear_acceleration).dot(n);
         let fast = |p: &ConstraintPoint| p.relative_velocity.abs() > IMPACT_SPEED;
         self.impact = self.points[..count].iter().any(fast);
@@ -346,8 +388,8 @@ impl ContactConstraint {
                 [pa, pb],
                 &points[..count],
                 [centers[ia], centers[ib]],
-                n,
-                sides,
+                (n, sides),
+                drift.as_ref(),
             )
         });
     }
@@ -429,7 +471,7 @@ impl ContactConstraint {
             cp.tangent_impulse = pair.solve_disc(
                 &rows,
                 self.tangents,
-                cp.tangent_impulse,
+                (cp.tangent_impulse, cp.tangent_drift),
                 (limit, self.inverse_mass),
             );
         }

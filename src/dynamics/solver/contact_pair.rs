@@ -57,18 +57,19 @@ impl Pair {
     }
 
     /// Two tangent rows clamped together to the disc `|λ| ≤ limit` (Coulomb friction, at a
-    /// point or a patch centre): the new accumulated impulses from the `old` ones.
+    /// point or a patch centre), each solving `J V + drift = 0` (`anchor_drift.rs`): the new
+    /// accumulated impulses from the `old` ones.
     pub(super) fn solve_disc(
         &mut self,
         [r0, r1]: &[RowPart; 2],
         [t0, t1]: [Vec3; 2],
-        [old0, old1]: [f32; 2],
+        ([old0, old1], [drift0, drift1]): ([f32; 2], [f32; 2]),
         (limit, inverse_mass): (f32, [Vec3; 2]),
     ) -> [f32; 2] {
         // Written out, not `[0, 1].map(..)`: the array map's drain was a tenth of the
         // solver's instructions (callgrind).
-        let w0 = old0 - r0.mass * self.along(t0, r0);
-        let w1 = old1 - r1.mass * self.along(t1, r1);
+        let w0 = old0 - r0.mass * (self.along(t0, r0) + drift0);
+        let w1 = old1 - r1.mass * (self.along(t1, r1) + drift1);
         let length = (w0 * w0 + w1 * w1).sqrt();
         let scale = if length > limit && length > 0.0 {
             limit / length
@@ -100,8 +101,8 @@ impl Pair {
         self.twist(patch, twist - old);
         patch.twist_impulse = twist;
         let rows = &patch.tangent_rows;
-        patch.tangent_impulse =
-            self.solve_disc(rows, tangents, patch.tangent_impulse, (limit, inverse_mass));
+        let old = (patch.tangent_impulse, patch.tangent_drift);
+        patch.tangent_impulse = self.solve_disc(rows, tangents, old, (limit, inverse_mass));
     }
 
     /// An angular impulse `λ n` on B, `−λ n` on A (the twist row).

@@ -52,7 +52,11 @@ fn a_constraint_refilled_over_a_fuller_one_equals_a_fresh_one_on_every_read_valu
             &bodies.centers,
             &bodies.states,
             &bodies.params,
-            (s, model),
+            RowSettings {
+                softness: s,
+                friction: model,
+                step: 1.0 / 60.0,
+            },
         )
     };
     // Last step's constraint: four points with impulses, flipped, rolling.
@@ -69,7 +73,11 @@ fn a_constraint_refilled_over_a_fuller_one_equals_a_fresh_one_on_every_read_valu
         &bodies.centers,
         &bodies.states,
         &bodies.params,
-        (stiff, FrictionModel::PerPoint),
+        RowSettings {
+            softness: stiff,
+            friction: FrictionModel::PerPoint,
+            step: 1.0 / 60.0,
+        },
     );
     let fresh = prepare(&next, stiff);
     assert_eq!(reused.points(), fresh.points());

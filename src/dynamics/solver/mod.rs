@@ -62,6 +62,7 @@
 //! batches follow the key order, so the result depends on nothing else (no hashing, no
 //! archetype or thread order).
 
+mod anchor_drift;
 pub mod batch;
 mod batch_rows;
 pub mod body;
@@ -88,7 +89,9 @@ mod scenarios;
 
 pub use batch::ContactBatches;
 pub use body::{BodyInput, BodyParams, BodyState, SolverBodies};
-pub use contact::{ConstraintPoint, ContactConstraint, ContactInput, ContactPointInput};
+pub use contact::{
+    ConstraintPoint, ContactConstraint, ContactInput, ContactPointInput, RowSettings,
+};
 pub use joint::{
     HeldLoad, JointConstraint, JointFrame, JointImpulses, JointInput, JointKind, JointLimit,
     JointMotor,
@@ -313,7 +316,7 @@ impl Solver {
         }
         let inv_h = 1.0 / h;
         self.substep = h;
-        self.prepare(bodies, contacts, h);
+        self.prepare(bodies, contacts, (h, substeps));
         self.prepare_joints(bodies, joints, inv_h);
         let joint_soft = Softness::new(s.joint_hertz, s.joint_damping_ratio, h);
         self.stabilise_springs(bodies, springs, h);
@@ -490,19 +493,30 @@ impl Solver {
         }
     }
 
-    /// Builds this step's constraints and seeds them from the cache.
-    fn prepare(&mut self, bodies: &SolverBodies, contacts: &[ContactInput], h: f32) {
+    /// Builds this step's constraints (a step of `substeps` substeps of `h`) and seeds them
+    /// from the cache.
+    fn prepare(
+        &mut self,
+        bodies: &SolverBodies,
+        contacts: &[ContactInput],
+        (h, substeps): (f32, u32),
+    ) {
         let s = self.settings;
         let soft = Softness::new(s.contact_hertz, s.damping_ratio, h);
         let static_soft = Softness::new(s.static_contact_hertz, s.damping_ratio, h);
+        let step = h * substeps as f32;
         // A dynamic body locked on every axis is as immovable as a static one, and its
         // contacts as stiff.
         let softness = |c: &ContactInput| {
             let immovable = |i: u32| bodies.params[i as usize].is_immovable();
-            if immovable(c.a) || immovable(c.b) {
-                (static_soft, s.friction)
-            } else {
-                (soft, s.friction)
+            RowSettings {
+                softness: if immovable(c.a) || immovable(c.b) {
+                    static_soft
+                } else {
+                    soft
+                },
+                friction: s.friction,
+                step,
             }
         };
         let (centers, states, params) = (&bodies.centers, &bodies.states, &bodies.params);

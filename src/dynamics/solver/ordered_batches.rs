@@ -154,7 +154,8 @@ impl OrderedBatches {
 mod tests {
     use super::*;
     use crate::dynamics::solver::{
-        BodyInput, ContactInput, ContactPointInput, FrictionModel, Softness, SolverBodies,
+        BodyInput, ContactInput, ContactPointInput, FrictionModel, RowSettings, Softness,
+        SolverBodies,
     };
     use glam::{Quat, Vec3};
 
@@ -202,7 +203,11 @@ mod tests {
                     &bodies.centers,
                     &bodies.states,
                     &bodies.params,
-                    (softness, FrictionModel::PerPoint),
+                    RowSettings {
+                        softness,
+                        friction: FrictionModel::PerPoint,
+                        step: 1.0 / 60.0,
+                    },
                 );
                 c.points[0].normal_impulse = 0.05;
                 c

@@ -29,6 +29,7 @@
 //! not symmetric about its axis, begins to rock and slides 9.7 mm (0.5 mm per point): hence
 //! per point is the default.
 
+use super::anchor_drift::AnchorDrift;
 use super::body::BodyParams;
 use super::contact::RowPart;
 use crate::geometry::MAX_MANIFOLD_POINTS;
@@ -57,6 +58,8 @@ pub struct PatchFriction {
     pub twist_mass: f32,
     /// Each point's distance from the centre in the contact plane (0 past the count).
     pub arms: [f32; MAX_MANIFOLD_POINTS],
+    /// The tangent rows' drift targets at the centre (`anchor_drift.rs`).
+    pub tangent_drift: [f32; 2],
     /// Accumulated impulses along the two tangents (N·s).
     pub tangent_impulse: [f32; 2],
     /// Accumulated twist impulse about the normal (N·m·s).
@@ -66,13 +69,14 @@ pub struct PatchFriction {
 impl PatchFriction {
     /// The rows of a contact with `points` (world, at least one) and normal `n` between bodies
     /// of centres of mass `centers`; `sides` are the tangents with their translational parts
-    /// `d·W_a d + d·W_b d` (as [`RowPart`] takes them).
-    pub fn new(
+    /// `d·W_a d + d·W_b d` (as [`RowPart`] takes them); `drift` gives the tangent rows' targets
+    /// (none: zero).
+    pub(super) fn new(
         [pa, pb]: [&BodyParams; 2],
         points: &[Vec3],
         centers: [Vec3; 2],
-        n: Vec3,
-        sides: [(Vec3, f32); 2],
+        (n, sides): (Vec3, [(Vec3, f32); 2]),
+        drift: Option<&AnchorDrift>,
     ) -> Self {
         let centre = points.iter().sum::<Vec3>() / points.len().max(1) as f32;
         let (ra, rb) = (centre - centers[0], centre - centers[1]);
@@ -92,6 +96,7 @@ impl PatchFriction {
                 0.0
             },
             arms,
+            tangent_drift: drift.map_or([0.0; 2], |d| d.at(ra, rb)),
             tangent_impulse: [0.0; 2],
             twist_impulse: 0.0,
         }
@@ -113,8 +118,8 @@ impl PatchFriction {
 mod tests {
     use super::*;
     use crate::dynamics::solver::{
-        BodyInput, ContactConstraint, ContactInput, ContactPointInput, Softness, SolverBodies,
-        WarmStartCache,
+        BodyInput, ContactConstraint, ContactInput, ContactPointInput, RowSettings, Softness,
+        SolverBodies, WarmStartCache,
     };
     use glam::Quat;
 
@@ -153,7 +158,12 @@ mod tests {
     fn prepare(bodies: &SolverBodies, input: &ContactInput, h: f32) -> ContactConstraint {
         let soft = Softness::new(60.0, 10.0, h);
         let (centers, states, params) = (&bodies.centers, &bodies.states, &bodies.params);
-        ContactConstraint::prepare(input, centers, states, params, (soft, FrictionModel::Patch))
+        let settings = RowSettings {
+            softness: soft,
+            friction: FrictionModel::Patch,
+            step: 4.0 * h,
+        };
+        ContactConstraint::prepare(input, centers, states, params, settings)
     }
 
     #[test]
@@ -206,7 +216,11 @@ mod tests {
             centers,
             states,
             params,
-            (soft, per_point),
+            RowSettings {
+                softness: soft,
+                friction: per_point,
+                step: 4.0 / 480.0,
+            },
         )];
         cache.seed(&mut plain, orientation, 1.0 / 480.0, 0.05);
         assert!(plain[0].patch.is_none());

@@ -1,0 +1,224 @@
+//! What friction at anchors fixed for a step misses when the bodies turn: the second-order
+//! drift of two material points held together, and the friction rows' target that removes it.
+//!
+//! # Why
+//! A contact's anchors `r_a`, `r_b` are taken once per step (Box2D v3), and friction drives the
+//! tangential relative velocity at them, `J V = t·(v_b + ω_b × r_b − v_a − ω_a × r_a)`, to
+//! zero. A box on a turntable then moves for the whole step along the tangent of the point of
+//! the table under it at the step's start, while that point moves along an arc: the box ends
+//! `ω² ρ h² / 2` further out every step (`h` the step), 1.8 cm/s at 2 m from the axis at
+//! 1 rad/s and 60 Hz, and walks off the table.
+//!
+//! # The target
+//! Two material points held together stay together over the step when their *mean* relative
+//! velocity over it is zero. With `v` and `ω` constant over the step a material point's anchor
+//! turns, `ṙ = ω × r`, so
+//!
+//! `d(J V)/dt = t·(ω_b × (ω_b × r_b) − ω_a × (ω_a × r_a))`,
+//!
+//! and the mean over the step is `J V + (h/2) d(J V)/dt`. Each friction row therefore solves
+//! `J V + drift = 0` with `drift = (h/2) t·(T_b − T_a)`, `T = ω × (ω × r)` in the contact
+//! plane: the box on the turntable gets the inward velocity `ω² ρ h/2` that carries it along
+//! the chord, and stays on its circle.
+//!
+//! # Which turn
+//! Only the spin about the normal is followed: `T = −(ω·n)² r_∥`, `r_∥ = r − (r·n) n` the
+//! anchor's part in the contact plane. A body's roll (its turn about an axis in the plane) does
+//! not carry its contact along as a material point when the body is round: a ball's contact
+//! stays below its centre however it rolls, and a cylinder rolling across a tessellated floor
+//! has points ahead of its axis. Turned as material points they gave a ball rolling with spin
+//! a sideways target (0.4 m/s at 10 rad/s of each) and sent the cylinder 11 cm off its line in
+//! 10 m. The spin about the normal moves a sticking contact with the spinning body whatever
+//! its shape (a ball spinning in place has `r_∥ = 0`), and it is the turn of a platform, a
+//! turntable or a carousel. For the box on the turntable the target is exact: `T_b − T_a =
+//! ω² (c_b − c_a)_∥`, the centripetal velocity change of the box's centre.
+//!
+//! # Sticking only
+//! The target holds material points together, so it applies while the contact sticks: a point
+//! that slips at the step's start much faster than its target ([`STICKING_SLIP`]) slides as
+//! before, along its relative velocity alone. Its friction impulse acts at the anchor of the
+//! step's start, where the target would only tilt it off the slip (a box spun on the ground
+//! at 20 rad/s slowed 3.2 % less than Coulomb's law with it, within 1 % without). Whether a
+//! point sticks is read from its slip, not from its friction disc: a point held at its target
+//! is always a target's width from the answer without it, and the corners of a box on a
+//! turntable touch their discs' edges, by turns, in most substeps. Bodies that do not spin about the normal, or spin slower
+//! than [`SPIN_FLOOR`], get no target, so a scene without rotation solves exactly the rows it
+//! solved before.
+
+use glam::Vec3;
+
+/// Spins about the normal slower than this (rad/s) get no target. The drift they would
+/// correct, `ω² ρ h² / 2` a step, is 1.4e-8 m per metre of `ρ` at 0.01 rad/s and 60 Hz, below
+/// the float spacing of a position a metre from the origin (6e-8 m): solving it adds only
+/// rounding, and a tall stack's sway answers rounding chaotically (the 20-box stack of
+/// `scenarios.rs` drifted 7.3 mm in 10 s without targets, 9.2–10.6 mm with targets for
+/// spins of 1e-5 to 1e-3 rad/s, and 7.3 mm again from a floor of 3e-3 rad/s up).
+pub(super) const SPIN_FLOOR: f32 = 0.01;
+
+/// A point slipping at up to this many times its drift target's size at the step's start
+/// sticks (the target in full), and one slipping at twice that slides (no target), with a
+/// linear fade between. A point held at its target last step slips at about the target's size
+/// (its chord's velocity against the tangent at the step's end); one sliding on a body that
+/// spins at `ω` slips at `1/(ω h/2)` times it (6 at 20 rad/s and 60 Hz).
+const STICKING_SLIP: f32 = 2.0;
+
+/// The friction targets of one contact's points (module docs), taken once per step.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct AnchorDrift {
+    /// `(v, ω)` of A and B at the step's start.
+    velocities: [(Vec3, Vec3); 2],
+    /// `ω·n` of A and B: their spins about the normal.
+    spins: [f32; 2],
+    normal: Vec3,
+    tangents: [Vec3; 2],
+    /// Half the step (`h/2`).
+    half_step: f32,
+}
+
+impl AnchorDrift {
+    /// The targets of a contact of normal `normal` and friction directions `tangents` between
+    /// bodies moving at `velocities` (`(v, ω)` of A and B), over a step of `2 half_step`; `None`
+    /// when neither body spins about the normal as fast as [`SPIN_FLOOR`] (every target zero).
+    #[inline]
+    pub fn new(
+        velocities: [(Vec3, Vec3); 2],
+        normal: Vec3,
+        tangents: [Vec3; 2],
+        half_step: f32,
+    ) -> Option<Self> {
+        let spins = [velocities[0].1.dot(normal), velocities[1].1.dot(normal)];
+        let turning = spins[0].abs() >= SPIN_FLOOR || spins[1].abs() >= SPIN_FLOOR;
+        turning.then_some(Self {
+            velocities,
+            spins,
+            normal,
+            tangents,
+            half_step,
+        })
+    }
+
+    /// `(h/2) t_k·(T_b − T_a)` along each tangent for the anchors `ra`, `rb`, in full while the
+    /// point sticks and faded out as it slides (module docs); zero where the product
+    /// overflows (a hostile spin) rather than an infinity.
+    pub fn at(&self, ra: Vec3, rb: Vec3) -> [f32; 2] {
+        let n = self.normal;
+        let [(va, wa), (vb, wb)] = self.velocities;
+        let [spin_a, spin_b] = self.spins;
+        let in_plane = |v: Vec3| v - n * n.dot(v);
+        let bend = |spin: f32, r: Vec3| in_plane(r) * (-spin * spin);
+        let change = (bend(spin_b, rb) - bend(spin_a, ra)) * self.half_step;
+        let reach = change.length();
+        if reach == 0.0 || !reach.is_finite() {
+            // The two anchors turn alike (the point on the axis of both), or overflowed.
+            return [0.0; 2];
+        }
+        let slip = in_plane(vb + wb.cross(rb) - va - wa.cross(ra)).length();
+        let hold = ((STICKING_SLIP * 2.0 * reach - slip) / (STICKING_SLIP * reach)).clamp(0.0, 1.0);
+        let [t0, t1] = self.tangents;
+        let drift = [t0.dot(change) * hold, t1.dot(change) * hold];
+        if drift.iter().all(|d| d.is_finite()) {
+            drift
+        } else {
+            [0.0; 2]
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HALF: f32 = 1.0 / 120.0;
+
+    /// The targets for bodies spinning at `spins`, their centres moving so that the point
+    /// `ra`, `rb` sticks (the slip is zero).
+    fn drift(spins: [Vec3; 2], ra: Vec3, rb: Vec3) -> Vec3 {
+        let velocities = [
+            (Vec3::ZERO, spins[0]),
+            (spins[0].cross(ra) - spins[1].cross(rb), spins[1]),
+        ];
+        let d = AnchorDrift::new(velocities, Vec3::Z, [Vec3::X, Vec3::Y], HALF);
+        let [x, y] = d.map_or([0.0; 2], |d| d.at(ra, rb));
+        Vec3::new(x, y, 0.0)
+    }
+
+    #[test]
+    fn a_box_on_a_turntable_is_sent_inward_at_omega_squared_rho_half_step_within_1e_6() {
+        // Table at the origin turning at 1 rad/s; the box 2 m out, turning with it, its
+        // corner 0.5 m off its centre.
+        let spin = Vec3::Z;
+        let point = Vec3::new(2.5, 0.5, 0.0);
+        let (ca, cb) = (Vec3::new(0.0, 0.0, -0.25), Vec3::new(2.0, 0.0, 0.5));
+        let d = drift([spin, spin], point - ca, point - cb);
+        // J V = −drift: the box's points move inward, along −x, at ω² ρ h/2.
+        let expected = Vec3::new(2.0, 0.0, 0.0) * HALF;
+        assert!((d - expected).length() < 1e-6, "{d}");
+    }
+
+    #[test]
+    fn a_ball_rolling_with_spin_about_the_normal_on_still_ground_gets_no_target_within_1e_9() {
+        let spin = Vec3::new(0.0, 10.0, 10.0);
+        let d = drift(
+            [Vec3::ZERO, spin],
+            Vec3::new(3.0, 1.0, 0.0),
+            Vec3::new(0.0, 0.0, -0.5),
+        );
+        assert!(d.length() < 1e-9, "{d}");
+    }
+
+    #[test]
+    fn a_roll_gets_no_target_and_a_tilted_spin_only_its_part_about_the_normal_within_1e_6() {
+        // A cylinder rolling about +y with a point 0.2 m ahead of its axis.
+        let rolling = drift(
+            [Vec3::ZERO, Vec3::Y * 6.0],
+            Vec3::ZERO,
+            Vec3::new(0.2, 0.4, -0.5),
+        );
+        assert!(rolling.length() < 1e-9, "{rolling}");
+        // Spin (0, 3, 2): only its 2 rad/s about the normal moves the anchor.
+        let d = drift(
+            [Vec3::ZERO, Vec3::new(0.0, 3.0, 2.0)],
+            Vec3::ZERO,
+            Vec3::new(0.5, 0.3, -0.5),
+        );
+        let expected = Vec3::new(0.5, 0.3, 0.0) * (-4.0 * HALF);
+        assert!((d - expected).length() < 1e-6, "{d}");
+    }
+
+    #[test]
+    fn a_point_slipping_past_twice_the_sticking_slip_gets_none_and_half_way_half_within_1e_6() {
+        let (spin, ra, rb) = (
+            Vec3::Z,
+            Vec3::new(2.5, 0.5, 0.25),
+            Vec3::new(0.5, 0.5, -0.5),
+        );
+        let full = drift([spin, spin], ra, rb);
+        let reach = full.length();
+        let at_slip = |slip: f32| {
+            let vb = spin.cross(ra) - spin.cross(rb) + Vec3::Y * slip;
+            let d = AnchorDrift::new(
+                [(Vec3::ZERO, spin), (vb, spin)],
+                Vec3::Z,
+                [Vec3::X, Vec3::Y],
+                HALF,
+            )
+            .expect("the bodies turn");
+            let [x, y] = d.at(ra, rb);
+            Vec3::new(x, y, 0.0)
+        };
+        assert!((at_slip(STICKING_SLIP * reach) - full).length() < 1e-6);
+        assert!((at_slip(1.5 * STICKING_SLIP * reach) - full * 0.5).length() < 1e-6);
+        assert_eq!(at_slip(2.01 * STICKING_SLIP * reach), Vec3::ZERO);
+    }
+
+    #[test]
+    fn bodies_spinning_under_the_floor_get_exactly_zero_and_an_overflowing_spin_gets_zero() {
+        let r = Vec3::new(1.0, 2.0, 3.0);
+        assert_eq!(drift([Vec3::ZERO; 2], r, -r), Vec3::ZERO);
+        let slow = Vec3::new(5.0, 0.0, 0.99 * SPIN_FLOOR);
+        assert_eq!(drift([slow, -slow], r, -r), Vec3::ZERO);
+        assert_ne!(drift([slow * 1.02, -slow], r, -r), Vec3::ZERO);
+        let wild = Vec3::new(0.0, 0.0, 1e30);
+        assert_eq!(drift([wild, Vec3::ZERO], r, -r), Vec3::ZERO);
+    }
+}
