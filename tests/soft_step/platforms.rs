@@ -6,6 +6,18 @@
 
 use super::*;
 
+/// A kinematic platform `2 half` m square and 0.5 m thick, its top at z = 0, at rest.
+fn spawn_platform(world: &mut World, half: f32) -> Entity {
+    world
+        .spawn((
+            Collider::cuboid(half, half, 0.25),
+            Position::new(0.0, 0.0, -0.25),
+            Velocity::default(),
+            Mass::INFINITE,
+        ))
+        .id()
+}
+
 /// A 6 m × 6 m kinematic platform with a unit box on it, settled for a second; the platform
 /// then moves at `velocity(step)` for 600 steps. The box's largest speed relative to the
 /// platform within the plane, after the first second of motion, and how far it ends from
@@ -13,14 +25,7 @@ use super::*;
 fn ride(velocity: impl Fn(u32) -> Vec3) -> (f32, f32) {
     let mut app = soft_step_app();
     let world = app.world_mut();
-    let platform = world
-        .spawn((
-            Collider::cuboid(3.0, 3.0, 0.25),
-            Position::new(0.0, 0.0, -0.25),
-            Velocity::default(),
-            Mass::INFINITE,
-        ))
-        .id();
+    let platform = spawn_platform(world, 3.0);
     let body = world
         .spawn((
             Collider::cuboid(0.5, 0.5, 0.5),
@@ -65,14 +70,7 @@ fn a_box_rides_a_sliding_platform_within_1_mm_s_and_a_reversing_lift_sends_it_si
 fn turntable_drifts() -> Vec<f32> {
     let mut app = soft_step_app();
     let world = app.world_mut();
-    let table = world
-        .spawn((
-            Collider::cuboid(4.0, 4.0, 0.25),
-            Position::new(0.0, 0.0, -0.25),
-            Velocity::default(),
-            Mass::INFINITE,
-        ))
-        .id();
+    let table = spawn_platform(world, 4.0);
     let riders: Vec<_> = [
         (Collider::cuboid(0.5, 0.5, 0.5), Vec3::new(2.0, 0.0, 0.52)),
         (Collider::cylinder(0.5, 0.5), Vec3::new(-2.0, 0.0, 0.52)),

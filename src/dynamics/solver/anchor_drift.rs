@@ -38,12 +38,12 @@
 //! that slips at the step's start much faster than its target ([`STICKING_SLIP`]) slides as
 //! before, along its relative velocity alone. Its friction impulse acts at the anchor of the
 //! step's start, where the target would only tilt it off the slip (a box spun on the ground
-//! at 20 rad/s slowed 3.2 % less than Coulomb's law with it, within 1 % without). Whether a
-//! point sticks is read from its slip, not from its friction disc: a point held at its target
-//! is always a target's width from the answer without it, and the corners of a box on a
-//! turntable touch their discs' edges, by turns, in most substeps. Bodies that do not spin about the normal, or spin slower
-//! than [`SPIN_FLOOR`], get no target, so a scene without rotation solves exactly the rows it
-//! solved before.
+//! at 20 rad/s slowed 3.2 % less than Coulomb's law predicts with it, 1.4 % without, as
+//! before the targets). Whether a point sticks is read from its slip, not from its friction
+//! disc: a point held at its target is always a target's width from the answer without it,
+//! and the corners of a box on a turntable touch their discs' edges, by turns, in most
+//! substeps. Bodies that do not spin about the normal, or spin slower than [`SPIN_FLOOR`], get
+//! no target, so a scene without rotation solves exactly the rows it solved before.
 
 use glam::Vec3;
 
