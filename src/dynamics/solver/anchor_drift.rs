@@ -45,6 +45,8 @@
 //! substeps. Bodies that do not spin about the normal, or spin slower than [`SPIN_FLOOR`], get
 //! no target, so a scene without rotation solves exactly the rows it solved before.
 
+use super::body::BodyState;
+use super::contact::point_velocity;
 use glam::Vec3;
 
 /// Spins about the normal slower than this (rad/s) get no target. The drift they would
@@ -64,9 +66,9 @@ const STICKING_SLIP: f32 = 2.0;
 
 /// The friction targets of one contact's points (module docs), taken once per step.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct AnchorDrift {
-    /// `(v, ω)` of A and B at the step's start.
-    velocities: [(Vec3, Vec3); 2],
+pub(super) struct AnchorDrift<'a> {
+    /// A's and B's states at the step's start.
+    states: [&'a BodyState; 2],
     /// `ω·n` of A and B: their spins about the normal.
     spins: [f32; 2],
     normal: Vec3,
@@ -75,34 +77,43 @@ pub(super) struct AnchorDrift {
     half_step: f32,
 }
 
-impl AnchorDrift {
+impl<'a> AnchorDrift<'a> {
     /// The targets of a contact of normal `normal` and friction directions `tangents` between
-    /// bodies moving at `velocities` (`(v, ω)` of A and B), over a step of `2 half_step`; `None`
-    /// when neither body spins about the normal as fast as [`SPIN_FLOOR`] (every target zero).
+    /// bodies in `states` (A, B), over a step of `step` seconds; `None` when neither body
+    /// spins about the normal as fast as [`SPIN_FLOOR`] (every target zero).
     #[inline]
     pub fn new(
-        velocities: [(Vec3, Vec3); 2],
+        states: [&'a BodyState; 2],
         normal: Vec3,
         tangents: [Vec3; 2],
-        half_step: f32,
+        step: f32,
     ) -> Option<Self> {
-        let spins = [velocities[0].1.dot(normal), velocities[1].1.dot(normal)];
+        let spins = [
+            states[0].angular_velocity.dot(normal),
+            states[1].angular_velocity.dot(normal),
+        ];
         let turning = spins[0].abs() >= SPIN_FLOOR || spins[1].abs() >= SPIN_FLOOR;
         turning.then_some(Self {
-            velocities,
+            states,
             spins,
             normal,
             tangents,
-            half_step,
+            half_step: 0.5 * step,
         })
     }
 
-    /// `(h/2) t_k·(T_b − T_a)` along each tangent for the anchors `ra`, `rb`, in full while the
-    /// point sticks and faded out as it slides (module docs); zero where the product
-    /// overflows (a hostile spin) rather than an infinity.
-    pub fn at(&self, ra: Vec3, rb: Vec3) -> [f32; 2] {
+    /// The velocity of B's point at `rb` relative to A's at `ra` (for a point whose caller
+    /// has not taken it already).
+    pub fn relative(&self, ra: Vec3, rb: Vec3) -> Vec3 {
+        point_velocity(self.states[1], rb) - point_velocity(self.states[0], ra)
+    }
+
+    /// `(h/2) t_k·(T_b − T_a)` along each tangent for the anchors `ra`, `rb`, whose points move
+    /// at `relative` ([`Self::relative`]), in full while the point sticks and faded out as it
+    /// slides (module docs); zero where the product overflows (a hostile spin) rather than an
+    /// infinity.
+    pub fn at(&self, ra: Vec3, rb: Vec3, relative: Vec3) -> [f32; 2] {
         let n = self.normal;
-        let [(va, wa), (vb, wb)] = self.velocities;
         let [spin_a, spin_b] = self.spins;
         let in_plane = |v: Vec3| v - n * n.dot(v);
         let bend = |spin: f32, r: Vec3| in_plane(r) * (-spin * spin);
@@ -112,7 +123,7 @@ impl AnchorDrift {
             // The two anchors turn alike (the point on the axis of both), or overflowed.
             return [0.0; 2];
         }
-        let slip = in_plane(vb + wb.cross(rb) - va - wa.cross(ra)).length();
+        let slip = in_plane(relative).length();
         let hold = ((STICKING_SLIP * 2.0 * reach - slip) / (STICKING_SLIP * reach)).clamp(0.0, 1.0);
         let [t0, t1] = self.tangents;
         let drift = [t0.dot(change) * hold, t1.dot(change) * hold];
@@ -130,16 +141,32 @@ mod tests {
 
     const HALF: f32 = 1.0 / 120.0;
 
+    /// A body state moving at `v`, turning at `w`.
+    fn state(v: Vec3, w: Vec3) -> BodyState {
+        BodyState {
+            linear_velocity: v,
+            angular_velocity: w,
+            ..Default::default()
+        }
+    }
+
+    /// The targets at `ra`, `rb` between bodies in `states` over a step of `2 HALF`.
+    fn targets(states: [BodyState; 2], ra: Vec3, rb: Vec3) -> Vec3 {
+        let d = AnchorDrift::new(
+            [&states[0], &states[1]],
+            Vec3::Z,
+            [Vec3::X, Vec3::Y],
+            2.0 * HALF,
+        );
+        let [x, y] = d.map_or([0.0; 2], |d| d.at(ra, rb, d.relative(ra, rb)));
+        Vec3::new(x, y, 0.0)
+    }
+
     /// The targets for bodies spinning at `spins`, their centres moving so that the point
     /// `ra`, `rb` sticks (the slip is zero).
     fn drift(spins: [Vec3; 2], ra: Vec3, rb: Vec3) -> Vec3 {
-        let velocities = [
-            (Vec3::ZERO, spins[0]),
-            (spins[0].cross(ra) - spins[1].cross(rb), spins[1]),
-        ];
-        let d = AnchorDrift::new(velocities, Vec3::Z, [Vec3::X, Vec3::Y], HALF);
-        let [x, y] = d.map_or([0.0; 2], |d| d.at(ra, rb));
-        Vec3::new(x, y, 0.0)
+        let b = state(spins[0].cross(ra) - spins[1].cross(rb), spins[1]);
+        targets([state(Vec3::ZERO, spins[0]), b], ra, rb)
     }
 
     #[test]
@@ -196,15 +223,7 @@ mod tests {
         let reach = full.length();
         let at_slip = |slip: f32| {
             let vb = spin.cross(ra) - spin.cross(rb) + Vec3::Y * slip;
-            let d = AnchorDrift::new(
-                [(Vec3::ZERO, spin), (vb, spin)],
-                Vec3::Z,
-                [Vec3::X, Vec3::Y],
-                HALF,
-            )
-            .expect("the bodies turn");
-            let [x, y] = d.at(ra, rb);
-            Vec3::new(x, y, 0.0)
+            targets([state(Vec3::ZERO, spin), state(vb, spin)], ra, rb)
         };
         assert!((at_slip(STICKING_SLIP * reach) - full).length() < 1e-6);
         assert!((at_slip(1.5 * STICKING_SLIP * reach) - full * 0.5).length() < 1e-6);

@@ -249,7 +249,7 @@ pub(super) fn impact_speed(vn: f32, s: f32, closing: f32) -> f32 {
 }
 
 /// Velocity of the point at `r` of a body.
-fn point_velocity(s: &BodyState, r: Vec3) -> Vec3 {
+pub(super) fn point_velocity(s: &BodyState, r: Vec3) -> Vec3 {
     s.linear_velocity + s.angular_velocity.cross(r)
 }
 
@@ -325,16 +325,12 @@ impl ContactConstraint {
         let per_point = model == FrictionModel::PerPoint;
         let still = [(pa, ia), (pb, ib)].map(|(p, i)| !p.dynamic && at_rest(&states[i]));
         let (sa, sb) = (&states[ia], &states[ib]);
-        let velocities = [
-            (sa.linear_velocity, sa.angular_velocity),
-            (sb.linear_velocity, sb.angular_velocity),
-        ];
-        let drift = AnchorDrift::new(velocities, n, tangents, 0.5 * step);
+        let drift = AnchorDrift::new([sa, sb], n, tangents, step);
         for (cp, p) in self.points.iter_mut().zip(&input.points[..count]) {
             let ra = p.point - centers[ia];
             let rb = p.point - centers[ib];
             let gap_arms = [on_moving(still[0], ra), on_moving(still[1], rb)];
-            let relative = point_velocity(&states[ib], rb) - point_velocity(&states[ia], ra);
+            let relative = point_velocity(sb, rb) - point_velocity(sa, ra);
             *cp = ConstraintPoint {
                 anchor_a: ra,
                 anchor_b: rb,
@@ -351,7 +347,7 @@ impl ContactConstraint {
                     [PointRow::default(); 2]
                 },
                 tangent_drift: match &drift {
-                    Some(drift) if per_point => drift.at(ra, rb),
+                    Some(drift) if per_point => drift.at(ra, rb, relative),
                     _ => [0.0; 2],
                 },
                 relative_velocity: relative.dot(n),

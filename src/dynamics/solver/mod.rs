@@ -316,7 +316,7 @@ impl Solver {
         }
         let inv_h = 1.0 / h;
         self.substep = h;
-        self.prepare(bodies, contacts, (h, substeps));
+        self.prepare(bodies, contacts, (h, dt));
         self.prepare_joints(bodies, joints, inv_h);
         let joint_soft = Softness::new(s.joint_hertz, s.joint_damping_ratio, h);
         self.stabilise_springs(bodies, springs, h);
@@ -493,18 +493,12 @@ impl Solver {
         }
     }
 
-    /// Builds this step's constraints (a step of `substeps` substeps of `h`) and seeds them
-    /// from the cache.
-    fn prepare(
-        &mut self,
-        bodies: &SolverBodies,
-        contacts: &[ContactInput],
-        (h, substeps): (f32, u32),
-    ) {
+    /// Builds this step's constraints (a step of `dt` in substeps of `h`) and seeds them from
+    /// the cache.
+    fn prepare(&mut self, bodies: &SolverBodies, contacts: &[ContactInput], (h, dt): (f32, f32)) {
         let s = self.settings;
         let soft = Softness::new(s.contact_hertz, s.damping_ratio, h);
         let static_soft = Softness::new(s.static_contact_hertz, s.damping_ratio, h);
-        let step = h * substeps as f32;
         // A dynamic body locked on every axis is as immovable as a static one, and its
         // contacts as stiff.
         let softness = |c: &ContactInput| {
@@ -516,7 +510,7 @@ impl Solver {
                     soft
                 },
                 friction: s.friction,
-                step,
+                step: dt,
             }
         };
         let (centers, states, params) = (&bodies.centers, &bodies.states, &bodies.params);

@@ -96,7 +96,7 @@ impl PatchFriction {
                 0.0
             },
             arms,
-            tangent_drift: drift.map_or([0.0; 2], |d| d.at(ra, rb)),
+            tangent_drift: drift.map_or([0.0; 2], |d| d.at(ra, rb, d.relative(ra, rb))),
             tangent_impulse: [0.0; 2],
             twist_impulse: 0.0,
         }
