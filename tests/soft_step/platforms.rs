@@ -95,7 +95,7 @@ fn turntable_drifts() -> Vec<f32> {
 fn a_turntable_carries_a_box_and_a_cylinder_on_their_circles_drifting_under_2_cm_in_8_s() {
     // Friction at anchors held for the step moved each along its step's chord, outward by
     // ω² ρ h² / 2 a step: 15.9 cm in these 8 s for the box until 2026-12-07
-    // (`anchor_drift.rs`; 15.0 cm for the cylinder). Measured 1.3 cm and 1.5 mm.
+    // (`anchor_drift.rs`; 15.0 cm for the cylinder). Measured 1.2 cm and 3.8 mm.
     for (rider, drift) in ["box", "cylinder"].iter().zip(turntable_drifts()) {
         assert!(drift.abs() < 0.02, "the {rider} drifted {drift} m");
     }
@@ -107,7 +107,7 @@ fn a_box_riding_a_free_disc_spinning_on_ice_drifts_under_2_cm_and_the_spin_keeps
     // Both bodies dynamic, nothing but the box's friction on the disc: the disc spins on ice
     // (ice on anything slides), the box rides it 2 m out, both turning at 1 rad/s. Until
     // 2026-12-07 the box drifted outward 18.5 cm in 10 s and, the pair's angular momentum
-    // kept, the disc slowed by 2.1 %. Measured 9.9 mm and 0.01 %.
+    // kept, the disc slowed by 2.1 %. Measured 10.9 mm and 0.003 %.
     let mut app = soft_step_app();
     let world = app.world_mut();
     world.spawn((Collider::half_space(Vec3::Z), Static, Friction(0.0)));
