@@ -80,7 +80,9 @@ pub(super) struct AnchorDrift<'a> {
 impl<'a> AnchorDrift<'a> {
     /// The targets of a contact of normal `normal` and friction directions `tangents` between
     /// bodies in `states` (A, B), over a step of `step` seconds; `None` when neither body
-    /// spins about the normal as fast as [`SPIN_FLOOR`] (every target zero).
+    /// spins about the normal as fast as [`SPIN_FLOOR`] (every target zero), or `step` is not
+    /// a positive finite duration (`RowSettings` is public: a negative step would aim the
+    /// targets outward).
     #[inline]
     pub fn new(
         states: [&'a BodyState; 2],
@@ -93,7 +95,8 @@ impl<'a> AnchorDrift<'a> {
             states[1].angular_velocity.dot(normal),
         ];
         let turning = spins[0].abs() >= SPIN_FLOOR || spins[1].abs() >= SPIN_FLOOR;
-        turning.then_some(Self {
+        let usable = step > 0.0 && step.is_finite();
+        (turning && usable).then_some(Self {
             states,
             spins,
             normal,
@@ -228,6 +231,16 @@ mod tests {
         assert!((at_slip(STICKING_SLIP * reach) - full).length() < 1e-6);
         assert!((at_slip(1.5 * STICKING_SLIP * reach) - full * 0.5).length() < 1e-6);
         assert_eq!(at_slip(2.01 * STICKING_SLIP * reach), Vec3::ZERO);
+    }
+
+    #[test]
+    fn a_step_that_is_not_a_positive_finite_duration_gives_no_targets() {
+        let (a, b) = (state(Vec3::ZERO, Vec3::Z), state(Vec3::Y * 2.0, Vec3::Z));
+        for step in [0.0, -1.0 / 60.0, f32::NAN, f32::INFINITY] {
+            let d = AnchorDrift::new([&a, &b], Vec3::Z, [Vec3::X, Vec3::Y], step);
+            assert!(d.is_none(), "a step of {step} s gave targets");
+        }
+        assert!(AnchorDrift::new([&a, &b], Vec3::Z, [Vec3::X, Vec3::Y], 1.0 / 60.0).is_some());
     }
 
     #[test]
