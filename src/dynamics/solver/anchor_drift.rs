@@ -33,6 +33,22 @@
 //! turntable or a carousel. For the box on the turntable the target is exact: `T_b − T_a =
 //! ω² (c_b − c_a)_∥`, the centripetal velocity change of the box's centre.
 //!
+//! # Rolling contacts
+//! A ball rolling on a turntable keeps its contact under its centre, so the contact point
+//! moves across the table at the ball's velocity, not with the table's material point under
+//! it: what friction holds at zero over the step is the relative velocity at a point `p(t)`
+//! that moves at `ṗ`, and a body's velocity there changes at `T = ω × (ṗ − v)` (`v` its centre
+//! of mass's velocity), which for a material point (`ṗ − v = ω × r`) is the `T` above. The
+//! contact knows which body, if either, is round against a flat other
+//! ([`RoundSide`], from the shapes): the flat side's `T = (ω·n) n × (ṗ − v)` is then taken
+//! with `ṗ = v_y + (ω_y·n) n × r_y`, the round side's point turned by its spin about the
+//! normal but not by its roll (for a ball `ṗ` is its centre's velocity). A solid ball
+//! rolling round a table at Ω orbits its axis at `2Ω/7` (`v̇ = (I/(I + m R²)) Ω × v`), and its
+//! target is 2/7 of a riding box's: taken as a point of the table it moved inward 3.4 mm/s
+//! at 2 m and 1 rad/s, now under 0.1 mm/s. The round side's own `T` stays material (a ball's
+//! spin about the normal does not move its contact; a standing cylinder's cap turns its
+//! points with it).
+//!
 //! # Sticking only
 //! The target holds material points together, so it applies while the contact sticks: a point
 //! that slips at the step's start much faster than its target ([`STICKING_SLIP`]) slides as
@@ -47,6 +63,7 @@
 
 use super::body::BodyState;
 use super::contact::point_velocity;
+use crate::geometry::contacts::RoundSide;
 use glam::Vec3;
 
 /// Spins about the normal slower than this (rad/s) get no target. The drift they would
@@ -71,6 +88,8 @@ pub(super) struct AnchorDrift<'a> {
     states: [&'a BodyState; 2],
     /// `ω·n` of A and B: their spins about the normal.
     spins: [f32; 2],
+    /// Which body, if either, is round against a flat other (its contact point rolls with it).
+    round: RoundSide,
     normal: Vec3,
     tangents: [Vec3; 2],
     /// Half the step (`h/2`).
@@ -86,8 +105,8 @@ impl<'a> AnchorDrift<'a> {
     #[inline]
     pub fn new(
         states: [&'a BodyState; 2],
-        normal: Vec3,
-        tangents: [Vec3; 2],
+        (normal, tangents): (Vec3, [Vec3; 2]),
+        round: RoundSide,
         step: f32,
     ) -> Option<Self> {
         let spins = [
@@ -99,6 +118,7 @@ impl<'a> AnchorDrift<'a> {
         (turning && usable).then_some(Self {
             states,
             spins,
+            round,
             normal,
             tangents,
             half_step: 0.5 * step,
@@ -117,10 +137,8 @@ impl<'a> AnchorDrift<'a> {
     /// infinity.
     pub fn at(&self, ra: Vec3, rb: Vec3, relative: Vec3) -> [f32; 2] {
         let n = self.normal;
-        let [spin_a, spin_b] = self.spins;
         let in_plane = |v: Vec3| v - n * n.dot(v);
-        let bend = |spin: f32, r: Vec3| in_plane(r) * (-spin * spin);
-        let change = (bend(spin_b, rb) - bend(spin_a, ra)) * self.half_step;
+        let change = (self.bend(1, [ra, rb]) - self.bend(0, [ra, rb])) * self.half_step;
         let reach = change.length();
         if reach == 0.0 || !reach.is_finite() {
             // The two anchors turn alike (the point on the axis of both), or overflowed.
@@ -134,6 +152,24 @@ impl<'a> AnchorDrift<'a> {
             drift
         } else {
             [0.0; 2]
+        }
+    }
+
+    /// `T` of side `x` (0: A, 1: B) for the anchors `r`: how fast its velocity at the point
+    /// the contact follows turns, from its spin about the normal. A material point turns with
+    /// the body, `T = −(ω·n)² r_∥`; a flat side under a round one is read where the round
+    /// body's contact goes, `T = (ω·n) n × (ṗ − v)` with `ṗ = v_y + (ω_y·n) n × r_y` the
+    /// round side's (module docs).
+    #[inline]
+    fn bend(&self, x: usize, r: [Vec3; 2]) -> Vec3 {
+        let (n, spin) = (self.normal, self.spins[x]);
+        let under_round = matches!((self.round, x), (RoundSide::B, 0) | (RoundSide::A, 1));
+        if under_round {
+            let y = 1 - x;
+            let contact = self.states[y].linear_velocity + n.cross(r[y]) * self.spins[y];
+            n.cross(contact - self.states[x].linear_velocity) * spin
+        } else {
+            (r[x] - n * n.dot(r[x])) * (-spin * spin)
         }
     }
 }
@@ -153,14 +189,21 @@ mod tests {
         }
     }
 
-    /// The targets at `ra`, `rb` between bodies in `states` over a step of `2 HALF`.
+    /// The targets at `ra`, `rb` between bodies in `states` over a step of `2 HALF`, across
+    /// normal `n`, each side's point material.
     fn targets(states: [BodyState; 2], ra: Vec3, rb: Vec3) -> Vec3 {
-        let d = AnchorDrift::new(
-            [&states[0], &states[1]],
-            Vec3::Z,
-            [Vec3::X, Vec3::Y],
-            2.0 * HALF,
-        );
+        targets_of(states, (Vec3::Z, RoundSide::Neither), ra, rb)
+    }
+
+    /// [`targets`] across normal `n`, the `round` side's contact rolling with it.
+    fn targets_of(
+        states: [BodyState; 2],
+        (n, round): (Vec3, RoundSide),
+        ra: Vec3,
+        rb: Vec3,
+    ) -> Vec3 {
+        let tangents = [Vec3::X, Vec3::Y];
+        let d = AnchorDrift::new([&states[0], &states[1]], (n, tangents), round, 2.0 * HALF);
         let [x, y] = d.map_or([0.0; 2], |d| d.at(ra, rb, d.relative(ra, rb)));
         Vec3::new(x, y, 0.0)
     }
@@ -183,6 +226,33 @@ mod tests {
         // J V = −drift: the box's points move inward, along −x, at ω² ρ h/2.
         let expected = Vec3::new(2.0, 0.0, 0.0) * HALF;
         assert!((d - expected).length() < 1e-6, "{d}");
+    }
+
+    #[test]
+    fn a_ball_rolling_round_a_turntable_at_two_sevenths_its_rate_gets_two_sevenths_of_a_box_target_within_1e_6()
+     {
+        // Table at the origin turning at 1 rad/s; a ball of radius 0.5 on it, 2 m out,
+        // rolling without slip on its circle at 2/7 rad/s (its centre's velocity turns at
+        // 2/7 Ω: `v̇ = (I/(I + m R²)) Ω × v`).
+        let (table, ball) = (Vec3::new(0.0, 0.0, -0.25), Vec3::new(2.0, 0.0, 0.5));
+        let point = Vec3::new(2.0, 0.0, 0.0);
+        let (ra, rb) = (point - table, point - ball);
+        let v = Vec3::Z.cross(ball) * (2.0 / 7.0);
+        // Its roll makes its contact point move with the table's point under it.
+        let roll = Vec3::new(20.0 / 7.0, 0.0, 0.0);
+        let states = [state(Vec3::ZERO, Vec3::Z), state(v, roll)];
+        let sticks = states[1].linear_velocity + roll.cross(rb) - Vec3::Z.cross(ra);
+        assert!(sticks.length() < 1e-6, "{sticks}");
+        let d = targets_of(states, (Vec3::Z, RoundSide::B), ra, rb);
+        // A box riding there gets ω² ρ h/2 inward; the rolling ball's contact turns at 2/7.
+        let expected = Vec3::new(2.0, 0.0, 0.0) * (HALF * 2.0 / 7.0);
+        assert!((d - expected).length() < 1e-6, "{d}");
+        // The same pair listed the other way round: the same motion, the opposite rows.
+        let swapped = targets_of([states[1], states[0]], (-Vec3::Z, RoundSide::A), rb, ra);
+        assert!((swapped + expected).length() < 1e-6, "{swapped}");
+        // Taken as material points, the table's would be the box's: 7/2 times too far in.
+        let material = targets(states, ra, rb);
+        assert!((material - expected * 3.5).length() < 1e-6, "{material}");
     }
 
     #[test]
@@ -237,10 +307,23 @@ mod tests {
     fn a_step_that_is_not_a_positive_finite_duration_gives_no_targets() {
         let (a, b) = (state(Vec3::ZERO, Vec3::Z), state(Vec3::Y * 2.0, Vec3::Z));
         for step in [0.0, -1.0 / 60.0, f32::NAN, f32::INFINITY] {
-            let d = AnchorDrift::new([&a, &b], Vec3::Z, [Vec3::X, Vec3::Y], step);
+            let d = AnchorDrift::new(
+                [&a, &b],
+                (Vec3::Z, [Vec3::X, Vec3::Y]),
+                RoundSide::Neither,
+                step,
+            );
             assert!(d.is_none(), "a step of {step} s gave targets");
         }
-        assert!(AnchorDrift::new([&a, &b], Vec3::Z, [Vec3::X, Vec3::Y], 1.0 / 60.0).is_some());
+        assert!(
+            AnchorDrift::new(
+                [&a, &b],
+                (Vec3::Z, [Vec3::X, Vec3::Y]),
+                RoundSide::Neither,
+                1.0 / 60.0
+            )
+            .is_some()
+        );
     }
 
     #[test]

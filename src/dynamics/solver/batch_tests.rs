@@ -67,6 +67,7 @@ fn scene_with(model: FrictionModel, grounds: bool) -> (SolverBodies, Vec<Contact
                 friction: 0.6,
                 restitution: 0.0,
                 rolling_resistance: 0.0,
+                round: Default::default(),
                 points: [ContactPointInput::default(); MAX_MANIFOLD_POINTS],
                 count,
                 key: k as u128,

@@ -46,6 +46,7 @@ use super::rolling::RollingRows;
 pub use super::row::{PointRow, RowPart};
 use super::softness::Softness;
 use crate::geometry::MAX_MANIFOLD_POINTS;
+use crate::geometry::contacts::RoundSide;
 use glam::Vec3;
 
 /// One point of a contact as detection found it.
@@ -73,6 +74,10 @@ pub struct ContactInput {
     pub restitution: f32,
     /// Lever arm of the pair's rolling resistance (m; 0: none; see [`RollingRows`]).
     pub rolling_resistance: f32,
+    /// Which body, if either, is round against a flat other: a ball's contact point moves
+    /// with the ball as it rolls, not with the surface under it (the friction targets on a
+    /// turning platform, `anchor_drift.rs`). `Neither` takes both sides' points as material.
+    pub round: RoundSide,
     /// The points (the first `count`).
     pub points: [ContactPointInput; MAX_MANIFOLD_POINTS],
     /// How many points are used.
@@ -325,7 +330,7 @@ impl ContactConstraint {
         let per_point = model == FrictionModel::PerPoint;
         let still = [(pa, ia), (pb, ib)].map(|(p, i)| !p.dynamic && at_rest(&states[i]));
         let (sa, sb) = (&states[ia], &states[ib]);
-        let drift = AnchorDrift::new([sa, sb], n, tangents, step);
+        let drift = AnchorDrift::new([sa, sb], (n, tangents), input.round, step);
         for (cp, p) in self.points.iter_mut().zip(&input.points[..count]) {
             let ra = p.point - centers[ia];
             let rb = p.point - centers[ib];

@@ -20,6 +20,7 @@ fn input(a: u32, b: u32, count: u8, k: f32) -> ContactInput {
         friction: 0.2 * k,
         restitution: 0.1 * k,
         rolling_resistance: 0.05 * (k - 1.0),
+        round: Default::default(),
         points,
         count,
         key: k as u128,

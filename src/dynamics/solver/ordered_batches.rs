@@ -188,6 +188,7 @@ mod tests {
                     friction: 0.5,
                     restitution: 0.0,
                     rolling_resistance: 0.0,
+                    round: Default::default(),
                     points: [ContactPointInput::default(); 4],
                     count: 1 + (k % 2) as u8,
                     key: k as u128,
