@@ -311,6 +311,23 @@ impl Shape {
         }
     }
 
+    /// How far the surface lies outside the shape's core: a sphere's radius (its core a point)
+    /// and a capsule's (a segment); 0 for shapes with faces, edges or corners. A rounded shape
+    /// rolls on its core: the contact under it stays the core's point plus this radius along
+    /// the normal however it turns, which the solver follows (`dynamics/solver/contact.rs`).
+    pub fn rounding(&self) -> f32 {
+        let radius = match self {
+            Self::Sphere(s) => s.radius,
+            Self::Capsule(c) => c.radius,
+            _ => 0.0,
+        };
+        if radius.is_finite() {
+            radius.max(0.0)
+        } else {
+            0.0
+        }
+    }
+
     /// Radius of the smallest origin-centred ball holding the shape (infinite if unbounded).
     pub fn bounding_radius(&self) -> f32 {
         match self {

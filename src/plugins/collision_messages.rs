@@ -373,7 +373,7 @@ mod tests {
             manifold: touching,
             normal_impulse,
             impact_speed: 0.0,
-            round: Default::default(),
+            rounding: [0.0; 2],
         };
         let contacts = Contacts {
             // Pair (1, 2) through three collider pairs, listed both ways round.

@@ -492,7 +492,7 @@ impl NarrowPhaseScratch {
                 manifold,
                 normal_impulse: 0.0,
                 impact_speed: 0.0,
-                round: RoundSide::of(&ca.shape, &cb.shape),
+                rounding: [ca.shape.rounding(), cb.shape.rounding()],
             });
             if debug.enabled && involves_mesh {
                 let overlap = leaf_overlap(la, &ca.shape, lb, &cb.shape, &self.contact);

@@ -65,6 +65,13 @@ struct ContactBatch {
     /// Whether any lane's friction rows may have a drift target
     /// ([`ContactConstraint::turning`]): the others solve them without one.
     turns: bool,
+    /// A's and B's rounding per lane ([`ContactConstraint::rounding`]).
+    rounding: [Lanes; 2],
+    /// Whether any lane has a rounded side: the others' separations skip the rounding.
+    rolls: bool,
+    /// The lanes with an immovable side (all bits set), whose drift targets are spread over
+    /// the substeps ([`contact_share`](super::anchor_drift::contact_share)).
+    carried: Lanes,
 }
 
 /// Where a batch's friction rows are ([`ContactBatch::rows`]).
@@ -184,14 +191,16 @@ impl ContactBatches {
     }
 
     /// One pass over the batches ([`ContactConstraint::solve`] per lane; `flip` visits the
-    /// points backwards): biased (push-out, normal rows only) or relaxing (no bias, friction).
+    /// points backwards): biased (push-out, normal rows only) or relaxing (no bias, friction
+    /// aiming at `share` of its drift targets: the substep's
+    /// [`drift_share`](super::anchor_drift::drift_share)).
     pub fn solve(
         &mut self,
         states: &mut [BodyState],
-        inv_h: f32,
-        max_push_out: f32,
+        (inv_h, max_push_out): (f32, f32),
         use_bias: bool,
         flip: bool,
+        share: f32,
     ) {
         let pass = Pass {
             inv_h,
@@ -208,13 +217,14 @@ impl ContactBatches {
                     FrictionRows::PerPoint(from) => {
                         let frictions = &mut self.frictions[batch.range(from)];
                         if batch.turns {
-                            solve_friction::<true>(batch, points, frictions, &mut pair);
+                            solve_friction::<true>(batch, points, frictions, &mut pair, share);
                         } else {
-                            solve_friction::<false>(batch, points, frictions, &mut pair);
+                            solve_friction::<false>(batch, points, frictions, &mut pair, share);
                         }
                     }
                     FrictionRows::Patch(at) => {
-                        solve_patch(batch, points, &mut self.patches[at as usize], &mut pair);
+                        let patch = &mut self.patches[at as usize];
+                        solve_patch(batch, points, patch, &mut pair, share);
                     }
                 }
             }
@@ -372,6 +382,10 @@ impl ContactBatch {
             rows,
             rubs: lanes.iter().flatten().any(|c| c.friction > 0.0),
             turns: lanes.iter().flatten().any(|c| c.turning),
+            rounding: [each(|c| c.rounding[0]), each(|c| c.rounding[1])],
+            rolls: lanes.iter().flatten().any(|c| c.rounding != [0.0; 2]),
+            carried: each(|c| f32::from(u8::from(!(c.dynamic[0] && c.dynamic[1]))))
+                .simd_gt(Lanes::ZERO),
         }
     }
 }
@@ -394,8 +408,10 @@ fn solve_friction<const DRIFT: bool>(
     points: &[PointX4],
     frictions: &mut [FrictionX4],
     pair: &mut PairVelocities,
+    share: f32,
 ) {
     let zero = Lanes::ZERO;
+    let share = batch.carried.select(Lanes::splat(share), Lanes::ONE);
     for (p, f) in points.iter().zip(frictions) {
         let [old0, old1] = f.impulse;
         let idle = p.normal_impulse.simd_eq(zero) & old0.simd_eq(zero) & old1.simd_eq(zero);
@@ -411,7 +427,7 @@ fn solve_friction<const DRIFT: bool>(
         f.impulse = pair.solve_disc::<DRIFT>(
             &rows,
             batch.tangents,
-            (f.impulse, f.drift),
+            (f.impulse, [f.drift[0] * share, f.drift[1] * share]),
             (limit, batch.inverse_mass),
         );
     }
@@ -426,6 +442,7 @@ fn solve_patch(
     points: &[PointX4],
     patch: &mut PatchX4,
     pair: &mut PairVelocities,
+    share: f32,
 ) {
     let zero = Lanes::ZERO;
     let (mut sum, mut moment) = (zero, zero);
@@ -445,10 +462,15 @@ fn solve_patch(
     pair.twist(patch, twist - old);
     patch.twist_impulse = twist;
     let rows = patch.tangent_rows;
+    let share = batch.carried.select(Lanes::splat(share), Lanes::ONE);
+    let drift = [
+        patch.tangent_drift[0] * share,
+        patch.tangent_drift[1] * share,
+    ];
     patch.tangent_impulse = pair.solve_disc::<true>(
         &rows,
         batch.tangents,
-        (patch.tangent_impulse, patch.tangent_drift),
+        (patch.tangent_impulse, drift),
         (limit, batch.inverse_mass),
     );
 }

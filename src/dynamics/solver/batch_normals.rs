@@ -83,10 +83,17 @@ impl<'a> NormalPass<'a> {
         let ((moved_a, dqa), (moved_b, dqb)) = (motion(0), motion(1));
         let n = batch.normal;
         let (zero, one) = (Lanes::ZERO, Lanes::ONE);
+        let turned = [dqa.inverse_rotate(n), dqb.inverse_rotate(n)];
+        let mut moved = (moved_b - moved_a).dot(n);
+        if batch.rolls {
+            // `contact_normals::rolled`, four lanes at once.
+            let [rho_a, rho_b] = batch.rounding;
+            moved = moved + rho_a * n.dot(turned[0] - n) + rho_b * n.dot(turned[1] - n);
+        }
         Self {
             batch,
-            moved: (moved_b - moved_a).dot(n),
-            turned: [dqa.inverse_rotate(n), dqb.inverse_rotate(n)],
+            moved,
+            turned,
             softness: if pass.use_bias {
                 batch.softness
             } else {

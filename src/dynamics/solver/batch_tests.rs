@@ -67,7 +67,7 @@ fn scene_with(model: FrictionModel, grounds: bool) -> (SolverBodies, Vec<Contact
                 friction: 0.6,
                 restitution: 0.0,
                 rolling_resistance: 0.0,
-                round: Default::default(),
+                rounding: [0.0; 2],
                 points: [ContactPointInput::default(); MAX_MANIFOLD_POINTS],
                 count,
                 key: k as u128,
@@ -125,8 +125,8 @@ fn batch_against_scalar(model: FrictionModel) {
     for c in &mut scalar {
         c.flip = true;
         c.warm_start(&mut scalar_states);
-        c.solve(&mut scalar_states, 1.0 / h, push, true);
-        c.solve(&mut scalar_states, 1.0 / h, push, false);
+        c.solve(&mut scalar_states, (1.0 / h, push), true, 1.0);
+        c.solve(&mut scalar_states, (1.0 / h, push), false, 1.0);
     }
     let mut batch_states = bodies.states.clone();
     let mut batched = constraints.clone();
@@ -135,8 +135,8 @@ fn batch_against_scalar(model: FrictionModel) {
         assert!(!ContactBatches::default().pack([refused], &constraints));
     }
     batch.warm_start(&mut batch_states);
-    batch.solve(&mut batch_states, 1.0 / h, push, true, true);
-    batch.solve(&mut batch_states, 1.0 / h, push, false, true);
+    batch.solve(&mut batch_states, (1.0 / h, push), true, true, 1.0);
+    batch.solve(&mut batch_states, (1.0 / h, push), false, true, 1.0);
     batch.unpack(&mut batched);
     for (s, b) in scalar_states.iter().zip(&batch_states) {
         assert!(
@@ -192,8 +192,8 @@ fn a_batch_repacked_over_a_fuller_one_solves_bit_for_bit_as_a_fresh_pack() {
     let solve = |batch: &mut ContactBatches| {
         let mut states = bodies.states.clone();
         batch.warm_start(&mut states);
-        batch.solve(&mut states, 240.0, 3.0, true, false);
-        batch.solve(&mut states, 240.0, 3.0, false, true);
+        batch.solve(&mut states, (240.0, 3.0), true, false, 1.0);
+        batch.solve(&mut states, (240.0, 3.0), false, true, 1.0);
         states
     };
     let mut reused = packed(&[&[0]], &constraints);
@@ -259,8 +259,8 @@ fn a_still_ground_read_as_constants_gives_the_bits_of_gathering_it() {
                 let mut states = bodies.states.clone();
                 batch.warm_start(&mut states);
                 for flip in [false, true] {
-                    batch.solve(&mut states, 240.0, 3.0, true, flip);
-                    batch.solve(&mut states, 240.0, 3.0, false, flip);
+                    batch.solve(&mut states, (240.0, 3.0), true, flip, 1.0);
+                    batch.solve(&mut states, (240.0, 3.0), false, flip, 1.0);
                 }
                 let mut out = constraints.to_vec();
                 batch.unpack(&mut out);

@@ -38,7 +38,7 @@
 //! step's chord and drift outward; `drift` (`anchor_drift.rs`, zero without such a spin) is
 //! the velocity that keeps it on its arc.
 
-use super::anchor_drift::AnchorDrift;
+use super::anchor_drift::{AnchorDrift, contact_share};
 use super::body::{BodyParams, BodyState, same_on_every_axis};
 use super::contact_pair::Pair;
 use super::patch_friction::{FrictionModel, PatchFriction};
@@ -46,7 +46,6 @@ use super::rolling::RollingRows;
 pub use super::row::{PointRow, RowPart};
 use super::softness::Softness;
 use crate::geometry::MAX_MANIFOLD_POINTS;
-use crate::geometry::contacts::RoundSide;
 use glam::Vec3;
 
 /// One point of a contact as detection found it.
@@ -74,10 +73,12 @@ pub struct ContactInput {
     pub restitution: f32,
     /// Lever arm of the pair's rolling resistance (m; 0: none; see [`RollingRows`]).
     pub rolling_resistance: f32,
-    /// Which body, if either, is round against a flat other: a ball's contact point moves
-    /// with the ball as it rolls, not with the surface under it (the friction targets on a
-    /// turning platform, `anchor_drift.rs`). `Neither` takes both sides' points as material.
-    pub round: RoundSide,
+    /// How far each body's surface lies outside its core at the contact (a ball's or a
+    /// capsule's radius, 0 for a shape with faces, edges or corners:
+    /// [`Shape::rounding`](crate::geometry::Shape::rounding)). A rounded body's contact stays
+    /// its core's point plus this radius as it rolls: its separation does not grow as it turns
+    /// and friction follows the contact across the other body (`anchor_drift.rs`).
+    pub rounding: [f32; 2],
     /// The points (the first `count`).
     pub points: [ContactPointInput; MAX_MANIFOLD_POINTS],
     /// How many points are used.
@@ -184,6 +185,9 @@ pub struct ContactConstraint {
     /// Whether a body spins about the normal (`anchor_drift.rs`): only then may the friction
     /// rows have a drift target, and a batch without one solves its rows without it.
     pub turning: bool,
+    /// A's and B's rounding ([`ContactInput::rounding`], finite and `>= 0`): a rounded
+    /// side's separation follows its core as it turns (`contact_normals.rs`).
+    pub rounding: [f32; 2],
 }
 
 /// How a step prepares its contacts' rows ([`ContactConstraint::prepare`]).
@@ -289,6 +293,7 @@ impl ContactConstraint {
             closing_acceleration: 0.0,
             impact: false,
             turning: false,
+            rounding: [0.0; 2],
         };
         c.refill(input, centers, states, params, settings);
         c
@@ -330,7 +335,10 @@ impl ContactConstraint {
         let per_point = model == FrictionModel::PerPoint;
         let still = [(pa, ia), (pb, ib)].map(|(p, i)| !p.dynamic && at_rest(&states[i]));
         let (sa, sb) = (&states[ia], &states[ib]);
-        let drift = AnchorDrift::new([sa, sb], (n, tangents), input.round, step);
+        let rounding = input
+            .rounding
+            .map(|r| if r.is_finite() { r.max(0.0) } else { 0.0 });
+        let drift = AnchorDrift::new([sa, sb], (n, tangents), rounding, step);
         for (cp, p) in self.points.iter_mut().zip(&input.points[..count]) {
             let ra = p.point - centers[ia];
             let rb = p.point - centers[ib];
@@ -375,6 +383,7 @@ impl ContactConstraint {
         self.dynamic = [pa.dynamic, pb.dynamic];
         self.still = still;
         self.turning = drift.is_some();
+        self.rounding = rounding;
         self.closing_acceleration = (pb.linear_acceleration - pa.linear_acceleration).dot(n);
         let fast = |p: &ConstraintPoint| p.relative_velocity.abs() > IMPACT_SPEED;
         self.impact = self.points[..count].iter().any(fast);
@@ -428,13 +437,14 @@ impl ContactConstraint {
     }
 
     /// One pass over the rows: non-penetration (biased when `use_bias`), then friction when
-    /// relaxing.
+    /// relaxing, aiming at `drift_share` of its drift targets (the substep's
+    /// [`drift_share`](super::anchor_drift::drift_share)).
     pub fn solve(
         &mut self,
         states: &mut [BodyState],
-        inv_h: f32,
-        max_push_out: f32,
+        (inv_h, max_push_out): (f32, f32),
         use_bias: bool,
+        drift_share: f32,
     ) {
         let mut pair = Pair::load(self, states);
         self.solve_normals(&mut pair, states, (inv_h, max_push_out), use_bias);
@@ -444,9 +454,10 @@ impl ContactConstraint {
                 let normal = self.points[..count].iter().map(|p| p.normal_impulse);
                 let limits = patch.limits(self.friction, normal);
                 let directions = (self.normal, self.tangents);
-                pair.solve_patch(patch, limits, directions, self.inverse_mass);
+                let share = contact_share(self.dynamic, drift_share);
+                pair.solve_patch(patch, limits, directions, (self.inverse_mass, share));
             } else {
-                self.solve_point_friction(&mut pair);
+                self.solve_point_friction(&mut pair, contact_share(self.dynamic, drift_share));
             }
         }
         if !use_bias && self.rolling.arm > 0.0 {
@@ -458,8 +469,8 @@ impl ContactConstraint {
     }
 
     /// Coulomb friction at each point: both tangent rows clamped together to the disc
-    /// `μ λ_n` of the point's own normal impulse.
-    fn solve_point_friction(&mut self, pair: &mut Pair) {
+    /// `μ λ_n` of the point's own normal impulse, aiming at `share` of the drift targets.
+    fn solve_point_friction(&mut self, pair: &mut Pair, share: f32) {
         for cp in &mut self.points[..self.count as usize] {
             let [old0, old1] = cp.tangent_impulse;
             if cp.normal_impulse == 0.0 && old0 == 0.0 && old1 == 0.0 {
@@ -469,10 +480,11 @@ impl ContactConstraint {
             }
             let limit = self.friction * cp.normal_impulse;
             let rows = [0, 1].map(|k| cp.row(&cp.tangent_rows[k], self.tangents[k]));
+            let [drift0, drift1] = cp.tangent_drift;
             cp.tangent_impulse = pair.solve_disc(
                 &rows,
                 self.tangents,
-                (cp.tangent_impulse, cp.tangent_drift),
+                (cp.tangent_impulse, [drift0 * share, drift1 * share]),
                 (limit, self.inverse_mass),
             );
         }

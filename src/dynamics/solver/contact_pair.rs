@@ -83,13 +83,14 @@ impl Pair {
     }
 
     /// A patch's friction ([`PatchFriction`]): the twist about the normal `n`, then the
-    /// tangent disc at the centre, within `(μ Σλ_i, μ Σλ_i d_i)`.
+    /// tangent disc at the centre, within `(μ Σλ_i, μ Σλ_i d_i)`, aiming at `share` of its
+    /// drift targets.
     pub(super) fn solve_patch(
         &mut self,
         patch: &mut PatchFriction,
         (limit, twist_limit): (f32, f32),
         (n, tangents): (Vec3, [Vec3; 2]),
-        inverse_mass: [Vec3; 2],
+        (inverse_mass, share): ([Vec3; 2], f32),
     ) {
         let old = patch.twist_impulse;
         if limit == 0.0 && old == 0.0 && patch.tangent_impulse == [0.0; 2] {
@@ -101,7 +102,8 @@ impl Pair {
         self.twist(patch, twist - old);
         patch.twist_impulse = twist;
         let rows = &patch.tangent_rows;
-        let old = (patch.tangent_impulse, patch.tangent_drift);
+        let [drift0, drift1] = patch.tangent_drift;
+        let old = (patch.tangent_impulse, [drift0 * share, drift1 * share]);
         patch.tangent_impulse = self.solve_disc(rows, tangents, old, (limit, inverse_mass));
     }
 

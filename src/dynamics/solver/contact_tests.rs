@@ -20,7 +20,7 @@ fn input(a: u32, b: u32, count: u8, k: f32) -> ContactInput {
         friction: 0.2 * k,
         restitution: 0.1 * k,
         rolling_resistance: 0.05 * (k - 1.0),
-        round: Default::default(),
+        rounding: [0.0; 2],
         points,
         count,
         key: k as u128,
@@ -86,4 +86,33 @@ fn a_constraint_refilled_over_a_fuller_one_equals_a_fresh_one_on_every_read_valu
     let mut unused_cleared = reused;
     unused_cleared.points[1..].copy_from_slice(&fresh.points[1..]);
     assert_eq!(unused_cleared, fresh);
+}
+
+#[test]
+fn a_rounded_side_rolled_by_any_turn_keeps_its_separation_and_an_unturned_one_adds_exactly_zero() {
+    // A ball of radius 0.5 on the ground (B, normal +z), its anchor straight down: rolled by
+    // θ its anchor, as a material point, rises by R (1 − cos θ); `rolled` takes that back.
+    let (n, radius) = (Vec3::Z, 0.5);
+    let anchor = -n * radius;
+    for angle in [0.01f32, 0.1, 0.5, 1.0] {
+        // A turn about the normal itself (z) lifts nothing either.
+        for axis in [
+            Vec3::X,
+            Vec3::new(0.6, 0.8, 0.0),
+            Vec3::new(0.0, 0.6, 0.8),
+            Vec3::Z,
+        ] {
+            let turned = Quat::from_axis_angle(axis, angle).inverse() * n;
+            let lifted = anchor.dot(turned) - anchor.dot(n);
+            let kept = lifted + normals::rolled([0.0, radius], n, [n, turned]);
+            assert!(
+                kept.abs() < 1e-6,
+                "rolled {angle} rad about {axis}: {kept} m"
+            );
+        }
+    }
+    assert_eq!(
+        normals::rolled([0.3, 0.5], n, [n, n]).to_bits(),
+        0.0f32.to_bits()
+    );
 }

@@ -103,6 +103,7 @@ pub use warm_start::WarmStartCache;
 
 use crate::dynamics::forces::{ForceModel, Spring, SpringEnd};
 use crate::settings::{MAX_SUBSTEPS, SettingsError};
+use anchor_drift::drift_share;
 use glam::Vec3;
 use integrate::{capped, integrate_positions, integrate_velocities};
 use joint_list::JointList;
@@ -322,7 +323,8 @@ impl Solver {
         self.stabilise_springs(bodies, springs, h);
         let springs = std::mem::take(&mut self.stable_springs);
         let mut flip = false;
-        for _ in 0..substeps {
+        for k in 0..substeps {
+            let share = drift_share(k, substeps);
             // Springs read the substep's starting state, as gravity and the forces do: read
             // after gravity's kick, a dashpot resisted it and a hanging body sagged (1 − c·h)
             // times its g/k (half of it at the damping bound).
@@ -335,7 +337,7 @@ impl Solver {
             self.joints.warm_start(&mut bodies.states);
             self.warm_start(bodies, flip);
             self.solve_joints(bodies, joint_soft, h, true);
-            self.solve_contacts(bodies, inv_h, true, flip);
+            self.solve_contacts(bodies, inv_h, true, (flip, share));
             integrate_positions(bodies, h, s.max_rotation_per_substep, s.max_linear_speed);
             self.joints.refresh(&bodies.states);
             for pass in 0..s.relax_iterations.max(s.joint_relax_iterations) {
@@ -343,7 +345,7 @@ impl Solver {
                     self.solve_joints(bodies, joint_soft, h, false);
                 }
                 if pass < s.relax_iterations {
-                    self.solve_contacts(bodies, inv_h, false, flip);
+                    self.solve_contacts(bodies, inv_h, false, (flip, share));
                 }
             }
         }
@@ -476,20 +478,20 @@ impl Solver {
     }
 
     /// One pass over every contact, batch by batch and then the rest one at a time: biased
-    /// (push-out) or relaxing (no bias, friction); `flip` visits each contact's points
-    /// backwards.
+    /// (push-out) or relaxing (no bias, friction aiming at `share` of its drift targets);
+    /// `flip` visits each contact's points backwards.
     fn solve_contacts(
         &mut self,
         bodies: &mut SolverBodies,
         inv_h: f32,
         use_bias: bool,
-        flip: bool,
+        (flip, share): (bool, f32),
     ) {
-        let push = self.settings.max_push_out;
-        self.batches
-            .solve(&mut bodies.states, inv_h, push, use_bias, flip);
+        let push = (inv_h, self.settings.max_push_out);
+        let states = &mut bodies.states;
+        self.batches.solve(states, push, use_bias, flip, share);
         for &i in self.batching.one_by_one() {
-            self.constraints[i as usize].solve(&mut bodies.states, inv_h, push, use_bias);
+            self.constraints[i as usize].solve(states, push, use_bias, share);
         }
     }
 

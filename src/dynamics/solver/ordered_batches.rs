@@ -188,7 +188,7 @@ mod tests {
                     friction: 0.5,
                     restitution: 0.0,
                     rolling_resistance: 0.0,
-                    round: Default::default(),
+                    rounding: [0.0; 2],
                     points: [ContactPointInput::default(); 4],
                     count: 1 + (k % 2) as u8,
                     key: k as u128,
@@ -265,7 +265,7 @@ mod tests {
             let mut scalar = cs.clone();
             for use_bias in [true, false, false] {
                 for c in &mut scalar {
-                    c.solve(&mut scalar_states, 1.0 / h, push, use_bias);
+                    c.solve(&mut scalar_states, (1.0 / h, push), use_bias, 1.0);
                 }
             }
             let mut packing = OrderedBatches::default();
@@ -274,7 +274,7 @@ mod tests {
             assert!(batches.pack(packing.batches(), &cs));
             let mut states = bodies.states.clone();
             for use_bias in [true, false, false] {
-                batches.solve(&mut states, 1.0 / h, push, use_bias, false);
+                batches.solve(&mut states, (1.0 / h, push), use_bias, false, 1.0);
             }
             for (s, b) in scalar_states.iter().zip(&states) {
                 assert!(

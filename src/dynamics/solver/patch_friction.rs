@@ -148,7 +148,7 @@ mod tests {
             friction: 0.5,
             restitution: 0.0,
             rolling_resistance: 0.0,
-            round: Default::default(),
+            rounding: [0.0; 2],
             points,
             count: 4,
             key: 7,

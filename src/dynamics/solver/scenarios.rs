@@ -115,7 +115,7 @@ impl Scene {
                     friction: (a.friction * b.friction).sqrt(),
                     restitution: a.restitution.max(b.restitution),
                     rolling_resistance: 0.0,
-                    round: Default::default(),
+                    rounding: [0.0; 2],
                     points: Default::default(),
                     count: m.points().len() as u8,
                     key: ((i as u128) << 32) | j as u128,

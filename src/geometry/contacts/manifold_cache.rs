@@ -35,14 +35,11 @@ use std::collections::HashMap;
 pub const MAX_SHIFT: f32 = 1e-3;
 
 /// Which body of a pair is round against a flat other, if one is: how an entry follows the
-/// bodies' motion since the test (the module notes), and whose motion the contact point
-/// follows as the bodies turn (a ball's rolls with the ball: the solver's friction targets,
-/// `dynamics/solver/anchor_drift.rs`).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+/// bodies' motion since the test (the module notes).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RoundSide {
     /// Neither is (two flat bodies meet on a face of either, two round ones along the line
     /// between them): the normal turns with A, the points are midway between the bodies'.
-    #[default]
     Neither,
     /// A is round, B flat.
     A,
@@ -58,15 +55,6 @@ impl RoundSide {
             (true, false) => Self::A,
             (false, true) => Self::B,
             _ => Self::Neither,
-        }
-    }
-
-    /// The same pair seen from the other side (A and B swapped).
-    pub fn flipped(self) -> Self {
-        match self {
-            Self::A => Self::B,
-            Self::B => Self::A,
-            Self::Neither => Self::Neither,
         }
     }
 }

@@ -30,7 +30,7 @@ use crate::ccd::{
 };
 use crate::components::*;
 use crate::dynamics::response::reflect;
-use crate::geometry::contacts::{ContactScratch, RoundSide};
+use crate::geometry::contacts::ContactScratch;
 use crate::geometry::{ContactManifold, Isometry};
 use crate::plugins::broad_phase::BroadPhaseIndex;
 use crate::plugins::integration::IntegrateBodies;
@@ -370,7 +370,7 @@ fn sweep_fast_bodies(
                     manifold: ContactManifold::single(-m.hit.normal, m.hit.point, 0.0),
                     normal_impulse: 0.0,
                     impact_speed: m.approach,
-                    round: RoundSide::Neither,
+                    rounding: [0.0; 2],
                 });
                 break;
             }
@@ -406,7 +406,7 @@ fn sweep_fast_bodies(
                 manifold: ContactManifold::single(-hit.normal, hit.point, 0.0),
                 normal_impulse: 0.0,
                 impact_speed: approach.max(0.0),
-                round: RoundSide::Neither,
+                rounding: [0.0; 2],
             });
         }
         // Impacts left over (max_impacts reached): stay at the last impact point. Without an

@@ -3,7 +3,6 @@
 //! [`OverlappingLeaves`] of each mesh contact.
 
 use crate::geometry::ContactManifold;
-use crate::geometry::contacts::RoundSide;
 use bevy_ecs::prelude::*;
 
 /// A contact between two bodies; the manifold's normal points from `a` to `b`.
@@ -33,10 +32,12 @@ pub struct ContactPair {
     /// damage by; about 0 for a resting contact, 0 until it has solved. The lecture's response
     /// gives the approach speed before it solved.
     pub impact_speed: f32,
-    /// Which collider, if either, is round against a flat other (a ball on a box): its
-    /// contact point moves with it as it rolls, which the solver's friction follows on a
-    /// turning platform.
-    pub round: RoundSide,
+    /// The rounding of `collider_a`'s and `collider_b`'s shapes ([`Shape::rounding`]: a
+    /// ball's or capsule's radius, else 0): the solver follows a rounded body's contact as it
+    /// rolls.
+    ///
+    /// [`Shape::rounding`]: crate::geometry::Shape::rounding
+    pub rounding: [f32; 2],
 }
 
 /// A sensor's overlap: `a` and `b` are the root bodies, `collider_a` and `collider_b` the parts

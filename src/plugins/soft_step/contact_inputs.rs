@@ -65,10 +65,11 @@ pub(super) fn gather_contacts(
         let ((ea, fa, ra), (eb, fb, rb)) = (material(a), material(b));
         // The lower slot first, whatever order the broad phase found the pair in (it follows
         // insertion, hence archetype, order).
-        let (a, b, normal, round) = if a <= b {
-            (a, b, pair.manifold.normal, pair.round)
+        let [rounding_a, rounding_b] = pair.rounding;
+        let (a, b, normal, rounding) = if a <= b {
+            (a, b, pair.manifold.normal, [rounding_a, rounding_b])
         } else {
-            (b, a, -pair.manifold.normal, pair.round.flipped())
+            (b, a, -pair.manifold.normal, [rounding_b, rounding_a])
         };
         let mut input = ContactInput {
             a: a as u32,
@@ -77,7 +78,7 @@ pub(super) fn gather_contacts(
             friction: (fa * fb).max(0.0).sqrt(),
             restitution: 0.5 * (ea + eb),
             rolling_resistance: ra.max(rb),
-            round,
+            rounding,
             points: Default::default(),
             count: pair.manifold.len() as u8,
             key: pair_key(pair.collider_a, pair.collider_b) << 16,
