@@ -316,15 +316,10 @@ impl Shape {
     /// rolls on its core: the contact under it stays the core's point plus this radius along
     /// the normal however it turns, which the solver follows (`dynamics/solver/contact.rs`).
     pub fn rounding(&self) -> f32 {
-        let radius = match self {
+        match self {
             Self::Sphere(s) => s.radius,
             Self::Capsule(c) => c.radius,
             _ => 0.0,
-        };
-        if radius.is_finite() {
-            radius.max(0.0)
-        } else {
-            0.0
         }
     }
 

@@ -65,10 +65,9 @@ struct ContactBatch {
     /// Whether any lane's friction rows may have a drift target
     /// ([`ContactConstraint::turning`]): the others solve them without one.
     turns: bool,
-    /// A's and B's rounding per lane ([`ContactConstraint::rounding`]).
+    /// A's and B's rounding per lane ([`ContactConstraint::rounding`]; zero in a batch
+    /// without a rounded side, which gathers none).
     rounding: [Lanes; 2],
-    /// Whether any lane has a rounded side: the others' separations skip the rounding.
-    rolls: bool,
     /// The lanes with an immovable side (all bits set), whose drift targets are spread over
     /// the substeps ([`contact_share`](super::anchor_drift::contact_share)).
     carried: Lanes,
@@ -359,6 +358,8 @@ impl ContactBatch {
             lanes.iter().flatten().all(|c| !c.translation_locked),
             "contacts of a body locked along some translation axes are solved one at a time"
         );
+        let turns = lanes.iter().flatten().any(|c| c.turning);
+        let rolls = lanes.iter().flatten().any(|c| c.rounding != [0.0; 2]);
         Self {
             bodies: [
                 std::array::from_fn(|l| real(l).a),
@@ -381,11 +382,16 @@ impl ContactBatch {
             count,
             rows,
             rubs: lanes.iter().flatten().any(|c| c.friction > 0.0),
-            turns: lanes.iter().flatten().any(|c| c.turning),
-            rounding: [each(|c| c.rounding[0]), each(|c| c.rounding[1])],
-            rolls: lanes.iter().flatten().any(|c| c.rounding != [0.0; 2]),
-            carried: each(|c| f32::from(u8::from(!(c.dynamic[0] && c.dynamic[1]))))
-                .simd_gt(Lanes::ZERO),
+            turns,
+            rounding: match rolls {
+                true => [each(|c| c.rounding[0]), each(|c| c.rounding[1])],
+                false => [Lanes::ZERO; 2],
+            },
+            carried: match turns {
+                true => each(|c| f32::from(u8::from(!(c.dynamic[0] && c.dynamic[1])))),
+                false => Lanes::ZERO,
+            }
+            .simd_gt(Lanes::ZERO),
         }
     }
 }
@@ -411,7 +417,11 @@ fn solve_friction<const DRIFT: bool>(
     share: f32,
 ) {
     let zero = Lanes::ZERO;
-    let share = batch.carried.select(Lanes::splat(share), Lanes::ONE);
+    let share = if DRIFT {
+        batch.carried.select(Lanes::splat(share), Lanes::ONE)
+    } else {
+        Lanes::ONE
+    };
     for (p, f) in points.iter().zip(frictions) {
         let [old0, old1] = f.impulse;
         let idle = p.normal_impulse.simd_eq(zero) & old0.simd_eq(zero) & old1.simd_eq(zero);
@@ -427,7 +437,7 @@ fn solve_friction<const DRIFT: bool>(
         f.impulse = pair.solve_disc::<DRIFT>(
             &rows,
             batch.tangents,
-            (f.impulse, [f.drift[0] * share, f.drift[1] * share]),
+            (f.impulse, f.drift, share),
             (limit, batch.inverse_mass),
         );
     }
@@ -463,14 +473,10 @@ fn solve_patch(
     patch.twist_impulse = twist;
     let rows = patch.tangent_rows;
     let share = batch.carried.select(Lanes::splat(share), Lanes::ONE);
-    let drift = [
-        patch.tangent_drift[0] * share,
-        patch.tangent_drift[1] * share,
-    ];
     patch.tangent_impulse = pair.solve_disc::<true>(
         &rows,
         batch.tangents,
-        (patch.tangent_impulse, drift),
+        (patch.tangent_impulse, patch.tangent_drift, share),
         (limit, batch.inverse_mass),
     );
 }

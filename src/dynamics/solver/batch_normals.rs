@@ -53,6 +53,16 @@ pub(super) fn solve_normals(
     }
 }
 
+/// `moved` with what `batch`'s rounded sides add to the separations when their bodies have
+/// turned the normal to `turned` (`contact_normals::rolled`, four lanes at once; nothing for
+/// lanes without rounding). Taken in every batch: behind a branch on whether any lane rolls,
+/// the pass's code cost a pyramid of boxes, which never took it, 0.8 % of its instructions.
+#[inline(always)]
+fn rolled(batch: &ContactBatch, moved: Lanes, [na, nb]: [Vec3x4; 2]) -> Lanes {
+    let (n, [rho_a, rho_b]) = (batch.normal, batch.rounding);
+    moved + rho_a * n.dot(na - n) + rho_b * n.dot(nb - n)
+}
+
 impl<'a> NormalPass<'a> {
     /// Inlined, as [`solve_normals`]: returned through memory, it was read back by each sweep.
     #[inline(always)]
@@ -84,15 +94,10 @@ impl<'a> NormalPass<'a> {
         let n = batch.normal;
         let (zero, one) = (Lanes::ZERO, Lanes::ONE);
         let turned = [dqa.inverse_rotate(n), dqb.inverse_rotate(n)];
-        let mut moved = (moved_b - moved_a).dot(n);
-        if batch.rolls {
-            // `contact_normals::rolled`, four lanes at once.
-            let [rho_a, rho_b] = batch.rounding;
-            moved = moved + rho_a * n.dot(turned[0] - n) + rho_b * n.dot(turned[1] - n);
-        }
+        let moved = (moved_b - moved_a).dot(n);
         Self {
             batch,
-            moved,
+            moved: rolled(batch, moved, turned),
             turned,
             softness: if pass.use_bias {
                 batch.softness

@@ -74,9 +74,10 @@ impl PointX4 {
     pub fn gather(points: [&ConstraintPoint; LANES], still: [[bool; 2]; LANES]) -> Self {
         let each = |f: fn(&ConstraintPoint) -> f32| Lanes::new(points.map(f));
         let anchors = |side: usize, r: fn(&ConstraintPoint) -> Vec3| {
-            Vec3x4::gather(std::array::from_fn(|l| {
-                on_moving(still[l][side], r(points[l]))
-            }))
+            // Written out, not `array::from_fn`, which may stay out of line (see
+            // `Vec3x4::gather`).
+            let at = |l: usize| on_moving(still[l][side], r(points[l]));
+            Vec3x4::gather([at(0), at(1), at(2), at(3)])
         };
         Self {
             anchor_a: anchors(0, |p| p.anchor_a),
@@ -210,20 +211,20 @@ impl PairVelocities {
     }
 
     /// Two tangent rows clamped together to the disc `|λ| ≤ limit`, each solving
-    /// `J V + drift = 0` (`J V = 0`, the drift unread, unless `DRIFT`), as the scalar rows: the
-    /// new accumulated impulses from the `old` ones.
+    /// `J V + share · drift = 0` (`J V = 0`, the drift unread, unless `DRIFT`), as the scalar
+    /// rows: the new accumulated impulses from the `old` ones.
     #[inline(always)]
     pub(super) fn solve_disc<const DRIFT: bool>(
         &mut self,
         [r0, r1]: &[RowX4; 2],
         [t0, t1]: [Vec3x4; 2],
-        ([old0, old1], [drift0, drift1]): ([Lanes; 2], [Lanes; 2]),
+        ([old0, old1], [drift0, drift1], share): ([Lanes; 2], [Lanes; 2], Lanes),
         (limit, inverse_mass): (Lanes, [Lanes; 2]),
     ) -> [Lanes; 2] {
         let (zero, one) = (Lanes::ZERO, Lanes::ONE);
         let (mut v0, mut v1) = (self.along(t0, r0), self.along(t1, r1));
         if DRIFT {
-            (v0, v1) = (v0 + drift0, v1 + drift1);
+            (v0, v1) = (v0 + drift0 * share, v1 + drift1 * share);
         }
         let w0 = old0 - r0.mass * v0;
         let w1 = old1 - r1.mass * v1;

@@ -84,22 +84,20 @@ impl WarmStartCache {
             let Some(old) = self.contacts.get(cursor).filter(|o| o.key == c.key) else {
                 continue;
             };
-            let matched = MatchedSide::of(c, &orientation);
             let old_points = &old.points[..old.count as usize];
-            let (normal, tangents) = (c.normal, c.tangents);
-            for cp in &mut c.points[..c.count as usize] {
-                let local = matched.local(cp);
-                let nearest = old_points
-                    .iter()
-                    .map(|p| (p.local_anchor.distance_squared(local), p))
-                    .min_by(|x, y| x.0.total_cmp(&y.0));
-                let close = nearest.filter(|(d2, _)| *d2 <= match_distance * match_distance);
-                if let Some((_, p)) = close {
-                    cp.normal_impulse = p.normal_impulse.max(0.0) * scale;
-                    cp.max_normal_impulse = cp.normal_impulse;
-                    cp.tangent_impulse = on_tangents(p.friction_impulse, normal, tangents, scale);
+            let reuse = (scale, match_distance);
+            // Two loops, not a choice per point: most contacts have no rounded side.
+            match MatchedSide::of(c) {
+                None => {
+                    let to_local = orientation(c.a).inverse();
+                    seed_points(c, old_points, |cp| to_local * cp.anchor_a, reuse);
+                }
+                Some(side) => {
+                    let to_local = orientation(side.slot).inverse();
+                    seed_points(c, old_points, |cp| to_local * side.anchor(cp), reuse);
                 }
             }
+            let (normal, tangents) = (c.normal, c.tangents);
             if let (Some(patch), Some((f, twist))) = (&mut c.patch, old.patch) {
                 patch.tangent_impulse = on_tangents(f, normal, tangents, scale);
                 patch.twist_impulse = twist * scale;
@@ -118,15 +116,16 @@ impl WarmStartCache {
         self.contacts.clear();
         self.h = h;
         for c in constraints {
-            let matched = MatchedSide::of(c, &orientation);
-            let mut points = [StoredPoint::default(); MAX_MANIFOLD_POINTS];
-            for (stored, cp) in points.iter_mut().zip(c.points()) {
-                *stored = StoredPoint {
-                    local_anchor: matched.local(cp),
-                    normal_impulse: cp.normal_impulse,
-                    friction_impulse: in_world(c.tangents, cp.tangent_impulse),
-                };
-            }
+            let points = match MatchedSide::of(c) {
+                None => {
+                    let to_local = orientation(c.a).inverse();
+                    stored_points(c, |cp| to_local * cp.anchor_a)
+                }
+                Some(side) => {
+                    let to_local = orientation(side.slot).inverse();
+                    stored_points(c, |cp| to_local * side.anchor(cp))
+                }
+            };
             let patch = c
                 .patch
                 .map(|p| (in_world(c.tangents, p.tangent_impulse), p.twist_impulse));
@@ -140,37 +139,87 @@ impl WarmStartCache {
     }
 }
 
-/// The side whose frame a contact's points are matched in (module docs): A's anchors, or a
-/// rounded side's core points.
+/// Seeds the points of `c` from the `old` ones of its pair: each takes the impulses of the
+/// nearest old point whose place (`local`, in the matched side's frame) lies within the match
+/// distance, scaled by the substeps' ratio.
+#[inline]
+fn seed_points(
+    c: &mut ContactConstraint,
+    old: &[StoredPoint],
+    local: impl Fn(&ConstraintPoint) -> Vec3,
+    (scale, match_distance): (f32, f32),
+) {
+    let (normal, tangents) = (c.normal, c.tangents);
+    for cp in &mut c.points[..c.count as usize] {
+        let local = local(cp);
+        let nearest = old
+            .iter()
+            .map(|p| (p.local_anchor.distance_squared(local), p))
+            .min_by(|x, y| x.0.total_cmp(&y.0));
+        let close = nearest.filter(|(d2, _)| *d2 <= match_distance * match_distance);
+        if let Some((_, p)) = close {
+            cp.normal_impulse = p.normal_impulse.max(0.0) * scale;
+            cp.max_normal_impulse = cp.normal_impulse;
+            cp.tangent_impulse = on_tangents(p.friction_impulse, normal, tangents, scale);
+        }
+    }
+}
+
+/// The points of `c` to remember, each at its place `local` in the matched side's frame.
+#[inline]
+fn stored_points(
+    c: &ContactConstraint,
+    local: impl Fn(&ConstraintPoint) -> Vec3,
+) -> [StoredPoint; MAX_MANIFOLD_POINTS] {
+    let mut points = [StoredPoint::default(); MAX_MANIFOLD_POINTS];
+    for (stored, cp) in points.iter_mut().zip(c.points()) {
+        *stored = StoredPoint {
+            local_anchor: local(cp),
+            normal_impulse: cp.normal_impulse,
+            friction_impulse: in_world(c.tangents, cp.tangent_impulse),
+        };
+    }
+    points
+}
+
+/// A rounded side whose frame a contact's points are matched in, at their core points
+/// (module docs).
 struct MatchedSide {
-    /// World to the side's body frame.
-    to_local: Quat,
+    /// The side's body slot.
+    slot: u32,
     /// B (else A).
     b: bool,
-    /// From the anchor to the core point along the normal (zero for a side without rounding).
+    /// From the anchor to the core point along the normal.
     to_core: Vec3,
 }
 
 impl MatchedSide {
-    fn of(c: &ContactConstraint, orientation: &impl Fn(u32) -> Quat) -> Self {
+    /// A's side if A is rounded, else B's if B is; none without rounding (A's anchors).
+    #[inline]
+    fn of(c: &ContactConstraint) -> Option<Self> {
         let [rho_a, rho_b] = c.rounding;
-        let b = rho_a == 0.0 && rho_b > 0.0;
-        let (slot, to_core) = if b {
-            (c.b, c.normal * rho_b)
+        if rho_a > 0.0 {
+            Some(Self {
+                slot: c.a,
+                b: false,
+                to_core: -c.normal * rho_a,
+            })
+        } else if rho_b > 0.0 {
+            Some(Self {
+                slot: c.b,
+                b: true,
+                to_core: c.normal * rho_b,
+            })
         } else {
-            (c.a, -c.normal * rho_a)
-        };
-        Self {
-            to_local: orientation(slot).inverse(),
-            b,
-            to_core,
+            None
         }
     }
 
-    /// Point `cp`'s place in the matched side's frame.
-    fn local(&self, cp: &ConstraintPoint) -> Vec3 {
+    /// Point `cp`'s core point from the side's centre (world axes).
+    #[inline]
+    fn anchor(&self, cp: &ConstraintPoint) -> Vec3 {
         let anchor = if self.b { cp.anchor_b } else { cp.anchor_a };
-        self.to_local * (anchor + self.to_core)
+        anchor + self.to_core
     }
 }
 
