@@ -116,3 +116,33 @@ fn a_rounded_side_rolled_by_any_turn_keeps_its_separation_and_an_unturned_one_ad
         0.0f32.to_bits()
     );
 }
+
+#[test]
+fn a_rounding_that_is_not_a_finite_length_is_taken_as_none_and_the_other_side_kept() {
+    let mut bodies = SolverBodies::default();
+    for x in [0.0, 1.0] {
+        bodies.push(BodyInput {
+            center: Vec3::new(x, 0.0, 0.0),
+            inverse_mass: 1.0,
+            inverse_principal_inertia: Vec3::ONE,
+            ..Default::default()
+        });
+    }
+    let settings = RowSettings {
+        softness: Softness::new(30.0, 10.0, 1.0 / 240.0),
+        friction: FrictionModel::PerPoint,
+        step: 1.0 / 60.0,
+    };
+    let cases = [
+        ([f32::NAN, -1.0], [0.0, 0.0]),
+        ([f32::INFINITY, 0.5], [0.0, 0.5]),
+        ([0.25, f32::NEG_INFINITY], [0.25, 0.0]),
+    ];
+    for (given, kept) in cases {
+        let mut c = input(0, 1, 2, 1.0);
+        c.rounding = given;
+        let (centers, states, params) = (&bodies.centers, &bodies.states, &bodies.params);
+        let prepared = ContactConstraint::prepare(&c, centers, states, params, settings);
+        assert_eq!(prepared.rounding, kept, "{given:?}");
+    }
+}
