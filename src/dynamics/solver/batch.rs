@@ -191,8 +191,8 @@ impl ContactBatches {
 
     /// One pass over the batches ([`ContactConstraint::solve`] per lane; `flip` visits the
     /// points backwards): biased (push-out, normal rows only) or relaxing (no bias, friction
-    /// aiming at `share` of its drift targets: the substep's
-    /// [`drift_share`](super::anchor_drift::drift_share)).
+    /// aiming at `share` of its drift targets: `(2k + 1)/n` in substep `k` of `n` on a
+    /// platform, `anchor_drift.rs`).
     pub fn solve(
         &mut self,
         states: &mut [BodyState],

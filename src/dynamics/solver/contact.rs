@@ -437,8 +437,8 @@ impl ContactConstraint {
     }
 
     /// One pass over the rows: non-penetration (biased when `use_bias`), then friction when
-    /// relaxing, aiming at `drift_share` of its drift targets (the substep's
-    /// [`drift_share`](super::anchor_drift::drift_share)).
+    /// relaxing, aiming at `drift_share` of its drift targets (`(2k + 1)/n` in substep `k` of
+    /// `n`, `anchor_drift.rs`; a contact between two dynamic bodies takes 1).
     pub fn solve(
         &mut self,
         states: &mut [BodyState],
