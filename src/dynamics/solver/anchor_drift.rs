@@ -109,7 +109,14 @@ pub(super) fn drift_share(k: u32, n: u32) -> f32 {
 /// from the first substep between two dynamic bodies (module docs, *Across substeps*).
 #[inline]
 pub(super) fn contact_share(dynamic: [bool; 2], share: f32) -> f32 {
-    if dynamic[0] && dynamic[1] { 1.0 } else { share }
+    if spreads_target(dynamic) { share } else { 1.0 }
+}
+
+/// Whether a contact between bodies that are `dynamic` spreads its drift target over the
+/// substeps: when one of them is immovable ([`contact_share`]).
+#[inline]
+pub(super) fn spreads_target(dynamic: [bool; 2]) -> bool {
+    !(dynamic[0] && dynamic[1])
 }
 
 /// The friction targets of one contact's points (module docs), taken once per step.

@@ -21,6 +21,7 @@
 //! unpacked into them after the substeps, so restitution, warm-start storage and contact
 //! reports read the constraints as before.
 
+use super::anchor_drift::spreads_target;
 use super::batch_rows::{FrictionX4, PatchX4, PointX4};
 use super::body::BodyState;
 use super::contact::{ConstraintPoint, ContactConstraint};
@@ -69,7 +70,7 @@ struct ContactBatch {
     /// without a rounded side, which gathers none).
     rounding: [Lanes; 2],
     /// The lanes with an immovable side (all bits set), whose drift targets are spread over
-    /// the substeps ([`contact_share`](super::anchor_drift::contact_share)).
+    /// the substeps ([`spreads_target`]).
     carried: Lanes,
 }
 
@@ -388,7 +389,7 @@ impl ContactBatch {
                 false => [Lanes::ZERO; 2],
             },
             carried: match turns {
-                true => each(|c| f32::from(u8::from(!(c.dynamic[0] && c.dynamic[1])))),
+                true => each(|c| f32::from(u8::from(spreads_target(c.dynamic)))),
                 false => Lanes::ZERO,
             }
             .simd_gt(Lanes::ZERO),

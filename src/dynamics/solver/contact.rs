@@ -45,7 +45,7 @@ use super::patch_friction::{FrictionModel, PatchFriction};
 use super::rolling::RollingRows;
 pub use super::row::{PointRow, RowPart};
 use super::softness::Softness;
-use crate::geometry::MAX_MANIFOLD_POINTS;
+use crate::geometry::{MAX_MANIFOLD_POINTS, length_or_zero};
 use glam::Vec3;
 
 /// One point of a contact as detection found it.
@@ -335,9 +335,7 @@ impl ContactConstraint {
         let per_point = model == FrictionModel::PerPoint;
         let still = [(pa, ia), (pb, ib)].map(|(p, i)| !p.dynamic && at_rest(&states[i]));
         let (sa, sb) = (&states[ia], &states[ib]);
-        let rounding = input
-            .rounding
-            .map(|r| if r.is_finite() { r.max(0.0) } else { 0.0 });
+        let rounding = input.rounding.map(length_or_zero);
         let drift = AnchorDrift::new([sa, sb], (n, tangents), rounding, step);
         for (cp, p) in self.points.iter_mut().zip(&input.points[..count]) {
             let ra = p.point - centers[ia];

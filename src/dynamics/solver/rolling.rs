@@ -10,6 +10,7 @@
 //! clamps the linear rows: a rolling ball decelerates at `(b/R) g / (1 + I/(m R²))`, and a ball
 //! resting on the floor feels nothing. Spin about the normal (drilling) is not resisted.
 
+use crate::geometry::length_or_zero;
 use glam::{Mat3, Vec3};
 
 /// The rolling rows of one contact, prepared once per step.
@@ -29,7 +30,7 @@ impl RollingRows {
     /// Rows for lever arm `arm` (a non-finite or negative one is 0: none) in the plane of
     /// `tangents`, with the world inverse inertias of A and B.
     pub fn new(arm: f32, tangents: [Vec3; 2], inverse_inertia: [Mat3; 2]) -> Self {
-        let arm = if arm.is_finite() { arm.max(0.0) } else { 0.0 };
+        let arm = length_or_zero(arm);
         if arm == 0.0 {
             return Self::default();
         }

@@ -18,7 +18,9 @@
 use super::{
     ContactScratch, contact_trimesh_trimesh_within, contact_with_scratch, general_convex_contact,
 };
-use crate::geometry::{Capsule, ContactManifold, ContactPoint, Cuboid, Isometry, Shape, Sphere};
+use crate::geometry::{
+    Capsule, ContactManifold, ContactPoint, Cuboid, Isometry, Shape, Sphere, length_or_zero,
+};
 
 /// The shape grown exactly by `margin` (a ball's or a capsule's radius), or `None`.
 fn rounded_grown(shape: &Shape, margin: f32) -> Option<Shape> {
@@ -184,8 +186,11 @@ const MAX_GROWN_BOX_ERROR: f32 = 1e-5;
 /// lookahead passes `a (n + 1) / n`. Non-finite inputs count as no motion (validation
 /// quarantines such bodies).
 pub fn motion_bound(speed: f32, angular_speed: f32, reach: f32, acceleration: f32, dt: f32) -> f32 {
-    let d = raw_motion_bound(speed + angular_speed * reach, acceleration, dt);
-    if d.is_finite() { d.max(0.0) } else { 0.0 }
+    length_or_zero(raw_motion_bound(
+        speed + angular_speed * reach,
+        acceleration,
+        dt,
+    ))
 }
 
 /// [`motion_bound`] of a point at `speed` as computed, infinite or NaN when the inputs are (a

@@ -40,6 +40,7 @@
 
 use crate::components::{AngularVelocity, BoundingVolume, GravityScale, Velocity};
 use crate::geometry::contacts::{motion_bound, raw_motion_bound};
+use crate::geometry::length_or_zero;
 use crate::settings::{Gravity, PhysicsTimestep};
 use bevy_ecs::prelude::*;
 use bevy_ecs::system::SystemParam;
@@ -208,7 +209,7 @@ impl Lookahead {
         let own = motion_bound(v.0.length(), spin, reach, fall * self.euler, self.dt)
             .min(m.reach_ratio * reach);
         let (moved, pulled) = moves.masks();
-        let finite = |x: f32| if x.is_finite() { x.max(0.0) } else { 0.0 };
+        let finite = length_or_zero;
         BodyMotion {
             velocity: v.0 * moved,
             pull: self.gravity * scale * pulled,
@@ -233,8 +234,7 @@ impl Lookahead {
         } else {
             f32::INFINITY
         };
-        let d = (a.distance + b.distance + closing).min(a.own + b.own);
-        if d.is_finite() { d.max(0.0) } else { 0.0 }
+        length_or_zero((a.distance + b.distance + closing).min(a.own + b.own))
     }
 }
 
