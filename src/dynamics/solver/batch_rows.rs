@@ -12,6 +12,7 @@
 //! 1,015, where it ran 1.11× rapier's instructions, when a point took 816 bytes in one piece).
 
 use super::contact::{ConstraintPoint, PointRow, RowPart, on_moving};
+use super::contact_pair::SLIDING_FROM;
 use super::lanes::{LANES, Lanes, PairVelocities, Vec3x4};
 use super::patch_friction::PatchFriction;
 use crate::geometry::MAX_MANIFOLD_POINTS;
@@ -230,10 +231,50 @@ impl PairVelocities {
         let w1 = old1 - r1.mass * v1;
         let length = (w0 * w0 + w1 * w1).sqrt();
         let clamped = length.simd_gt(limit) & length.simd_gt(zero);
+        // Sliding, the impulse opposes the slip (the scalar rows' `Pair::solve_disc` says
+        // why and how); only clamped lanes take it, so a batch with none skips it.
+        let (w0, w1, length) = if clamped.any() {
+            sliding(
+                [w0, w1],
+                length,
+                clamped,
+                ([old0, old1], [v0, v1]),
+                (limit, [r0, r1]),
+            )
+        } else {
+            (w0, w1, length)
+        };
         let scale = clamped.select(limit / length, one);
         let (new0, new1) = (w0 * scale, w1 * scale);
         self.push(inverse_mass, t0, &r0.turn, new0 - old0);
         self.push(inverse_mass, t1, &r1.turn, new1 - old1);
         [new0, new1]
     }
+}
+
+/// The impulse of clamped lanes that slide, before the clamp (see `Pair::solve_disc`): from
+/// the rows' own masses `w` towards `old − m̄ v` as the lane asks for 4–8 times its limit.
+/// Where nothing is asked and there is no limit, the blend is 0/0, and such a lane is not
+/// clamped: the mask keeps `w` there.
+#[inline(always)]
+fn sliding(
+    [w0, w1]: [Lanes; 2],
+    length: Lanes,
+    clamped: Lanes,
+    ([old0, old1], [v0, v1]): ([Lanes; 2], [Lanes; 2]),
+    (limit, [r0, r1]): (Lanes, [&RowX4; 2]),
+) -> (Lanes, Lanes, Lanes) {
+    let (zero, one) = (Lanes::ZERO, Lanes::ONE);
+    let mean = (r0.mass + r1.mass) * Lanes::splat(0.5);
+    let from = Lanes::splat(SLIDING_FROM);
+    let slid = ((length / limit - from) / from).min(one).max(zero);
+    let s0 = w0 + slid * (old0 - mean * v0 - w0);
+    let s1 = w1 + slid * (old1 - mean * v1 - w1);
+    let slide = (s0 * s0 + s1 * s1).sqrt();
+    let slides = clamped & slide.simd_gt(zero);
+    (
+        slides.select(s0, w0),
+        slides.select(s1, w1),
+        slides.select(slide, length),
+    )
 }

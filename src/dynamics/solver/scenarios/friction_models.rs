@@ -27,22 +27,34 @@ fn spun_box(model: FrictionModel, mu: f32, spin: f32, seconds: f32) -> f32 {
 }
 
 #[test]
-fn a_box_spun_on_the_ground_slows_as_coulomb_predicts_within_3_percent_per_point_and_per_patch() {
+fn a_box_spun_on_the_ground_slows_as_coulomb_predicts_within_0_1_percent_per_point_and_per_patch() {
     // Each corner carries m g / 4 at √2 · 0.5 m from the axis and slides across its radius,
     // so friction's torque is μ m g √2 · 0.5 and the cube (I = m s² / 6 = m / 6) slows at
-    // 6 μ g √2 · 0.5 rad/s² (20.8 at μ = 0.5) until it stops.
-    let (mu, spin, t) = (0.5f32, 20.0f32, 0.5f32);
-    let slowing = 6.0 * mu * 9.81 * 2f32.sqrt() * 0.5;
-    let expected = spin - slowing * t;
+    // 6 μ g √2 · 0.5 rad/s² (20.8 at μ = 0.5) until it stops. Per point, each corner's two
+    // friction rows have masses 2.7:1 apart once the box has turned 30°: solved apart and
+    // clamped, they slowed it 1.3 % less than this (`Pair::solve_disc`). Above 30 rad/s (half
+    // a radian a step) the turning-platform target, which fades out for a point slipping at
+    // 2–4 times it, is no longer faded for a corner that slips at `ω r` against its `ω² r h/2`:
+    // at 40 rad/s the cube slows 1.7 % less.
+    for (mu, spin, t) in [
+        (0.5f32, 20.0f32, 0.5f32),
+        (0.2, 3.0, 0.25),
+        (0.5, 30.0, 0.3),
+    ] {
+        let slowing = 6.0 * mu * 9.81 * 2f32.sqrt() * 0.5;
+        let expected = spin - slowing * t;
+        for model in [FrictionModel::PerPoint, PATCH] {
+            let w = spun_box(model, mu, spin, t);
+            eprintln!("{model:?}: {w} rad/s after {t} s, Coulomb predicts {expected}");
+            assert!(
+                ((spin - w) / (spin - expected) - 1.0).abs() < 1e-3,
+                "{model:?}, mu {mu}, from {spin} rad/s: {w} rad/s, Coulomb predicts {expected}"
+            );
+        }
+    }
     for model in [FrictionModel::PerPoint, PATCH] {
-        let w = spun_box(model, mu, spin, t);
-        eprintln!("{model:?}: {w} rad/s after {t} s, Coulomb predicts {expected}");
-        assert!(
-            (w / expected - 1.0).abs() < 0.03,
-            "{model:?}: {w} rad/s, Coulomb predicts {expected}"
-        );
         // And it stops, not reverses.
-        let stopped = spun_box(model, mu, spin, 1.5);
+        let stopped = spun_box(model, 0.5, 20.0, 1.5);
         assert!(stopped.abs() < 0.05, "{model:?}: still {stopped} rad/s");
     }
 }
