@@ -8,8 +8,9 @@
 //! A shape never stores its pose: the pose comes with every query (see [`Isometry`]).
 
 use crate::bounding::Aabb;
+use crate::geometry::convex::support::LINE_FEATURE_SINE;
 use crate::geometry::{ConvexHull, Isometry, MeshCollider};
-use glam::Vec3;
+use glam::{Quat, Vec3};
 use std::fmt;
 use std::sync::Arc;
 
@@ -320,6 +321,24 @@ impl Shape {
             Self::Sphere(s) => s.radius,
             Self::Capsule(c) => c.radius,
             _ => 0.0,
+        }
+    }
+
+    /// [`Self::rounding`] for a contact of normal `normal` (world) with the shape turned by
+    /// `rotation`: also a cylinder's radius where it lies on its side (the normal square to its
+    /// axis within the tolerance that makes its side line the contact feature). Rolling, it
+    /// turns about its axis, which keeps its axis at its radius from the contact as a ball's
+    /// centre is kept: read as a material point instead, its contact rose `r (1 − cos θ)` a
+    /// step and the solver let it sink that far, 1.8 mm at 3 m/s for a 0.3 m radius (`∝ v²`).
+    /// On its cap or its rim it has corners: 0.
+    pub fn rounding_along(&self, rotation: Quat, normal: Vec3) -> f32 {
+        match self {
+            Self::Cylinder(c) => {
+                let axis = rotation * Vec3::Z;
+                let square = axis.dot(normal).abs() <= LINE_FEATURE_SINE * normal.length();
+                if square { c.radius } else { 0.0 }
+            }
+            _ => self.rounding(),
         }
     }
 

@@ -492,7 +492,10 @@ impl NarrowPhaseScratch {
                 manifold,
                 normal_impulse: 0.0,
                 impact_speed: 0.0,
-                rounding: [ca.shape.rounding(), cb.shape.rounding()],
+                rounding: [
+                    ca.shape.rounding_along(ga.0.rotation, manifold.normal),
+                    cb.shape.rounding_along(gb.0.rotation, manifold.normal),
+                ],
             });
             if debug.enabled && involves_mesh {
                 let overlap = leaf_overlap(la, &ca.shape, lb, &cb.shape, &self.contact);

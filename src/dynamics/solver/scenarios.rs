@@ -115,7 +115,10 @@ impl Scene {
                     friction: (a.friction * b.friction).sqrt(),
                     restitution: a.restitution.max(b.restitution),
                     rolling_resistance: 0.0,
-                    rounding: [0.0; 2],
+                    rounding: [
+                        a.shape.rounding_along(a.orientation, m.normal),
+                        b.shape.rounding_along(b.orientation, m.normal),
+                    ],
                     points: Default::default(),
                     count: m.points().len() as u8,
                     key: ((i as u128) << 32) | j as u128,

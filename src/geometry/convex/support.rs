@@ -29,7 +29,7 @@ const CAP_FEATURE_COSINE: f32 = 0.5;
 
 /// A cylinder's side or a capsule's segment lies flat along the direction's plane when the
 /// direction's axial component is at most this (sine, ~3°); a line contact then has two ends.
-const LINE_FEATURE_SINE: f32 = 0.05;
+pub(crate) const LINE_FEATURE_SINE: f32 = 0.05;
 
 /// The inner shape a convex shape is rounded from.
 #[derive(Clone, Copy, Debug)]

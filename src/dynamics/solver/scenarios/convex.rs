@@ -72,7 +72,7 @@ fn a_standing_cylinder_rests_on_ground_within_0_2_mm_box_0_25_mm_and_mesh_0_5_mm
 }
 
 #[test]
-fn a_cylinder_rolling_across_a_tessellated_floor_keeps_its_line_within_2_mm_per_m_and_95_percent_of_its_speed()
+fn a_cylinder_rolling_across_a_tessellated_floor_keeps_its_line_within_2_mm_per_m_its_height_within_0_1_mm_and_99_5_percent_of_its_speed()
  {
     let radius = 0.3;
     let floor = MeshCollider::new(TriMesh::grid_floor(20.0, 40).unwrap()).unwrap();
@@ -93,16 +93,16 @@ fn a_cylinder_rolling_across_a_tessellated_floor_keeps_its_line_within_2_mm_per_
     let b = &scene.bodies[c];
     let travelled = b.center.x + 6.0;
     assert!(travelled > 5.0, "rolled only {travelled} m");
-    // Across the seams: no hop, no veer. Not all the speed is kept: 2.87 m/s of 3 (on a
-    // half-space 2.997), a limit the README states. Before the seams handed a separated
-    // part beside them to the neighbour, 2.39.
-    assert!((b.center.z - radius).abs() < 2e-3, "height {}", b.center.z);
+    // Across the seams: no hop, no veer, and its speed kept. Read as a material point (before
+    // `Shape::rounding_along`), it sank 1.8 mm and hopped at the seams, keeping 2.87 m/s of 3;
+    // before the seams handed a separated part beside them to the neighbour, 2.39.
+    assert!((b.center.z - radius).abs() < 1e-4, "height {}", b.center.z);
     assert!(
         (b.center.y - 0.1).abs() < 2e-3 * travelled,
         "veered to y = {}",
         b.center.y
     );
-    assert!(b.v.x > 0.95 * 3.0, "speed {}", b.v.x);
+    assert!(b.v.x > 0.995 * 3.0, "speed {}", b.v.x);
 }
 
 /// The hull of a box's corners and its face centres (coplanar extras the hull must merge).
