@@ -13,6 +13,72 @@ use glam::Vec3;
 /// Most points a manifold keeps: four span a face-face contact, enough for a box to rest flat.
 pub const MAX_MANIFOLD_POINTS: usize = 4;
 
+/// Which features of the two shapes made a contact point: the same number from step to step
+/// while the same features touch (a box's corner on a face, an edge crossing a side of the
+/// reference face), whatever has moved, so that a warm start follows the point (Box2D's
+/// `b2ManifoldPoint::id`, parry's `PackedFeatureId` under rapier and Avian). Where a shape
+/// test has none to give, [`FeatureId::NONE`], and the point is matched by place.
+///
+/// The number is a name, not a ranking: only equality means something, and two different
+/// features of one pair may rarely share one (mesh triangles' numbers are mixed into 32 bits);
+/// a warm start taken from the wrong point is a worse first guess, nothing more.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub struct FeatureId(pub u32);
+
+/// The bit of a [`FeatureId`] that marks a feature of the shape a mesh part meets, alone.
+const OTHER_ALONE: u32 = 1 << 30;
+
+impl FeatureId {
+    /// No feature known.
+    pub const NONE: Self = Self(0);
+
+    /// The vertex where two lines of a face contact cross (`tag`, the clipping's name for
+    /// the pair of lines), within `context` (which faces met, whose is the reference).
+    #[inline]
+    pub(crate) fn clipped(context: u32, tag: u16) -> Self {
+        Self(((context & 0x3FFF) << 16 | tag as u32) | 1 << 31)
+    }
+
+    /// A point named by `context` alone (a corner, an end, the deepest point).
+    #[inline]
+    pub(crate) fn single(context: u32) -> Self {
+        Self::clipped(context, 0)
+    }
+
+    /// This feature of part `part` of a shape (a mesh's triangle or vertex), mixed in so that
+    /// neighbouring parts' points do not share numbers; a feature of the other shape alone
+    /// ([`Self::of_other_alone`]) keeps its number.
+    #[inline]
+    pub(crate) fn of_part(self, part: u32) -> Self {
+        if self.0 & OTHER_ALONE != 0 {
+            return self;
+        }
+        let mixed = (self.0 ^ part.wrapping_mul(0x9E37_79B1)).rotate_left(5);
+        Self((mixed | 1) & !OTHER_ALONE)
+    }
+
+    /// The same feature marked as one of the shape a mesh part meets, whichever part it meets
+    /// (a box's corner): it keeps its number as it slides from triangle to triangle of a
+    /// floor, so its warm start follows it.
+    #[inline]
+    pub(crate) fn of_other_alone(self) -> Self {
+        Self(self.0 | OTHER_ALONE)
+    }
+
+    /// Whether this is a feature of the shape a mesh part meets, alone
+    /// ([`Self::of_other_alone`]).
+    #[inline]
+    pub(crate) fn is_other_alone(self) -> bool {
+        self.0 & OTHER_ALONE != 0
+    }
+
+    /// Whether a feature is named.
+    #[inline]
+    pub fn is_some(self) -> bool {
+        self != Self::NONE
+    }
+}
+
 /// One point of contact.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct ContactPoint {
@@ -22,6 +88,27 @@ pub struct ContactPoint {
     /// for the points of a speculative contact
     /// ([`speculative_contact`](crate::geometry::contacts::speculative_contact)) still apart.
     pub depth: f32,
+    /// The features that made it ([`FeatureId::NONE`] where the test names none).
+    pub feature: FeatureId,
+}
+
+impl ContactPoint {
+    /// A point no feature names.
+    #[inline]
+    pub fn new(point: Vec3, depth: f32) -> Self {
+        Self {
+            point,
+            depth,
+            feature: FeatureId::NONE,
+        }
+    }
+
+    /// The same point named by `feature`.
+    #[inline]
+    #[must_use]
+    pub fn with_feature(self, feature: FeatureId) -> Self {
+        Self { feature, ..self }
+    }
 }
 
 /// Up to [`MAX_MANIFOLD_POINTS`] contact points sharing one normal, stored inline (the narrow
@@ -47,7 +134,7 @@ impl ContactManifold {
     /// A manifold of a single point.
     pub fn single(normal: Vec3, point: Vec3, depth: f32) -> Self {
         let mut m = Self::new(normal);
-        m.push(ContactPoint { point, depth });
+        m.push(ContactPoint::new(point, depth));
         m
     }
 
@@ -126,7 +213,7 @@ impl ContactManifold {
         for p in self.points() {
             out.push(ContactPoint {
                 point: point(p.point),
-                depth: p.depth,
+                ..*p
             });
         }
         out
@@ -148,7 +235,7 @@ mod tests {
         let mut m = ContactManifold::new(Vec3::Z);
         for (i, &depth) in depths.iter().enumerate() {
             let point = Vec3::new(i as f32, 0.0, 0.0);
-            m.push(ContactPoint { point, depth });
+            m.push(ContactPoint::new(point, depth));
         }
         m
     }

@@ -21,7 +21,7 @@ mod triangle;
 mod trimesh;
 mod weld;
 
-pub use contact::{ContactManifold, ContactPoint, MAX_MANIFOLD_POINTS};
+pub use contact::{ContactManifold, ContactPoint, FeatureId, MAX_MANIFOLD_POINTS};
 pub use convex_hull::{ConvexHull, HullError, HullFace};
 pub use isometry::Isometry;
 pub use lengths::length_or_zero;

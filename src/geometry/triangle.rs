@@ -15,7 +15,9 @@ use crate::bounding::Aabb;
 use crate::geometry::active_edges::{ALL_EDGES_ACTIVE, face_normal_at_inactive_edge};
 use crate::geometry::contacts::FALLBACK_NORMAL;
 use crate::geometry::predicates::collinear;
-use crate::geometry::{ContactManifold, ContactPoint, Cuboid, HalfSpace, Isometry, Sphere};
+use crate::geometry::{
+    ContactManifold, ContactPoint, Cuboid, FeatureId, HalfSpace, Isometry, Sphere,
+};
 use glam::{DVec3, Vec3};
 
 /// A triangle given by its three corners; `a, b, c` counter-clockwise seen from the front.
@@ -275,12 +277,13 @@ pub fn contact_triangle_halfspace(
 ) -> Option<ContactManifold> {
     let n = pose.transform_vector(h.normal);
     let mut manifold = ContactManifold::new(-n);
-    for corner in tri.vertices() {
+    for (k, corner) in tri.vertices().into_iter().enumerate() {
         let signed_distance = n.dot(corner - pose.translation);
         if signed_distance <= 0.0 {
             manifold.push(ContactPoint {
                 point: corner - n * (0.5 * signed_distance),
                 depth: -signed_distance,
+                feature: FeatureId::single(1 + k as u32),
             });
         }
     }

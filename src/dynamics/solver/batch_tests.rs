@@ -76,6 +76,7 @@ fn scene_with(model: FrictionModel, grounds: bool) -> (SolverBodies, Vec<Contact
                 *p = ContactPointInput {
                     point: Vec3::new(a as f32 + 0.5, 0.2 * j as f32, 0.1 * k as f32),
                     separation: 0.01 * (j as f32 - 1.5),
+                    ..Default::default()
                 };
             }
             let mut c = ContactConstraint::prepare(

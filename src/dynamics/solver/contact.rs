@@ -45,7 +45,7 @@ use super::patch_friction::{FrictionModel, PatchFriction};
 use super::rolling::RollingRows;
 pub use super::row::{PointRow, RowPart};
 use super::softness::Softness;
-use crate::geometry::{MAX_MANIFOLD_POINTS, length_or_zero};
+use crate::geometry::{FeatureId, MAX_MANIFOLD_POINTS, length_or_zero};
 use glam::Vec3;
 
 /// One point of a contact as detection found it.
@@ -55,6 +55,9 @@ pub struct ContactPointInput {
     pub point: Vec3,
     /// Distance between the surfaces along the normal: negative in penetration.
     pub separation: f32,
+    /// The features that made it (the narrow phase's [`FeatureId`]; `NONE`: matched by place
+    /// for its warm start).
+    pub feature: FeatureId,
 }
 
 /// A contact between two bodies (slots into [`SolverBodies`](super::SolverBodies)), with up to
@@ -120,6 +123,9 @@ pub struct ConstraintPoint {
     /// landing flat all read the same speed (read after the points solved before them, they
     /// bounced differently and spun the body).
     pub relative_velocity: f32,
+    /// The features that made the point: last step's impulses of the same features seed it
+    /// (`warm_start.rs`).
+    pub feature: FeatureId,
 }
 
 impl ConstraintPoint {
@@ -362,6 +368,7 @@ impl ContactConstraint {
                     _ => [0.0; 2],
                 },
                 relative_velocity: relative.dot(n),
+                feature: p.feature,
                 ..Default::default()
             };
         }

@@ -11,6 +11,7 @@ fn input(a: u32, b: u32, count: u8, k: f32) -> ContactInput {
         *p = ContactPointInput {
             point: Vec3::new(k + 0.5, 0.2 * j as f32, -0.1 * k),
             separation: 0.01 * (j as f32 - k),
+            ..Default::default()
         };
     }
     ContactInput {

@@ -197,6 +197,7 @@ mod tests {
                     *p = ContactPointInput {
                         point: Vec3::new(0.5 * (a + b) as f32, 0.1 * j as f32, 0.0),
                         separation: -0.01 + 0.004 * j as f32,
+                        ..Default::default()
                     };
                 }
                 let mut c = ContactConstraint::prepare(

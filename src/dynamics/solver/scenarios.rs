@@ -17,6 +17,7 @@ const MARGIN: f32 = 0.02;
 
 mod capsules;
 mod convex;
+mod feature_ids;
 mod friction_models;
 mod ghost_edges;
 mod joints;
@@ -127,6 +128,7 @@ impl Scene {
                     *p = ContactPointInput {
                         point: cp.point,
                         separation: -cp.depth,
+                        feature: cp.feature,
                     };
                 }
                 self.contacts.push(input);

@@ -70,9 +70,11 @@ fn contact_in_order(
     } else {
         crossing_normal(sa, sb, pose_b.translation - pose_a.translation)
     };
-    let midway = |on_a: Vec3, on_b: Vec3, depth: f32| ContactPoint {
-        point: (on_a + normal * a.radius + on_b - normal * b.radius) * 0.5,
-        depth,
+    let midway = |on_a: Vec3, on_b: Vec3, depth: f32| {
+        ContactPoint::new(
+            (on_a + normal * a.radius + on_b - normal * b.radius) * 0.5,
+            depth,
+        )
     };
     let closest = midway(pa, pb, (reach - dist).max(0.0));
     let mut out = ContactManifold::new(normal);

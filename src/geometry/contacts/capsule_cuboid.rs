@@ -54,10 +54,7 @@ pub fn contact_capsule_cuboid(
         (normal, penetration + r, feature)
     };
     let mut local = ContactManifold::new(normal);
-    let midway = |x: Vec3, depth: f32| ContactPoint {
-        point: x + normal * (r - 0.5 * depth),
-        depth,
-    };
+    let midway = |x: Vec3, depth: f32| ContactPoint::new(x + normal * (r - 0.5 * depth), depth);
     for (x, d) in face_points(p0, p1, h, normal, r).into_iter().flatten() {
         local.push(midway(x, d.min(depth)));
     }

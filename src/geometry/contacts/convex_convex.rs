@@ -9,13 +9,20 @@
 //!
 //! With a `margin`, pairs still apart by up to it report their gap as a negative depth (the
 //! speculative contacts of `speculative.rs`), exactly: GJK measures the gap directly.
+//!
+//! Feature ids: a clipped point is named by the two features (A's, then B's, by their numbers
+//! within their shapes) and its clip tag (`polygon_clip.rs`) with each line renumbered by the
+//! shape it belongs to, so that it keeps its name when the reference passes from one face to
+//! the other (two parallel faces tie, and a spinning plate on a hull slab swapped them from
+//! step to step: its warm start was lost and it sank 0.13 mm, 0.02 µm once named this way);
+//! the ends of two parallel lines by which end; the deepest point by being it.
 
 use super::manifold_reduction::spread_points;
-use super::polygon_clip::ClipPolygon;
+use super::polygon_clip::{ClipPolygon, FIRST_PLANE};
 use crate::geometry::convex::SignedDistance;
 use crate::geometry::convex::core_distance;
 use crate::geometry::convex::support::{ConvexPart, Feature, MAX_FEATURE_POINTS};
-use crate::geometry::{ContactManifold, ContactPoint, HalfSpace, Isometry, Shape};
+use crate::geometry::{ContactManifold, ContactPoint, FeatureId, HalfSpace, Isometry, Shape};
 use glam::Vec3;
 
 /// A face serves as the reference only when its normal is this close to the contact normal
@@ -28,6 +35,17 @@ const PARALLEL_SINE: f32 = 0.05;
 
 /// Capacity of the clipped polygon: a feature clipped by as many side planes.
 const CLIP_CAPACITY: usize = 2 * MAX_FEATURE_POINTS;
+
+/// Feature-id contexts (module docs), the kind in bits 13–14.
+const CLIPPED: u32 = 1 << 13;
+const PARALLEL_END: u32 = 2 << 13;
+const DEEPEST: u32 = 3 << 13;
+const ON_PLANE: u32 = 1 << 12;
+const LOWEST: u32 = 2 << 12;
+
+/// Where B's lines start in a clipped point's tag (A's from 0; a feature has at most
+/// [`MAX_FEATURE_POINTS`] edges).
+const B_LINES: u8 = 0x40;
 
 /// Contact between `a` at `pose_a` and `b` at `pose_b`, any convex shapes (see
 /// [`ConvexPart::of_shape`]), with a speculative `margin` (0: touching or overlapping only).
@@ -65,10 +83,8 @@ pub(crate) fn manifold(
     margin: f32,
 ) -> ContactManifold {
     let n = d.normal;
-    let deepest = ContactPoint {
-        point: (d.on_a + d.on_b) * 0.5,
-        depth: -d.distance,
-    };
+    let deepest = ContactPoint::new((d.on_a + d.on_b) * 0.5, -d.distance)
+        .with_feature(FeatureId::single(DEEPEST));
     let (fa, fb) = (a.feature(n), b.feature(-n));
     let mut points = [ContactPoint::default(); CLIP_CAPACITY];
     let mut len = 0;
@@ -95,9 +111,9 @@ pub(crate) fn manifold(
             }
         };
         match (facing_a, facing_b) {
-            (Some(ca), Some(cb)) if ca >= cb => clip(&fa, &fb, n, radii, &mut keep),
-            (Some(_), None) => clip(&fa, &fb, n, radii, &mut keep),
-            (_, Some(_)) => clip(&fb, &fa, -n, radii, &mut keep),
+            (Some(ca), Some(cb)) if ca >= cb => clip((&fa, &fb, false), n, radii, &mut keep),
+            (Some(_), None) => clip((&fa, &fb, false), n, radii, &mut keep),
+            (_, Some(_)) => clip((&fb, &fa, true), -n, radii, &mut keep),
             (None, None) if fa.normal.is_none() && fb.normal.is_none() => {
                 parallel_lines(&fa, &fb, n, (a.rounding, b.rounding), &mut keep)
             }
@@ -128,13 +144,12 @@ fn spread_into(mut out: ContactManifold, points: &[ContactPoint]) -> ContactMani
     out
 }
 
-/// Clips `incident` to the side planes of the face `reference`; `n` points from the reference's
-/// shape to the incident's. Each point inside gets its depth below the reference plane along
-/// `n` plus the incident's rounding (a face's own core is never rounded), and the midpoint
-/// between the surfaces.
+/// Clips `incident` to the side planes of the face `reference` (B's when `of_b`); `n` points
+/// from the reference's shape to the incident's. Each point inside gets its depth below the
+/// reference plane along `n` plus the incident's rounding (a face's own core is never rounded),
+/// the midpoint between the surfaces, and its feature id (module docs).
 fn clip(
-    reference: &Feature,
-    incident: &Feature,
+    (reference, incident, of_b): (&Feature, &Feature, bool),
     n: Vec3,
     radii: f32,
     keep: &mut impl FnMut(ContactPoint),
@@ -149,11 +164,17 @@ fn clip(
         if side.dot(centre - r) > 0.0 {
             side = -side;
         }
-        poly = poly.clipped(side, side.dot(r));
+        poly = poly.clipped(side, side.dot(r), FIRST_PLANE + k as u8);
     }
+    let ([a, b], [incident_lines, reference_lines]) = if of_b {
+        ([incident, reference], [0, B_LINES])
+    } else {
+        ([reference, incident], [B_LINES, 0])
+    };
+    let faces = CLIPPED | (a.id & 0x3F) << 6 | (b.id & 0x3F);
     let offset = m.dot(face[0]);
     let along = m.dot(n);
-    for &p in poly.vertices() {
+    for (p, tag) in poly.tagged() {
         // The incident core point p lies `sunk` below the reference plane, along n; only the
         // incident side is rounded (faces belong to unrounded cores).
         let sunk = (offset - m.dot(p)) / along;
@@ -161,6 +182,22 @@ fn clip(
         keep(ContactPoint {
             point: (on_reference + p - n * radii) * 0.5,
             depth: radii + sunk,
+            feature: if (tag.has_edge() && !incident.numbered)
+                || (tag.has_plane() && !reference.numbered)
+            {
+                // A line of a cap that turns with the query: no name that lasts.
+                FeatureId::NONE
+            } else {
+                let owned = tag.by_owner(incident_lines, reference_lines);
+                let id = FeatureId::clipped(faces, owned.bits());
+                // A corner of B's own (B meets a mesh's triangles as A): named alike on
+                // every triangle.
+                if owned.lines_from(B_LINES) {
+                    id.of_other_alone()
+                } else {
+                    id
+                }
+            },
         });
     }
 }
@@ -187,7 +224,7 @@ fn parallel_lines(
     if (tb1 - tb0).abs() <= f32::EPSILON || lo > hi {
         return; // the spans do not overlap: the single deepest point stands
     }
-    for ta in [lo, hi] {
+    for (end, ta) in [lo, hi].into_iter().enumerate() {
         let on_a = a0 + da * ta;
         let s = (ta - tb0) / (tb1 - tb0);
         let on_b = b0 + db * s.clamp(0.0, 1.0);
@@ -195,6 +232,7 @@ fn parallel_lines(
         keep(ContactPoint {
             point: (on_a + on_b + n * (ra - rb)) * 0.5,
             depth: ra + rb - gap,
+            feature: FeatureId::single(PARALLEL_END + end as u32),
         });
     }
 }
@@ -233,13 +271,20 @@ pub(crate) fn contact_convex_halfspace(
     let normal = -up;
     let mut points = [ContactPoint::default(); MAX_FEATURE_POINTS];
     let mut len = 0;
-    for &p in part.feature(normal).points() {
+    let feature = part.feature(normal);
+    for (k, &p) in feature.points().iter().enumerate() {
         let gap = height(p);
         if gap <= margin {
             let surface = p - up * part.rounding;
+            let name = ON_PLANE | (feature.id & 0x7F) << 5 | k as u32;
             points[len] = ContactPoint {
                 point: surface - up * (0.5 * gap),
                 depth: -gap,
+                feature: if feature.numbered {
+                    FeatureId::single(name)
+                } else {
+                    FeatureId::NONE
+                },
             };
             len += 1;
         }
@@ -247,10 +292,10 @@ pub(crate) fn contact_convex_halfspace(
     let mut out = ContactManifold::new(normal);
     if len == 0 {
         let gap = height(lowest);
-        out.push(ContactPoint {
-            point: lowest - up * (part.rounding + 0.5 * gap),
-            depth: -gap,
-        });
+        out.push(
+            ContactPoint::new(lowest - up * (part.rounding + 0.5 * gap), -gap)
+                .with_feature(FeatureId::single(LOWEST)),
+        );
         return Some(out);
     }
     Some(spread_into(out, &points[..len]))

@@ -19,19 +19,28 @@
 //!    side planes of the reference face (Sutherland & Hodgman 1974), the points below the
 //!    reference face are kept, and at most four spread-out ones survive.
 //! 5. **Edge contact.** The closest points of the two edges that span the axis.
+//! 6. **Feature ids.** A face contact's point is named by the two faces (whose is the reference)
+//!    and its clip tag (`polygon_clip.rs`: the incident edges and reference sides it lies on);
+//!    an edge contact's by the two edge directions.
 
 use super::FALLBACK_NORMAL;
 use super::closest_segment_points::{Segment, closest_segment_points};
 use super::cuboid_axes::{Axis, BestAxes, Feature, FramedBox, choose_axis, least_penetration_axes};
 use super::manifold_reduction::spread_points;
-use super::polygon_clip::{ClipPolygon, MAX_CLIP_VERTICES};
-use crate::geometry::{ContactManifold, ContactPoint, Cuboid, Isometry};
+use super::polygon_clip::{ClipPolygon, FIRST_PLANE, MAX_CLIP_VERTICES};
+use crate::geometry::{ContactManifold, ContactPoint, Cuboid, FeatureId, Isometry};
 use glam::{Mat3, Vec3};
 use std::cmp::Ordering;
 
 /// Lateral widening of the reference face's side planes in face clipping, as a fraction of the
 /// magnitude of the coordinates (about 80 ulps): see `face_contact`.
 const CLIP_MARGIN_FRACTION: f32 = 1e-5;
+
+/// Feature-id contexts: a face contact (with its faces in the low bits), an edge contact (with
+/// its two edge directions), the last-resort deepest vertex.
+const FACE_CONTACT: u32 = 1 << 8;
+const EDGE_CONTACT: u32 = 2 << 8;
+const DEEPEST_VERTEX: u32 = 3 << 8;
 
 /// Contact between a box at `pose_a` (shape A) and a box at `pose_b` (shape B).
 ///
@@ -112,7 +121,7 @@ fn contact_in_order(
         let c = candidates[k];
         manifold.push(ContactPoint {
             point: pose_a.transform_point(c.point),
-            depth: c.depth,
+            ..c
         });
     }
     Some(manifold)
@@ -132,15 +141,15 @@ fn contact_points(
     axis: Axis,
     out: &mut [ContactPoint; MAX_CLIP_VERTICES],
 ) -> (Axis, usize) {
-    let (reference, face, ref_normal, incident) = match axis.feature {
-        Feature::FaceOfA(i) => (box_a, i, axis.normal, box_b),
-        Feature::FaceOfB(j) => (box_b, j, -axis.normal, box_a),
+    let (reference, face, ref_normal, incident, of_b) = match axis.feature {
+        Feature::FaceOfA(i) => (box_a, i, axis.normal, box_b, false),
+        Feature::FaceOfB(j) => (box_b, j, -axis.normal, box_a, true),
         Feature::Edges(i, j) => {
             out[0] = edge_contact(box_a, i, box_b, j, axis.normal, axis.depth);
             return (axis, 1);
         }
     };
-    let len = face_contact(reference, face, ref_normal, incident, out);
+    let len = face_contact((reference, face, of_b), ref_normal, incident, out);
     if len > 0 {
         return (axis, len);
     }
@@ -154,16 +163,16 @@ fn contact_points(
     (axis, 1)
 }
 
-/// Face contact: `reference`'s face along its local axis `axis`, of outward unit normal
-/// `ref_normal`, against the face of `incident` most anti-parallel to it. Writes the candidate
-/// points (A's frame, midway between the faces) into `out` and returns how many (possibly none).
+/// Face contact: `reference`'s face along its local axis `axis` (B's when `of_b`), of outward
+/// unit normal `ref_normal`, against the face of `incident` most anti-parallel to it. Writes
+/// the candidate points (A's frame, midway between the faces, named by the faces and their clip
+/// tags) into `out` and returns how many (possibly none).
 ///
 /// The side planes are widened by a margin of [`CLIP_MARGIN_FRACTION`] of the coordinates'
 /// magnitude: clipping interpolates, and without the margin a reference face of zero width (a
 /// box with a zero half extent) would lose every interpolated point to rounding.
 fn face_contact(
-    reference: &FramedBox,
-    axis: usize,
+    (reference, axis, of_b): (&FramedBox, usize, bool),
     ref_normal: Vec3,
     incident: &FramedBox,
     out: &mut [ContactPoint; MAX_CLIP_VERTICES],
@@ -176,26 +185,31 @@ fn face_contact(
         + reference.half.max_element()
         + incident.half.max_element();
     let margin = CLIP_MARGIN_FRACTION * scale;
-    let mut polygon =
-        ClipPolygon::<MAX_CLIP_VERTICES>::from_quad(incident_face(incident, ref_normal));
-    for k in [(axis + 1) % 3, (axis + 2) % 3] {
+    let (corners, incident_id) = incident_face(incident, ref_normal);
+    let mut polygon = ClipPolygon::<MAX_CLIP_VERTICES>::from_quad(corners);
+    for (n, k) in [(axis + 1) % 3, (axis + 2) % 3].into_iter().enumerate() {
         let side = reference.axes.col(k);
         let centre = reference.center.dot(side);
         let reach = reference.half[k] + margin;
-        polygon = polygon
-            .clipped(side, centre + reach)
-            .clipped(-side, reach - centre);
+        let plane = FIRST_PLANE + 2 * n as u8;
+        polygon =
+            polygon
+                .clipped(side, centre + reach, plane)
+                .clipped(-side, reach - centre, plane + 1);
     }
+    let outward = reference.axes.col(axis).dot(ref_normal) > 0.0;
+    let faces = FACE_CONTACT | u32::from(of_b) << 6 | face_id(axis, outward) << 3 | incident_id;
 
     let face_offset = reference.center.dot(ref_normal) + reference.half[axis];
     let mut len = 0;
-    for &p in polygon.vertices() {
+    for (p, tag) in polygon.tagged() {
         let separation = p.dot(ref_normal) - face_offset;
         if separation <= 0.0 {
             out[len] = ContactPoint {
                 point: p - ref_normal * (separation * 0.5),
                 // `0 - x` rather than `-x`: touching gives +0, not -0.
                 depth: 0.0 - separation,
+                feature: FeatureId::clipped(faces, tag.bits()),
             };
             len += 1;
         }
@@ -215,15 +229,18 @@ fn deepest_vertex_contact(
     let local = reference.axes.transpose() * (vertex - reference.center);
     let clamped = local.max(-reference.half).min(reference.half);
     let on_reference = reference.center + reference.axes * clamped;
-    ContactPoint {
-        point: (vertex + on_reference) * 0.5,
-        depth: depth.max(0.0),
-    }
+    ContactPoint::new((vertex + on_reference) * 0.5, depth.max(0.0))
+        .with_feature(FeatureId::single(DEEPEST_VERTEX))
+}
+
+/// A box face's number (0..6) from its axis and side.
+fn face_id(axis: usize, outward: bool) -> u32 {
+    axis as u32 * 2 + u32::from(outward)
 }
 
 /// The face of `b` whose outward normal is most anti-parallel to `direction`, as four corners
-/// in order around it.
-fn incident_face(b: &FramedBox, direction: Vec3) -> [Vec3; 4] {
+/// in order around it, and its number ([`face_id`]).
+fn incident_face(b: &FramedBox, direction: Vec3) -> ([Vec3; 4], u32) {
     let dots = Vec3::new(
         b.axes.x_axis.dot(direction),
         b.axes.y_axis.dot(direction),
@@ -241,12 +258,13 @@ fn incident_face(b: &FramedBox, direction: Vec3) -> [Vec3; 4] {
     let centre = b.center + b.axes.col(j) * (outward * b.half[j]);
     let u = b.axes.col((j + 1) % 3) * b.half[(j + 1) % 3];
     let v = b.axes.col((j + 2) % 3) * b.half[(j + 2) % 3];
-    [
+    let corners = [
         centre + u + v,
         centre - u + v,
         centre - u - v,
         centre + u - v,
-    ]
+    ];
+    (corners, face_id(j, outward > 0.0))
 }
 
 /// The vertex of `b` farthest along `direction` (ties: the `+` vertex).
@@ -272,10 +290,9 @@ fn edge_contact(
         supporting_edge(a, i, normal),
         supporting_edge(b, j, -normal),
     );
-    ContactPoint {
-        point: (on_a.0 + on_a.1) * 0.5,
-        depth: depth.max(0.0),
-    }
+    let edges = EDGE_CONTACT | (i * 3 + j) as u32;
+    ContactPoint::new((on_a.0 + on_a.1) * 0.5, depth.max(0.0))
+        .with_feature(FeatureId::single(edges))
 }
 
 /// The edge of `b` parallel to its local axis `k` that lies farthest along `direction`

@@ -7,14 +7,15 @@
 //! three dot products and the kept vertices three additions each.
 
 use crate::geometry::MAX_MANIFOLD_POINTS;
-use crate::geometry::{ContactManifold, ContactPoint, Cuboid, HalfSpace, Isometry};
+use crate::geometry::{ContactManifold, ContactPoint, Cuboid, FeatureId, HalfSpace, Isometry};
 use glam::{Mat3, Vec3};
 
 /// Contact between a box at `pose_a` (shape A) and a half-space at `pose_b` (shape B).
 ///
 /// The normal from A to B is the plane's inward normal. The points are the (up to four) deepest
 /// vertices at or below the plane, deepest first (ties by vertex index), each moved halfway to
-/// the plane. Vertices that coincide because a half extent is zero are counted once.
+/// the plane, named by its vertex ([`FeatureId`]). Vertices that coincide because a half extent
+/// is zero are counted once.
 pub fn contact_cuboid_halfspace(
     pose_a: &Isometry,
     a: &Cuboid,
@@ -64,6 +65,7 @@ pub fn contact_cuboid_halfspace(
             // Halfway between the vertex (on A) and its projection on the plane (on B).
             point: corner + n * (depth * 0.5),
             depth,
+            feature: FeatureId::single(1 + vertex as u32),
         });
     }
     Some(manifold)

@@ -104,6 +104,7 @@ fn carried(
         now.push(ContactPoint {
             point: pose_a.transform_point(point(p.point, motion)),
             depth: p.depth - motion.dot(local.normal),
+            ..*p
         });
     }
     now

@@ -26,7 +26,7 @@ pub(crate) const FRONT_PREFERENCE: f32 = 0.25;
 
 /// A third or fourth point must add at least this fraction of `|p1 - p0|²` in area (that is, lie
 /// farther than this fraction of `|p1 - p0|` from the hull so far) to be kept.
-const MIN_AREA_FRACTION: f32 = 1e-3;
+const MIN_AREA_FRACTION: f32 = 1e-2;
 
 /// Indices of at most [`MAX_MANIFOLD_POINTS`] of `points` (all lying roughly in a plane of
 /// normal `normal`) and how many there are, chosen as the module describes; ties go to the
@@ -36,7 +36,7 @@ pub(crate) fn spread_points(
     normal: Vec3,
 ) -> ([usize; MAX_MANIFOLD_POINTS], usize) {
     let mut chosen = [0usize; MAX_MANIFOLD_POINTS];
-    let Some(deepest) = argmax(points, |p| p.depth) else {
+    let Some(deepest) = deepest_corner(points) else {
         return (chosen, 0);
     };
     chosen[0] = deepest;
@@ -119,6 +119,33 @@ fn pick(
     }
 }
 
+/// The deepest point; among points as deep within [`DEPTH_TIE`] (a face resting flat, whose
+/// depths differ by rounding), the one farthest from the points' mean, a corner of the
+/// polygon. By depth alone, rounding picked the first, which on a tessellated floor could be
+/// where a seam crosses the box's side: the manifold then kept that point instead of the corner
+/// beside it, and took other points each step as the box slid.
+fn deepest_corner(points: &[ContactPoint]) -> Option<usize> {
+    let deepest = argmax(points, |p| p.depth)?;
+    let floor = points[deepest].depth - DEPTH_TIE;
+    let tied = points.iter().filter(|p| p.depth >= floor).count();
+    if tied < 3 {
+        return Some(deepest);
+    }
+    let mean = points.iter().map(|p| p.point).sum::<Vec3>() / points.len() as f32;
+    let spread = |p: &ContactPoint| {
+        if p.depth >= floor {
+            (p.point - mean).length_squared()
+        } else {
+            f32::NAN
+        }
+    };
+    argmax(points, spread).or(Some(deepest))
+}
+
+/// Depths this close to the deepest tie with it (m): rounding on a flat contact, far below
+/// any tilt a solver resolves.
+const DEPTH_TIE: f32 = 1e-6;
+
 /// Index of the first point maximising `key` (NaN keys never win), or `None` when empty or
 /// every key is NaN.
 fn argmax(points: &[ContactPoint], key: impl Fn(&ContactPoint) -> f32) -> Option<usize> {
@@ -137,10 +164,7 @@ mod tests {
     use super::*;
 
     fn at(x: f32, y: f32, depth: f32) -> ContactPoint {
-        ContactPoint {
-            point: Vec3::new(x, y, 0.0),
-            depth,
-        }
+        ContactPoint::new(Vec3::new(x, y, 0.0), depth)
     }
 
     #[test]

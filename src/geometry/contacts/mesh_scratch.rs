@@ -116,8 +116,8 @@ impl ContactScratch {
 
     /// The leaf work of every mesh–primitive test, as a new query: descends `mesh`'s hierarchy
     /// through the nodes `node` keeps, collects the contact `test` finds for each triangle of
-    /// the leaves reached (with the triangle's index), records the triangles when asked to, and
-    /// counts the work. The caller merges.
+    /// the leaves reached (with the triangle's index, which its points' feature ids take in),
+    /// records the triangles when asked to, and counts the work. The caller merges.
     pub(crate) fn collect_triangle_contacts<C: TriangleContact>(
         &mut self,
         mesh: &MeshCollider,
@@ -139,7 +139,11 @@ impl ContactScratch {
                 .triangle(t as usize)
                 .and_then(|tri| test(t, &tri));
             if let Some(c) = found {
+                let first = points.len();
                 push_contribution(contributions, points, c.normal(), c.depth(), 0, c.points());
+                for p in &mut points[first..] {
+                    p.feature = p.feature.of_part(t);
+                }
                 if record {
                     hits.push([t, NO_TRIANGLE]);
                 }

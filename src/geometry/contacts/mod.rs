@@ -58,6 +58,8 @@ mod convex_convex;
 mod cuboid_axes;
 mod cuboid_cuboid;
 mod cuboid_halfspace;
+#[cfg(test)]
+mod feature_id_tests;
 mod manifold_cache;
 mod manifold_reduction;
 mod mesh_manifold;

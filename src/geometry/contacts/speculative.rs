@@ -62,6 +62,7 @@ fn from_grown(
         out.push(ContactPoint {
             point,
             depth: p.depth - added,
+            ..*p
         });
     }
     out

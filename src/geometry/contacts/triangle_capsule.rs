@@ -53,9 +53,8 @@ pub fn contact_triangle_capsule(
         None => (normal, on_triangle),
     };
     let depth = (radius - gap.dot(normal)).max(0.0);
-    let midway = |on_tri: Vec3, on_axis: Vec3, depth: f32| ContactPoint {
-        point: (on_tri + on_axis - normal * radius) * 0.5,
-        depth,
+    let midway = |on_tri: Vec3, on_axis: Vec3, depth: f32| {
+        ContactPoint::new((on_tri + on_axis - normal * radius) * 0.5, depth)
     };
     let mut out = ContactManifold::new(normal);
     for (end, foot) in [p0, p1].into_iter().zip(feet) {

@@ -32,10 +32,10 @@
 
 use super::manifold_reduction::spread_points;
 use super::mesh_manifold::reduce_to_manifold;
-use super::polygon_clip::{ClipPolygon, MAX_TRIANGLE_CLIP_VERTICES};
+use super::polygon_clip::{ClipPolygon, FIRST_PLANE, MAX_TRIANGLE_CLIP_VERTICES};
 use crate::ccd::segment_in_box;
 use crate::geometry::active_edges::ALL_EDGES_ACTIVE;
-use crate::geometry::{ContactManifold, ContactPoint, Cuboid, Isometry, Triangle};
+use crate::geometry::{ContactManifold, ContactPoint, Cuboid, FeatureId, Isometry, Triangle};
 use glam::Vec3;
 
 /// Candidate points of one triangle–box contact: the clipped triangle and the box's corners.
@@ -55,6 +55,14 @@ const SWITCH_ABS_FRACTION: f32 = 1e-3;
 /// magnitude (about 80 ulps): keeps points of a triangle lying exactly on a face.
 const CLIP_MARGIN_FRACTION: f32 = 1e-5;
 
+/// Feature-id contexts: a vertex of the triangle clipped by the box (with its clip tag; a mesh
+/// mixes in the triangle's number, `FeatureId::of_part`, unless two of the box's planes made
+/// it), a box corner inside the triangle's outline or the last-resort deepest corner (with the
+/// corner's number). The box's own features are named alike on every triangle they cross, so
+/// a box sliding over a tessellated floor keeps its warm start from triangle to triangle.
+const TRIANGLE_CLIPPED: u32 = 1 << 8;
+const BOX_CORNER: u32 = 2 << 8;
+
 /// A triangle–box contact in the box's frame.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct TriangleBoxContact {
@@ -72,13 +80,15 @@ impl TriangleBoxContact {
         &self.points[..self.len]
     }
 
-    /// Adds a point, its depth clamped to `[0, self.depth]` (rounding can step out of it).
-    fn push(&mut self, point: Vec3, depth: f32) {
+    /// Adds a point named `feature`, its depth clamped to `[0, self.depth]` (rounding can step
+    /// out of it).
+    fn push(&mut self, point: Vec3, depth: f32, feature: FeatureId) {
         if self.len < MAX_TRIANGLE_BOX_POINTS {
             self.points[self.len] = ContactPoint {
                 point,
                 // Not `clamp`, which panics on NaN (non-finite input must not panic).
                 depth: depth.max(0.0).min(self.depth),
+                feature,
             };
             self.len += 1;
         }
@@ -225,32 +235,45 @@ pub(crate) fn triangle_box_contact(
     let margin = CLIP_MARGIN_FRACTION * scale;
     let mut polygon = ClipPolygon::<MAX_TRIANGLE_CLIP_VERTICES>::from_corners(&v);
     for (i, e) in Vec3::AXES.into_iter().enumerate() {
-        polygon = polygon.clipped(e, h[i] + margin).clipped(-e, h[i] + margin);
+        let plane = FIRST_PLANE + 2 * i as u8;
+        polygon = polygon
+            .clipped(e, h[i] + margin, plane)
+            .clipped(-e, h[i] + margin, plane + 1);
     }
-    for &p in polygon.vertices() {
+    for (p, tag) in polygon.tagged() {
         let depth = p.dot(n) + r;
-        out.push(p - n * (0.5 * depth), depth);
+        let feature = FeatureId::clipped(TRIANGLE_CLIPPED, tag.bits());
+        // Where two of the box's planes cross the triangle's plane: the box's own edge.
+        let feature = if tag.of_planes_alone() {
+            feature.of_other_alone()
+        } else {
+            feature
+        };
+        out.push(p - n * (0.5 * depth), depth, feature);
     }
 
     // Box corners behind the triangle's plane, inside its outline.
     let top = v.iter().fold(f32::NEG_INFINITY, |m, x| m.max(x.dot(n)));
     if along_triangle_normal {
-        for corner in box_corners(h) {
+        for (k, corner) in box_corners(h).into_iter().enumerate() {
             let depth = top - corner.dot(n);
             if depth >= 0.0 && inside_outline(&v, corner) {
-                out.push(corner + n * (0.5 * depth), depth);
+                let feature = FeatureId::single(BOX_CORNER + k as u32).of_other_alone();
+                out.push(corner + n * (0.5 * depth), depth, feature);
             }
         }
     }
 
     if out.len == 0 {
         // Rounding left no point: the box's deepest corner along the normal.
-        let corner = box_corners(h)
+        let (k, corner) = box_corners(h)
             .into_iter()
-            .min_by(|a, b| a.dot(n).total_cmp(&b.dot(n)))
-            .unwrap_or(Vec3::ZERO);
+            .enumerate()
+            .min_by(|a, b| a.1.dot(n).total_cmp(&b.1.dot(n)))
+            .unwrap_or((0, Vec3::ZERO));
         let depth = top - corner.dot(n);
-        out.push(corner + n * (0.5 * depth), depth);
+        let feature = FeatureId::single(BOX_CORNER + k as u32).of_other_alone();
+        out.push(corner + n * (0.5 * depth), depth, feature);
     }
     // The deepest point carries the separating depth.
     let (chosen, count) = spread_points(out.points(), n);

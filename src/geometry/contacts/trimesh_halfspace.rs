@@ -7,7 +7,9 @@
 use super::mesh_manifold::reduce_to_manifold;
 use super::mesh_scratch::ContactScratch;
 use crate::bounding::{Obb, RELATIVE_SLACK};
-use crate::geometry::{ContactManifold, ContactPoint, HalfSpace, Isometry, MeshCollider};
+use crate::geometry::{
+    ContactManifold, ContactPoint, FeatureId, HalfSpace, Isometry, MeshCollider,
+};
 use glam::Vec3;
 use std::ops::ControlFlow;
 
@@ -69,6 +71,8 @@ pub fn contact_trimesh_halfspace(
             point: v - n * (0.5 * signed),
             // `0 - x` rather than `-x`: touching gives depth +0, not -0.
             depth: 0.0 - signed,
+            // Named by the mesh's vertex.
+            feature: FeatureId::single(1).of_part(i),
         });
     }
     let mut manifold = reduce_to_manifold(-n, &scratch.points, pose_mesh)?;

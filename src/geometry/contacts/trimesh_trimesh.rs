@@ -46,11 +46,11 @@
 
 use super::FALLBACK_NORMAL;
 use super::mesh_scratch::{ContactScratch, push_contribution};
-use super::polygon_clip::ClipPolygon;
+use super::polygon_clip::{ClipPolygon, FIRST_PLANE};
 use super::triangle_distance::closest_points_triangle_triangle;
 use crate::bvh::TraversalOrder;
 use crate::geometry::{
-    ContactManifold, ContactPoint, Isometry, MeshCollider, TriTriIntersection, Triangle,
+    ContactManifold, ContactPoint, FeatureId, Isometry, MeshCollider, TriTriIntersection, Triangle,
     tri_tri_intersection,
 };
 use glam::Vec3;
@@ -173,10 +173,10 @@ fn contact_in_order(
         margin,
         TraversalOrder::DepthFirst,
         query,
-        |ta, tb| {
+        |ia, ib| {
             let (Some(ta), Some(tb)) = (
-                a.mesh().triangle(ta as usize),
-                b.mesh().triangle(tb as usize),
+                a.mesh().triangle(ia as usize),
+                b.mesh().triangle(ib as usize),
             ) else {
                 return false;
             };
@@ -199,10 +199,9 @@ fn contact_in_order(
             else {
                 return false;
             };
-            let point = ContactPoint {
-                point: c.point,
-                depth: c.depth,
-            };
+            // Named by the two triangles (one point per pair of them).
+            let feature = FeatureId::single(1).of_part(ia).of_part(ib);
+            let point = ContactPoint::new(c.point, c.depth).with_feature(feature);
             let weight = c.depth + margin;
             push_contribution(contributions, points, c.normal, weight, c.side, &[point]);
             true
@@ -355,7 +354,7 @@ fn depth_behind(t: &Triangle, base: &Triangle, n: Vec3) -> f32 {
         let (a, b) = (corners[k], corners[(k + 1) % 3]);
         // Points outside the edge `a → b` (counter-clockwise about n) have `out·x > out·a`.
         let out = (b - a).cross(n);
-        part = part.clipped(out, out.dot(a));
+        part = part.clipped(out, out.dot(a), FIRST_PLANE + k as u8);
     }
     part.vertices()
         .iter()

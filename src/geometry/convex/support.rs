@@ -76,7 +76,22 @@ pub(crate) struct Feature {
     len: usize,
     /// Outward unit normal of a face feature; `None` for a point or an edge.
     pub normal: Option<Vec3>,
+    /// The feature's number within its shape (a box's or hull's face, a cylinder's cap or side
+    /// line; 0 for a single point), which the contact's feature ids are built from.
+    pub id: u32,
+    /// Whether its corners are numbered in the shape's own frame, the same from step to step
+    /// (a box's or hull's face, a side line's ends). A cylinder's cap is not: its polygon
+    /// turns with the query's direction, so its corners name no feature.
+    pub numbered: bool,
 }
+
+/// Feature numbers of the curved shapes' features (a box's faces take 1..=6, a hull's from
+/// [`HULL_FACES`]).
+const CAP: u32 = 8;
+const SIDE_LINE: u32 = 10;
+const AXIS_LINE: u32 = 11;
+const TRIANGLE_FACE: u32 = 12;
+const HULL_FACES: u32 = 16;
 
 impl Feature {
     fn new(normal: Option<Vec3>) -> Self {
@@ -84,6 +99,17 @@ impl Feature {
             points: [Vec3::ZERO; MAX_FEATURE_POINTS],
             len: 0,
             normal,
+            id: 0,
+            numbered: false,
+        }
+    }
+
+    /// The feature numbered `id`, its corners numbered in the shape's frame.
+    fn named(self, id: u32) -> Self {
+        Self {
+            id,
+            numbered: true,
+            ..self
         }
     }
 
@@ -231,7 +257,7 @@ impl<'a> ConvexPart<'a> {
         if let Core::Triangle([a, b, c]) = self.core {
             let normal = (b - a).cross(c - a).try_normalize();
             let normal = normal.map(|n| if n.dot(dir) < 0.0 { -n } else { n });
-            let mut f = Feature::new(normal);
+            let mut f = Feature::new(normal).named(TRIANGLE_FACE);
             // Counter-clockwise about the outward normal.
             let flip = normal.is_some_and(|n| (b - a).cross(c - a).dot(n) < 0.0);
             for p in if flip { [a, c, b] } else { [a, b, c] } {
@@ -252,7 +278,7 @@ impl<'a> ConvexPart<'a> {
         let len = d.length();
         match self.core {
             Core::Segment(h) if d.z.abs() <= LINE_FEATURE_SINE * len => {
-                let mut f = Feature::new(None);
+                let mut f = Feature::new(None).named(AXIS_LINE);
                 f.push(Vec3::new(0.0, 0.0, -h));
                 f.push(Vec3::new(0.0, 0.0, h));
                 f
@@ -305,7 +331,7 @@ fn box_face(h: Vec3, d: Vec3) -> Feature {
     let (j, k) = ((i + 1) % 3, (i + 2) % 3);
     let mut normal = Vec3::ZERO;
     normal[i] = s;
-    let mut f = Feature::new(Some(normal));
+    let mut f = Feature::new(Some(normal)).named(1 + 2 * i as u32 + u32::from(s > 0.0));
     // (+u +v), (-u +v), (-u -v), (+u -v) turn counter-clockwise about e_j × e_k = e_i; the
     // bottom face (s < 0) runs the other way.
     let corners = [(1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0), (1.0, -1.0)];
@@ -327,6 +353,7 @@ fn cylinder_feature(h: f32, r: f32, d: Vec3, len: f32) -> Feature {
     let s = sign(d.z);
     if d.z.abs() >= CAP_FEATURE_COSINE * len {
         let mut f = Feature::new(Some(Vec3::new(0.0, 0.0, s)));
+        f.id = CAP + u32::from(s > 0.0);
         for n in 0..CAP_CORNERS {
             let turn = std::f32::consts::TAU * n as f32 / CAP_CORNERS as f32 * s;
             let dir = Vec2::from_angle(turn).rotate(radial) * r;
@@ -335,7 +362,7 @@ fn cylinder_feature(h: f32, r: f32, d: Vec3, len: f32) -> Feature {
         return f;
     }
     let rim = radial * r;
-    let mut f = Feature::new(None);
+    let mut f = Feature::new(None).named(SIDE_LINE);
     if d.z.abs() <= LINE_FEATURE_SINE * len {
         f.push(Vec3::new(rim.x, rim.y, -h));
         f.push(Vec3::new(rim.x, rim.y, h));
@@ -360,7 +387,7 @@ fn cone_feature(h: f32, r: f32, d: Vec3, len: f32) -> Feature {
         return cylinder_feature(h, r, d, len);
     }
     let (apex, rim) = cone_apex_and_rim(h, r, d);
-    let mut f = Feature::new(None);
+    let mut f = Feature::new(None).named(SIDE_LINE);
     // `d` lies in the plane of its azimuth, as the side line does: the line supports the cone
     // when `d` is nearly square to it and points out of the cone.
     let along = (apex - rim).try_normalize().map_or(1.0, |s| s.dot(d).abs());
@@ -379,7 +406,7 @@ fn cone_feature(h: f32, r: f32, d: Vec3, len: f32) -> Feature {
 fn hull_face(hull: &ConvexHull, d: Vec3) -> Feature {
     let face = hull.best_face(d);
     let normal = hull.faces().get(face).map(|f| f.normal);
-    let mut f = Feature::new(normal);
+    let mut f = Feature::new(normal).named(HULL_FACES + face as u32);
     let ids = hull.face_vertices(face);
     let step = ids.len().div_ceil(MAX_FEATURE_POINTS).max(1);
     for &i in ids.iter().step_by(step) {

@@ -87,6 +87,7 @@ pub(super) fn gather_contacts(
             *p = ContactPointInput {
                 point: cp.point,
                 separation: -cp.depth,
+                feature: cp.feature,
             };
         }
         keyed.found.push((input, source as u32));

@@ -106,7 +106,7 @@ fn a_cylinder_rolling_across_a_tessellated_floor_keeps_its_line_within_2_mm_per_
 }
 
 /// The hull of a box's corners and its face centres (coplanar extras the hull must merge).
-fn hull_box(half: Vec3) -> Shape {
+pub(super) fn hull_box(half: Vec3) -> Shape {
     let mut points = Vec::new();
     for k in 0..8 {
         let s = |bit: usize| if k & (1 << bit) != 0 { 1.0 } else { -1.0 };

@@ -1,0 +1,84 @@
+//! Warm starts that follow a contact's features (`warm_start.rs`): a body sliding or spinning
+//! on a support moves its points across the support's frame, where they were matched by place
+//! until the shape tests named their features. The same scene then ran two ways by which body
+//! was spawned first (A's frame is the one the places are kept in).
+
+use super::*;
+
+/// The supports tried: the ground, a static box slab, a static hull slab. (A tessellated floor
+/// is left out: a box sliding across it at 10 m/s sinks 0.14–0.16 mm whichever body is A, and
+/// ends 0.45 mm apart by spawn order, as its manifold takes new points from triangle to
+/// triangle; the warm start is not the cause, with ids or without.)
+fn supports() -> [(&'static str, Shape, Vec3); 3] {
+    let slab = Vec3::new(20.0, 20.0, 0.5);
+    let under = Vec3::new(0.0, 0.0, -0.5);
+    [
+        ("ground", Shape::half_space(Vec3::Z), Vec3::ZERO),
+        ("box slab", Shape::cuboid(slab), under),
+        ("hull slab", convex::hull_box(slab), under),
+    ]
+}
+
+/// `body` (1 kg) set on `support` and left 0.5 s, then launched at `v` and `w` for 1 s, the
+/// support spawned first or second: where it ends, how it moves, and how far it sank below its
+/// resting height meanwhile.
+fn launched(
+    (support, at): (&Shape, Vec3),
+    body: &Shape,
+    height: f32,
+    (v, w): (Vec3, Vec3),
+    support_first: bool,
+) -> (Vec3, Vec3, Vec3, f32) {
+    let mut scene = Scene::default();
+    let place = Vec3::new(0.0, 0.0, height);
+    let (s, b) = if support_first {
+        let s = scene.add(support.clone(), at, Quat::IDENTITY, 0.0);
+        (s, scene.add(body.clone(), place, Quat::IDENTITY, 1.0))
+    } else {
+        let b = scene.add(body.clone(), place, Quat::IDENTITY, 1.0);
+        (scene.add(support.clone(), at, Quat::IDENTITY, 0.0), b)
+    };
+    for k in [s, b] {
+        scene.bodies[k].friction = 0.2;
+    }
+    scene.run(0.5);
+    let resting = scene.bodies[b].center.z;
+    scene.bodies[b].v = v;
+    scene.bodies[b].w = w;
+    let mut lowest = resting;
+    for _ in 0..60 {
+        scene.step();
+        lowest = lowest.min(scene.bodies[b].center.z);
+    }
+    let end = &scene.bodies[b];
+    (end.center, end.v, end.w, resting - lowest)
+}
+
+#[test]
+fn a_box_sliding_at_10_m_s_and_a_plate_spun_at_10_rad_s_end_within_10_um_whichever_is_spawned_first_and_sink_under_10_um()
+ {
+    // Matched by place alone, a body whose support was A lost its warm start every step: it
+    // sank 14 µm (sliding on the ground), 131 µm (spinning on the ground), 52 and 158 µm on a
+    // box slab, 52 and 158 µm on a hull slab, against under 1 µm with the support as B. The
+    // box slab keeps an asymmetry of its own (the speculative test grows whichever box is A),
+    // 4 µm and 2 µm apart; the cube on the hull slab sinks 8 µm in both orders.
+    let cube = (Shape::cuboid(Vec3::splat(0.5)), 0.5);
+    let plate = (Shape::cuboid(Vec3::new(1.0, 1.0, 0.1)), 0.1);
+    let sliding = (Vec3::new(10.0, 0.0, 0.0), Vec3::ZERO);
+    let spinning = (Vec3::ZERO, Vec3::new(0.0, 0.0, 10.0));
+    for (name, support, at) in supports() {
+        for ((body, height), motion) in [(&cube, sliding), (&plate, spinning)] {
+            let runs =
+                [true, false].map(|first| launched((&support, at), body, *height, motion, first));
+            let [(c0, v0, w0, sank0), (c1, v1, w1, sank1)] = runs;
+            eprintln!("{name}: {c0} {v0} {w0} sank {sank0}; {c1} {v1} {w1} sank {sank1}");
+            assert!(
+                c0.distance(c1) < 1e-5 && v0.distance(v1) < 1e-4 && w0.distance(w1) < 1e-4,
+                "{name}: support first {c0} {v0} {w0}, second {c1} {v1} {w1}"
+            );
+            for (sank, first) in [(sank0, true), (sank1, false)] {
+                assert!(sank < 1e-5, "{name}, support first {first}: sank {sank} m");
+            }
+        }
+    }
+}
