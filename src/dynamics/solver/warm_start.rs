@@ -6,7 +6,7 @@
 //! kept under the caller's pair key, in key order (a merge, never a hash: the same input gives
 //! the same result on every run), with each point's anchor in A's body frame and its feature id.
 //! A new point takes the impulses of the old point of the same pair made by the same features
-//! ([`FeatureId`](crate::geometry::FeatureId): Box2D's and rapier's rule), wherever it has
+//! ([`FeatureId`]: Box2D's and rapier's rule), wherever it has
 //! moved; a point no feature names, or whose features are new, takes those of the nearest old
 //! point within `match_distance` (the persistent-manifold rule of Bullet and Jolt). The
 //! friction impulse is kept as a world vector and projected on the new tangents. Under friction
