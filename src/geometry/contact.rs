@@ -50,7 +50,7 @@ impl FeatureId {
     /// ([`Self::of_other_alone`]) keeps its number.
     #[inline]
     pub(crate) fn of_part(self, part: u32) -> Self {
-        if self.0 & OTHER_ALONE != 0 {
+        if self.is_other_alone() {
             return self;
         }
         let mixed = (self.0 ^ part.wrapping_mul(0x9E37_79B1)).rotate_left(5);

@@ -462,6 +462,22 @@ impl<'a> Builder<'a> {
     }
 }
 
+/// The hull of a box's corners and its face centres (coplanar extras the hull must merge), a
+/// hull shaped as the box `half` for tests that compare the two.
+#[cfg(test)]
+pub(crate) fn box_hull(half: glam::Vec3) -> super::Shape {
+    let mut points = Vec::new();
+    for k in 0..8 {
+        let s = |bit: usize| if k & (1 << bit) != 0 { 1.0 } else { -1.0 };
+        points.push(half * glam::Vec3::new(s(0), s(1), s(2)));
+    }
+    for axis in [glam::Vec3::X, glam::Vec3::Y, glam::Vec3::Z] {
+        points.push(half * axis);
+        points.push(-half * axis);
+    }
+    super::Shape::convex_hull(&points).unwrap()
+}
+
 #[cfg(test)]
 #[path = "convex_hull_tests.rs"]
 mod tests;

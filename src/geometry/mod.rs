@@ -6,6 +6,8 @@ mod contact;
 pub mod contacts;
 pub mod convex;
 mod convex_hull;
+#[cfg(test)]
+pub(crate) use convex_hull::box_hull;
 mod hull_lanes;
 mod isometry;
 mod lengths;

@@ -2,22 +2,10 @@
 //! names of its contact points, each on the same feature of the body.
 
 use super::contact;
-use crate::geometry::{ContactManifold, FeatureId, Isometry, MeshCollider, Shape, TriMesh};
+use crate::geometry::{
+    ContactManifold, FeatureId, Isometry, MeshCollider, Shape, TriMesh, box_hull as hull_box,
+};
 use glam::{Quat, Vec3};
-
-/// The hull of a box's corners and face centres.
-fn hull_box(half: Vec3) -> Shape {
-    let mut points = Vec::new();
-    for k in 0..8 {
-        let s = |bit: usize| if k & (1 << bit) != 0 { 1.0 } else { -1.0 };
-        points.push(half * Vec3::new(s(0), s(1), s(2)));
-    }
-    for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
-        points.push(half * axis);
-        points.push(-half * axis);
-    }
-    Shape::convex_hull(&points).unwrap()
-}
 
 /// Each point's feature id and its place in the body's frame, the ids checked to be named and
 /// distinct.

@@ -64,11 +64,6 @@ impl Tag {
         Self::new(owned(self.0[0]), owned(self.0[1]))
     }
 
-    /// Whether both lines are clipping planes (a vertex of the clipping shape's own).
-    pub(crate) fn of_planes_alone(self) -> bool {
-        self.0[0] >= FIRST_PLANE
-    }
-
     /// Whether either line is an edge of the clipped polygon (not a plane).
     pub(crate) fn has_edge(self) -> bool {
         self.0[0] < FIRST_PLANE

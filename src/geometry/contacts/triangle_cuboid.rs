@@ -244,7 +244,7 @@ pub(crate) fn triangle_box_contact(
         let depth = p.dot(n) + r;
         let feature = FeatureId::clipped(TRIANGLE_CLIPPED, tag.bits());
         // Where two of the box's planes cross the triangle's plane: the box's own edge.
-        let feature = if tag.of_planes_alone() {
+        let feature = if tag.lines_from(FIRST_PLANE) {
             feature.of_other_alone()
         } else {
             feature

@@ -5,7 +5,7 @@
 //! leaving it. Two bounds here are measured limits, not goals (see the tests).
 
 use super::*;
-use crate::geometry::{MeshCollider, TriMesh};
+use crate::geometry::{MeshCollider, TriMesh, box_hull as hull_box};
 
 #[test]
 fn a_cylinder_rolls_down_a_20_degree_incline_at_two_thirds_g_sin_theta_within_1_percent() {
@@ -103,20 +103,6 @@ fn a_cylinder_rolling_across_a_tessellated_floor_keeps_its_line_within_2_mm_per_
         b.center.y
     );
     assert!(b.v.x > 0.995 * 3.0, "speed {}", b.v.x);
-}
-
-/// The hull of a box's corners and its face centres (coplanar extras the hull must merge).
-pub(super) fn hull_box(half: Vec3) -> Shape {
-    let mut points = Vec::new();
-    for k in 0..8 {
-        let s = |bit: usize| if k & (1 << bit) != 0 { 1.0 } else { -1.0 };
-        points.push(half * Vec3::new(s(0), s(1), s(2)));
-    }
-    for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
-        points.push(half * axis);
-        points.push(-half * axis);
-    }
-    Shape::convex_hull(&points).unwrap()
 }
 
 #[test]
