@@ -51,6 +51,8 @@ struct Scene {
     joints: Vec<JointInput>,
     /// Pairs never tested for contact (bodies a joint keeps apart).
     unpaired: Vec<(usize, usize)>,
+    /// Every contact point's feature id replaced by this one (hostile input), when set.
+    renamed: Option<crate::geometry::FeatureId>,
 }
 
 impl Scene {
@@ -138,6 +140,11 @@ impl Scene {
 
     fn step(&mut self) {
         self.detect();
+        if let Some(feature) = self.renamed {
+            for c in &mut self.contacts {
+                c.points.iter_mut().for_each(|p| p.feature = feature);
+            }
+        }
         self.arrays.clear();
         for b in &self.bodies {
             self.arrays.push(BodyInput {
