@@ -38,7 +38,7 @@ fn slide(
 }
 
 #[test]
-fn a_ball_capsule_and_box_slide_across_a_tessellated_floor_without_bumps_over_2_mm_per_s() {
+fn a_ball_capsule_and_box_slide_across_a_tessellated_floor_without_bumps_over_10_um_per_s() {
     let velocity = Vec3::new(4.0, 0.3, 0.0);
     let lying = Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
     for (name, shape, orientation) in [
@@ -59,10 +59,13 @@ fn a_ball_capsule_and_box_slide_across_a_tessellated_floor_without_bumps_over_2_
             1.5,
         );
         let (bump, spin, turned) = slide(Shape::TriMesh(mesh), shape, orientation, velocity, 1.5);
-        // Without the internal-edge rule the box bumped at 0.16 m/s.
+        // Without the internal-edge rule the box bumped at 0.16 m/s; until the reduction took
+        // a corner for its first point among equally deep ones (the thirty-fifth stop), at
+        // 1.08 mm/s, turning at 7.9 mrad/s, as its points moved from triangle to triangle
+        // (now 0.36 µm/s and 3 µrad/s).
         let context = format!("{name}: bump {bump} spin {spin} turned {turned}; plane {plane:?}");
-        assert!(bump < 2e-3, "{context}");
-        assert!(spin < 2e-2, "{context}");
+        assert!(bump < 1e-5, "{context}");
+        assert!(spin < 1e-4, "{context}");
         assert!(turned < 1e-3, "{context}");
     }
 }
