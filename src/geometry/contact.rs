@@ -33,7 +33,8 @@ impl FeatureId {
     pub const NONE: Self = Self(0);
 
     /// The vertex where two lines of a face contact cross (`tag`, the clipping's name for
-    /// the pair of lines), within `context` (which faces met, whose is the reference).
+    /// the pair of lines), within `context` (which features met; for box–box also whose face
+    /// is the reference).
     #[inline]
     pub(crate) fn clipped(context: u32, tag: u16) -> Self {
         Self(((context & 0x3FFF) << 16 | tag as u32) | 1 << 31)

@@ -95,18 +95,8 @@ impl WarmStartCache {
                 continue;
             };
             let old_points = &old.points[..old.count as usize];
-            let reuse = (scale, match_distance);
-            // Two loops, not a choice per point: most contacts have no rounded side.
-            match MatchedSide::of(c) {
-                None => {
-                    let to_local = orientation(c.a).inverse();
-                    seed_points(c, old_points, |cp| to_local * cp.anchor_a, reuse);
-                }
-                Some(side) => {
-                    let to_local = orientation(side.slot).inverse();
-                    seed_points(c, old_points, |cp| to_local * side.anchor(cp), reuse);
-                }
-            }
+            let side = MatchedSide::of(c, &orientation);
+            seed_points(c, old_points, &side, (scale, match_distance));
             let (normal, tangents) = (c.normal, c.tangents);
             if let (Some(patch), Some((f, twist))) = (&mut c.patch, old.patch) {
                 patch.tangent_impulse = on_tangents(f, normal, tangents, scale);
@@ -126,16 +116,7 @@ impl WarmStartCache {
         self.contacts.clear();
         self.h = h;
         for c in constraints {
-            let points = match MatchedSide::of(c) {
-                None => {
-                    let to_local = orientation(c.a).inverse();
-                    stored_points(c, |cp| to_local * cp.anchor_a)
-                }
-                Some(side) => {
-                    let to_local = orientation(side.slot).inverse();
-                    stored_points(c, |cp| to_local * side.anchor(cp))
-                }
-            };
+            let points = stored_points(c, &MatchedSide::of(c, &orientation));
             let patch = c
                 .patch
                 .map(|p| (in_world(c.tangents, p.tangent_impulse), p.twist_impulse));
@@ -150,13 +131,12 @@ impl WarmStartCache {
 }
 
 /// Seeds the points of `c` from the `old` ones of its pair: each takes the impulses of the old
-/// point made by the same features, else of the nearest old point whose place (`local`, in the
-/// matched side's frame) lies within the match distance, scaled by the substeps' ratio.
-#[inline]
+/// point made by the same features, else of the nearest old point whose place (in the matched
+/// `side`'s frame) lies within the match distance, scaled by the substeps' ratio.
 fn seed_points(
     c: &mut ContactConstraint,
     old: &[StoredPoint],
-    local: impl Fn(&ConstraintPoint) -> Vec3,
+    side: &MatchedSide,
     (scale, match_distance): (f32, f32),
 ) {
     let (normal, tangents) = (c.normal, c.tangents);
@@ -171,7 +151,7 @@ fn seed_points(
             taken |= 1 << k;
         }
         let matched = same.map(|(_, p)| p).or_else(|| {
-            let local = local(cp);
+            let local = side.local(cp);
             let nearest = old
                 .iter()
                 .map(|p| (p.local_anchor.distance_squared(local), p))
@@ -187,16 +167,12 @@ fn seed_points(
     }
 }
 
-/// The points of `c` to remember, each at its place `local` in the matched side's frame.
-#[inline]
-fn stored_points(
-    c: &ContactConstraint,
-    local: impl Fn(&ConstraintPoint) -> Vec3,
-) -> [StoredPoint; MAX_MANIFOLD_POINTS] {
+/// The points of `c` to remember, each at its place in the matched `side`'s frame.
+fn stored_points(c: &ContactConstraint, side: &MatchedSide) -> [StoredPoint; MAX_MANIFOLD_POINTS] {
     let mut points = [StoredPoint::default(); MAX_MANIFOLD_POINTS];
     for (stored, cp) in points.iter_mut().zip(c.points()) {
         *stored = StoredPoint {
-            local_anchor: local(cp),
+            local_anchor: side.local(cp),
             feature: cp.feature,
             normal_impulse: cp.normal_impulse,
             friction_impulse: in_world(c.tangents, cp.tangent_impulse),
@@ -205,44 +181,41 @@ fn stored_points(
     points
 }
 
-/// A rounded side whose frame a contact's points are matched in, at their core points
-/// (module docs).
+/// The side whose frame a contact's points are matched in: a rounded side, at its points'
+/// cores (module docs), else A at its anchors.
 struct MatchedSide {
-    /// The side's body slot.
-    slot: u32,
+    /// From world axes to the side's body frame (at the step's start).
+    to_local: Quat,
     /// B (else A).
     b: bool,
-    /// From the anchor to the core point along the normal.
+    /// From the anchor to the core point along the normal (zero on a side with corners).
     to_core: Vec3,
 }
 
 impl MatchedSide {
-    /// A's side if A is rounded, else B's if B is; none without rounding (A's anchors).
-    #[inline]
-    fn of(c: &ContactConstraint) -> Option<Self> {
+    /// A's side if A is rounded, else B's if B is; A's anchors without rounding.
+    /// `orientation` gives each body's orientation by slot.
+    fn of(c: &ContactConstraint, orientation: &impl Fn(u32) -> Quat) -> Self {
         let [rho_a, rho_b] = c.rounding;
-        if rho_a > 0.0 {
-            Some(Self {
-                slot: c.a,
-                b: false,
-                to_core: -c.normal * rho_a,
-            })
-        } else if rho_b > 0.0 {
-            Some(Self {
-                slot: c.b,
-                b: true,
-                to_core: c.normal * rho_b,
-            })
+        let b = rho_a <= 0.0 && rho_b > 0.0;
+        let (slot, to_core) = if b {
+            (c.b, c.normal * rho_b)
+        } else if rho_a > 0.0 {
+            (c.a, -c.normal * rho_a)
         } else {
-            None
+            (c.a, Vec3::ZERO)
+        };
+        Self {
+            to_local: orientation(slot).inverse(),
+            b,
+            to_core,
         }
     }
 
-    /// Point `cp`'s core point from the side's centre (world axes).
-    #[inline]
-    fn anchor(&self, cp: &ConstraintPoint) -> Vec3 {
+    /// Point `cp`'s place in the side's frame: its core point, or A's anchor.
+    fn local(&self, cp: &ConstraintPoint) -> Vec3 {
         let anchor = if self.b { cp.anchor_b } else { cp.anchor_a };
-        anchor + self.to_core
+        self.to_local * (anchor + self.to_core)
     }
 }
 
