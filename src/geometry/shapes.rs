@@ -380,6 +380,31 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_cylinder_is_rounded_only_on_its_side_and_a_bad_normal_or_turn_gives_no_rounding() {
+        let c = Shape::cylinder(0.4, 0.3);
+        let lying = Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
+        // Lying (axis along y): rounded against the ground, not against a wall at its cap.
+        assert_eq!(c.rounding_along(lying, Vec3::Z), 0.3);
+        assert_eq!(c.rounding_along(lying, Vec3::Y), 0.0);
+        // Standing on its cap, or tilted past the side line's 3°: corners.
+        assert_eq!(c.rounding_along(Quat::IDENTITY, Vec3::Z), 0.0);
+        let tilted = Quat::from_rotation_x(std::f32::consts::FRAC_PI_2 - 0.1);
+        assert_eq!(c.rounding_along(tilted, Vec3::Z), 0.0);
+        // Bad input reads as no rounding, never NaN.
+        let nan = Vec3::splat(f32::NAN);
+        assert_eq!(c.rounding_along(lying, nan), 0.0);
+        assert_eq!(
+            c.rounding_along(Quat::from_xyzw(f32::NAN, 0.0, 0.0, 1.0), Vec3::Z),
+            0.0
+        );
+        let inf = c.rounding_along(lying, Vec3::splat(f32::INFINITY));
+        assert!(inf == 0.0 || inf == 0.3, "{inf}");
+        // Other shapes keep their rounding whatever the normal.
+        assert_eq!(Shape::sphere(0.5).rounding_along(lying, nan), 0.5);
+        assert_eq!(Shape::cuboid(Vec3::ONE).rounding_along(lying, Vec3::Z), 0.0);
+    }
+
+    #[test]
     fn validation_refuses_nan_negative_and_zero_normals() {
         assert!(Shape::sphere(0.0).validate().is_ok());
         assert!(Shape::sphere(-1.0).validate().is_err());
