@@ -27,7 +27,7 @@ use super::predicates::orient3d;
 use super::shapes::MAX_SHAPE_EXTENT;
 use super::{MeshError, TriMesh};
 use crate::bounding::Aabb;
-use glam::{DVec3, Vec3};
+use glam::{DVec3, Vec3, Vec4};
 use std::fmt;
 
 /// A convex polyhedron built from a point cloud: its vertices, and its faces as planar convex
@@ -39,8 +39,10 @@ pub struct ConvexHull {
     /// Face `f`'s corners are `face_indices[face_start[f]..face_start[f + 1]]`.
     face_indices: Vec<u32>,
     face_start: Vec<u32>,
-    /// Per vertex, the vertices it shares an edge with.
-    neighbours: Vec<Vec<u32>>,
+    /// Vertex `v`'s neighbours (the vertices it shares an edge with) are
+    /// `neighbours[neighbour_start[v]..neighbour_start[v + 1]]`: one array, not one per vertex.
+    neighbours: Vec<u32>,
+    neighbour_start: Vec<u32>,
     /// The first vertices laid out for the support scan.
     lanes: SupportLanes,
     /// The longest vertex, taken once: the manifold cache asks for it on every lookup of a
@@ -151,7 +153,7 @@ impl ConvexHull {
     pub fn support_index(&self, dir: Vec3) -> usize {
         let v = &self.vertices;
         let mut best = self.lanes.farthest(dir);
-        let higher = |b: usize| self.neighbours[b].iter().map(|&n| n as usize);
+        let higher = |b: usize| self.neighbours_of(b).iter().map(|&n| n as usize);
         let higher = |b: usize| higher(b).find(|&n| v[n].dot(dir) > v[b].dot(dir));
         while v.len() > SCANNED_VERTICES
             && let Some(n) = higher(best)
@@ -159,6 +161,12 @@ impl ConvexHull {
             best = n;
         }
         best
+    }
+
+    /// The vertices sharing an edge with vertex `v`.
+    fn neighbours_of(&self, v: usize) -> &[u32] {
+        let (start, end) = (self.neighbour_start[v], self.neighbour_start[v + 1]);
+        &self.neighbours[start as usize..end as usize]
     }
 
     /// Index of the face whose normal has the largest dot product with `dir`.
@@ -207,6 +215,8 @@ struct Tri {
     n: Vec3,
     d: f32,
     out: Vec<(usize, Vec3)>,
+    /// The plane as `(n, -d)`: `plane · (x, 1)` is the height of `x` above it.
+    plane: Vec4,
     dead: bool,
     mark: u32,
 }
@@ -219,6 +229,8 @@ struct Scratch {
     cand: Vec<usize>,
     edges: Vec<[usize; 3]>,
     cone: Vec<usize>,
+    /// The cone's planes, side by side: each orphaned point is measured against all of them.
+    planes: Vec<Vec4>,
     pool: Vec<(usize, Vec3)>,
 }
 
@@ -233,6 +245,8 @@ struct Builder<'a> {
     /// Per point: the stamp of the loop being traced, and the loop's edge leaving the point.
     at: Vec<(u32, usize)>,
     stamp: u32,
+    /// The loop [`trace`](Self::trace) puts in order, kept for its capacity.
+    ring: Vec<[usize; 3]>,
 }
 
 impl<'a> Builder<'a> {
@@ -260,8 +274,9 @@ impl<'a> Builder<'a> {
         for (v, adj) in tetra.into_iter().zip(adj) {
             b.add_tri(v, adj);
         }
+        let planes = [0, 1, 2, 3].map(|t| b.tris[t].plane);
         for q in (0..count).filter(|q| ![i, j, k, l].contains(q)) {
-            b.assign((q, p[q]), &[0, 1, 2, 3]);
+            b.assign((q, p[q]), &[0, 1, 2, 3], &planes);
         }
         Ok(b)
     }
@@ -276,15 +291,23 @@ impl<'a> Builder<'a> {
             .resize_with(self.tris.len().max(id + 1), Tri::default);
         let t = &mut self.tris[id]; // a dead triangle's outside set is empty
         (t.v, t.adj, t.n, t.d, t.dead) = (v, adj, n, n.dot((a + b + c) / 3.0), false);
+        t.plane = n.extend(-t.d);
         id
     }
 
-    /// Gives point `q` to the face of `faces` it is farthest above, if by more than `eps`.
-    fn assign(&mut self, (q, at): (usize, Vec3), faces: &[usize]) {
-        let dist = |f: usize| self.tris[f].n.dot(at) - self.tris[f].d;
-        let best = faces[argmax(faces.len(), |k| dist(faces[k]))];
-        if dist(best) > self.eps {
-            self.tris[best].out.push((q, at));
+    /// Gives point `q` to the face of `faces` (whose planes are `planes`) it is farthest above,
+    /// if by more than `eps`.
+    fn assign(&mut self, (q, at): (usize, Vec3), faces: &[usize], planes: &[Vec4]) {
+        let at1 = at.extend(1.0);
+        let (best, height) = planes
+            .iter()
+            .enumerate()
+            .fold((0, f32::MIN), |b, (k, plane)| {
+                let h = plane.dot(at1);
+                if h > b.1 { (k, h) } else { b }
+            });
+        if height > self.eps {
+            self.tris[faces[best]].out.push((q, at));
         }
     }
 
@@ -334,8 +357,10 @@ impl<'a> Builder<'a> {
             w.pool.append(&mut self.tris[g].out); // keeps the face's capacity
             self.free.push(g);
         }
+        w.planes.clear();
+        w.planes.extend(w.cone.iter().map(|&c| self.tris[c].plane));
         for q in w.pool.drain(..).filter(|q| q.0 != eye) {
-            self.assign(q, &w.cone);
+            self.assign(q, &w.cone, &w.planes);
         }
         let with_points = w.cone.drain(..).filter(|&c| !self.tris[c].out.is_empty());
         w.stack.extend(with_points);
@@ -347,15 +372,16 @@ impl<'a> Builder<'a> {
         for (k, e) in edges.iter().enumerate() {
             self.at[e[0]] = (self.stamp, k);
         }
-        let (first, mut ring) = (edges.first().map_or(0, |e| e[0]), vec![]);
+        let first = edges.first().map_or(0, |e| e[0]);
+        self.ring.clear();
         let mut v = first;
         while self.at[v].0 == self.stamp {
             let k = self.at[v].1;
             (self.at[v].0, v) = (0, edges[k][1]); // 0: visited
-            ring.push(edges[k]);
+            self.ring.push(edges[k]);
         }
-        let closed = !edges.is_empty() && ring.len() == edges.len() && v == first;
-        *edges = ring;
+        let closed = !edges.is_empty() && self.ring.len() == edges.len() && v == first;
+        std::mem::swap(edges, &mut self.ring);
         closed
     }
 
@@ -377,7 +403,8 @@ impl<'a> Builder<'a> {
         let (mut group, mut stack) = (vec![usize::MAX; tris.len()], vec![]);
         for &s in &alive {
             if group[s] == usize::MAX {
-                (group[s], stack) = (s, vec![s]); // a group is named by its first, largest triangle
+                group[s] = s; // a group is named by its first, largest triangle
+                stack.push(s);
             }
             while let Some(t) = stack.pop() {
                 for u in tris[t].adj {
@@ -418,7 +445,7 @@ impl<'a> Builder<'a> {
         // Points on two faces only are dropped; a triangle left with two was between those faces.
         let mut count = vec![0u32; p.len()];
         ring.iter().for_each(|&v| count[v] += 1);
-        let (mut vertices, mut faces, mut face_indices, mut neighbours) =
+        let (mut vertices, mut faces, mut face_indices, mut edges_out) =
             (vec![], vec![], vec![], vec![]);
         let (mut remap, mut face_start, mut kept) = (vec![u32::MAX; p.len()], vec![0], vec![]);
         for &(start, end, fallback) in &loops {
@@ -438,17 +465,17 @@ impl<'a> Builder<'a> {
                 if remap[v] == u32::MAX {
                     remap[v] = vertices.len() as u32;
                     vertices.push(self.orig[v]);
-                    neighbours.push(vec![]);
                 }
             }
             for (i, &v) in kept.iter().enumerate() {
                 face_indices.push(remap[v]);
-                neighbours[remap[v] as usize].push(remap[kept[(i + 1) % k]]);
+                edges_out.push([remap[v], remap[kept[(i + 1) % k]]]);
             }
             faces.push(HullFace { normal, offset });
             face_start.push(face_indices.len() as u32);
         }
         let solid = faces.len() > 3; // else a thin tetrahedron whose faces merged
+        let (neighbours, neighbour_start) = grouped_by_start(&edges_out, vertices.len());
         let hull = ConvexHull {
             lanes: SupportLanes::new(&vertices),
             bounding_radius: vertices.iter().fold(0.0, |r, v| r.max(v.length())),
@@ -457,9 +484,29 @@ impl<'a> Builder<'a> {
             face_indices,
             face_start,
             neighbours,
+            neighbour_start,
         };
         solid.then_some(hull).ok_or(HullError::Degenerate)
     }
+}
+
+/// The ends of `edges` grouped by their start (a counting sort, so each start's ends keep their
+/// order), with where each start's run begins: `ends[start[v]..start[v + 1]]` for `v` in
+/// `0..vertices`.
+fn grouped_by_start(edges: &[[u32; 2]], vertices: usize) -> (Vec<u32>, Vec<u32>) {
+    let mut start = vec![0u32; vertices + 1];
+    for &[from, _] in edges {
+        start[from as usize + 1] += 1;
+    }
+    for v in 0..vertices {
+        start[v + 1] += start[v];
+    }
+    let (mut next, mut ends) = (start.clone(), vec![0u32; edges.len()]);
+    for &[from, to] in edges {
+        ends[next[from as usize] as usize] = to;
+        next[from as usize] += 1;
+    }
+    (ends, start)
 }
 
 /// The hull of a box's corners and its face centres (coplanar extras the hull must merge), a
