@@ -124,7 +124,7 @@ fn pick(
 /// polygon. By depth alone, rounding picked the first, which on a tessellated floor could be
 /// where a seam crosses the box's side: the manifold then kept that point instead of the corner
 /// beside it, and took other points each step as the box slid.
-fn deepest_corner(points: &[ContactPoint]) -> Option<usize> {
+pub(crate) fn deepest_corner(points: &[ContactPoint]) -> Option<usize> {
     let deepest = argmax(points, |p| p.depth)?;
     let floor = points[deepest].depth - DEPTH_TIE;
     let tied = points.iter().filter(|p| p.depth >= floor).count();

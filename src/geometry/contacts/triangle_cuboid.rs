@@ -30,7 +30,7 @@
 //! [`active_edges`](crate::geometry::active_edges)), the triangle's normal is taken whatever the
 //! other axes say (they still separate the pair when apart).
 
-use super::manifold_reduction::spread_points;
+use super::manifold_reduction::deepest_corner;
 use super::mesh_manifold::reduce_to_manifold;
 use super::polygon_clip::{ClipPolygon, FIRST_PLANE, MAX_TRIANGLE_CLIP_VERTICES};
 use crate::ccd::segment_in_box;
@@ -275,10 +275,10 @@ pub(crate) fn triangle_box_contact(
         let feature = FeatureId::single(BOX_CORNER + k as u32).of_other_alone();
         out.push(corner + n * (0.5 * depth), depth, feature);
     }
-    // The deepest point carries the separating depth.
-    let (chosen, count) = spread_points(out.points(), n);
-    if count > 0 {
-        out.points[chosen[0]].depth = axis.depth;
+    // The deepest point (the one the merged manifold's reduction takes first) carries the
+    // separating depth.
+    if let Some(deepest) = deepest_corner(out.points()) {
+        out.points[deepest].depth = axis.depth;
     }
     Some(out)
 }
