@@ -20,7 +20,7 @@
 use super::manifold_reduction::spread_points;
 use super::polygon_clip::{ClipPolygon, FIRST_PLANE};
 use crate::geometry::convex::SignedDistance;
-use crate::geometry::convex::core_distance;
+use crate::geometry::convex::core_distance_within;
 use crate::geometry::convex::support::{ConvexPart, Feature, MAX_FEATURE_POINTS};
 use crate::geometry::{ContactManifold, ContactPoint, FeatureId, HalfSpace, Isometry, Shape};
 use glam::Vec3;
@@ -70,7 +70,7 @@ pub(crate) fn contact_parts(
     b: &ConvexPart,
     margin: f32,
 ) -> Option<ContactManifold> {
-    let d = core_distance(a, b)?;
+    let d = core_distance_within(a, b, margin)?;
     (d.distance <= margin).then(|| manifold(a, b, &d, margin))
 }
 

@@ -25,7 +25,7 @@ use crate::geometry::active_edges::{
     COPLANAR_DEGREES, edges_holding, face_normal_at_inactive_edge,
 };
 use crate::geometry::convex::support::ConvexPart;
-use crate::geometry::convex::{SignedDistance, core_distance};
+use crate::geometry::convex::{SignedDistance, core_distance_within};
 use crate::geometry::{ContactManifold, Isometry, MeshCollider, Shape, Triangle};
 use glam::Vec3;
 
@@ -70,7 +70,7 @@ fn triangle_contact(
     margin: f32,
 ) -> Option<ContactManifold> {
     let face = ConvexPart::triangle(tri);
-    let d = core_distance(&face, part)?;
+    let d = core_distance_within(&face, part, margin)?;
     if d.distance > margin {
         return None;
     }
