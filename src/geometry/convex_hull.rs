@@ -267,7 +267,15 @@ impl<'a> Builder<'a> {
         }
         let swap = orient3d(orig[i], orig[j], orig[k], orig[l]) > 0.0; // l must be below i, j, k
         let (j, k) = if swap { (k, j) } else { (j, k) };
-        let mut b = Self::default();
+        // Room for the hull's triangles from the start (at most 2n - 4 alive, a few dead
+        // between eyes): a small hull's build was a fifth allocations growing one by one.
+        let room = 2 * count.min(4096) + 8;
+        let mut b = Self {
+            tris: Vec::with_capacity(room),
+            free: Vec::with_capacity(room / 4),
+            ring: Vec::with_capacity(32),
+            ..Self::default()
+        };
         (b.p, b.orig, b.eps, b.at) = (p, orig, eps, vec![(0, 0); count]);
         let tetra = [[i, j, k], [i, l, j], [j, l, k], [k, l, i]];
         let adj = [[1, 2, 3], [3, 2, 0], [1, 3, 0], [2, 1, 0]]; // the faces' neighbours
@@ -387,7 +395,15 @@ impl<'a> Builder<'a> {
 
     /// Runs quickhull, then merges coplanar triangles into the hull's polygons.
     fn hull(mut self) -> Result<ConvexHull, HullError> {
-        let mut w = Scratch::default();
+        let mut w = Scratch {
+            stack: Vec::with_capacity(64),
+            seen: Vec::with_capacity(32),
+            cand: Vec::with_capacity(64),
+            edges: Vec::with_capacity(32),
+            cone: Vec::with_capacity(32),
+            planes: Vec::with_capacity(32),
+            pool: Vec::with_capacity(self.p.len().min(4096)),
+        };
         w.stack.extend(0..4);
         while let Some(f) = w.stack.pop() {
             if !self.tris[f].dead && !self.tris[f].out.is_empty() {
@@ -400,7 +416,7 @@ impl<'a> Builder<'a> {
             let [a, b, c] = tris[t].v.map(|i| p[i]);
             std::cmp::Reverse((b - a).cross(c - a).length_squared().to_bits())
         });
-        let (mut group, mut stack) = (vec![usize::MAX; tris.len()], vec![]);
+        let (mut group, mut stack) = (vec![usize::MAX; tris.len()], Vec::with_capacity(64));
         for &s in &alive {
             if group[s] == usize::MAX {
                 group[s] = s; // a group is named by its first, largest triangle
@@ -418,7 +434,12 @@ impl<'a> Builder<'a> {
         }
         alive.sort_by_key(|&t| group[t]); // stable: a group's first triangle leads it
         // Each face: its boundary loop `ring[start..end]`, and a normal if it is degenerate.
-        let (mut ring, mut loops, mut edges) = (vec![], vec![], vec![[0; 3]; 0]);
+        let n = alive.len();
+        let (mut ring, mut loops, mut edges) = (
+            Vec::with_capacity(3 * n),
+            Vec::with_capacity(n),
+            Vec::with_capacity(32),
+        );
         for members in alive.chunk_by(|&x, &y| group[x] == group[y]) {
             let (g, seed) = (group[members[0]], tris[members[0]].n);
             edges.clear();
@@ -445,9 +466,18 @@ impl<'a> Builder<'a> {
         // Points on two faces only are dropped; a triangle left with two was between those faces.
         let mut count = vec![0u32; p.len()];
         ring.iter().for_each(|&v| count[v] += 1);
-        let (mut vertices, mut faces, mut face_indices, mut edges_out) =
-            (vec![], vec![], vec![], vec![]);
-        let (mut remap, mut face_start, mut kept) = (vec![u32::MAX; p.len()], vec![0], vec![]);
+        let (mut vertices, mut faces, mut face_indices, mut edges_out) = (
+            Vec::with_capacity(n / 2 + 2),
+            Vec::with_capacity(loops.len()),
+            Vec::with_capacity(ring.len()),
+            Vec::with_capacity(ring.len()),
+        );
+        let (mut remap, mut face_start, mut kept) = (
+            vec![u32::MAX; p.len()],
+            Vec::with_capacity(loops.len() + 1),
+            Vec::with_capacity(32),
+        );
+        face_start.push(0);
         for &(start, end, fallback) in &loops {
             kept.clear();
             kept.extend(ring[start..end].iter().copied().filter(|&v| count[v] != 2));
