@@ -206,15 +206,19 @@ fn tolerance(points: &[Vec3]) -> f32 {
     3.0 * f32::EPSILON * (m.x + m.y + m.z)
 }
 
+/// The end of an outside set's list.
+const NO_POINT: usize = usize::MAX;
+
 /// A triangle of the hull being built: edge `k` is `v[k] → v[k + 1]`, shared with `adj[k]`;
-/// `out` its outside set (points with positions), `mark` the stamp of the last eye seeing it.
+/// `out` the first point of its outside set ([`NO_POINT`] when empty; the others follow
+/// through [`Builder::next`]), `mark` the stamp of the last eye seeing it.
 #[derive(Default)]
 struct Tri {
     v: [usize; 3],
     adj: [usize; 3],
     n: Vec3,
     d: f32,
-    out: Vec<(usize, Vec3)>,
+    out: usize,
     /// The plane as `(n, -d)`: `plane · (x, 1)` is the height of `x` above it.
     plane: Vec4,
     dead: bool,
@@ -231,7 +235,8 @@ struct Scratch {
     cone: Vec<usize>,
     /// The cone's planes, side by side: each orphaned point is measured against all of them.
     planes: Vec<Vec4>,
-    pool: Vec<(usize, Vec3)>,
+    /// The points of the faces an eye removed, to be given to its cone.
+    pool: Vec<usize>,
 }
 
 /// Quickhull's state: the centred, scaled points `p` for distances, `orig` for exact signs.
@@ -247,6 +252,11 @@ struct Builder<'a> {
     stamp: u32,
     /// The loop [`trace`](Self::trace) puts in order, kept for its capacity.
     ring: Vec<[usize; 3]>,
+    /// Per point, the next point of the outside set it is in: the sets are lists threaded
+    /// through one array, so that a face made or removed allocates nothing (Jolt's
+    /// `ConvexHullBuilder` keeps a vector per face, as this one did: most of a small hull's
+    /// allocations).
+    next: Vec<usize>,
 }
 
 impl<'a> Builder<'a> {
@@ -277,6 +287,7 @@ impl<'a> Builder<'a> {
             ..Self::default()
         };
         (b.p, b.orig, b.eps, b.at) = (p, orig, eps, vec![(0, 0); count]);
+        b.next = vec![NO_POINT; count];
         let tetra = [[i, j, k], [i, l, j], [j, l, k], [k, l, i]];
         let adj = [[1, 2, 3], [3, 2, 0], [1, 3, 0], [2, 1, 0]]; // the faces' neighbours
         for (v, adj) in tetra.into_iter().zip(adj) {
@@ -284,7 +295,7 @@ impl<'a> Builder<'a> {
         }
         let planes = [0, 1, 2, 3].map(|t| b.tris[t].plane);
         for q in (0..count).filter(|q| ![i, j, k, l].contains(q)) {
-            b.assign((q, p[q]), &[0, 1, 2, 3], &planes);
+            b.assign(q, &[0, 1, 2, 3], &planes);
         }
         Ok(b)
     }
@@ -297,16 +308,17 @@ impl<'a> Builder<'a> {
         let id = self.free.pop().unwrap_or(self.tris.len());
         self.tris
             .resize_with(self.tris.len().max(id + 1), Tri::default);
-        let t = &mut self.tris[id]; // a dead triangle's outside set is empty
+        let t = &mut self.tris[id];
         (t.v, t.adj, t.n, t.d, t.dead) = (v, adj, n, n.dot((a + b + c) / 3.0), false);
+        t.out = NO_POINT;
         t.plane = n.extend(-t.d);
         id
     }
 
     /// Gives point `q` to the face of `faces` (whose planes are `planes`) it is farthest above,
     /// if by more than `eps`.
-    fn assign(&mut self, (q, at): (usize, Vec3), faces: &[usize], planes: &[Vec4]) {
-        let at1 = at.extend(1.0);
+    fn assign(&mut self, q: usize, faces: &[usize], planes: &[Vec4]) {
+        let at1 = self.p[q].extend(1.0);
         let (best, height) = planes
             .iter()
             .enumerate()
@@ -315,14 +327,44 @@ impl<'a> Builder<'a> {
                 if h > b.1 { (k, h) } else { b }
             });
         if height > self.eps {
-            self.tris[faces[best]].out.push((q, at));
+            let face = &mut self.tris[faces[best]];
+            self.next[q] = face.out;
+            face.out = q;
+        }
+    }
+
+    /// The points of face `f`'s outside set.
+    fn outside(&self, f: usize) -> impl Iterator<Item = usize> + '_ {
+        let first = self.tris[f].out;
+        std::iter::successors((first != NO_POINT).then_some(first), |&q| {
+            let next = self.next[q];
+            (next != NO_POINT).then_some(next)
+        })
+    }
+
+    /// Takes point `q` out of face `f`'s outside set.
+    fn unlink(&mut self, f: usize, q: usize) {
+        if self.tris[f].out == q {
+            self.tris[f].out = self.next[q];
+        } else {
+            let before = self.outside(f).find(|&r| self.next[r] == q);
+            if let Some(before) = before {
+                self.next[before] = self.next[q];
+            }
         }
     }
 
     /// Adds face `f`'s farthest point to the hull.
     fn add_point(&mut self, f: usize, w: &mut Scratch) {
         let (t, p, orig, eps) = (&self.tris[f], self.p, self.orig, self.eps);
-        let eye = t.out[argmax(t.out.len(), |k| t.n.dot(t.out[k].1))].0;
+        // The farthest point; on a tie the lowest index (the list's order is the assignments').
+        let height = |q: &usize| (t.n.dot(p[*q]), std::cmp::Reverse(*q));
+        let eye = self.outside(f).max_by(|x, y| {
+            height(x)
+                .partial_cmp(&height(y))
+                .unwrap_or(std::cmp::Ordering::Equal)
+        });
+        let Some(eye) = eye else { return };
         let sees = |t: &Tri| {
             let d = t.n.dot(p[eye]) - t.d; // clear beyond 4 eps, else decided exactly
             let [a, b, c] = t.v.map(|i| orig[i]);
@@ -346,7 +388,7 @@ impl<'a> Builder<'a> {
             w.edges.extend(horizon.map(edge));
         }
         if !self.trace(&mut w.edges) {
-            self.tris[f].out.retain(|q| q.0 != eye); // `f` does not see its eye after all
+            self.unlink(f, eye); // `f` does not see its eye after all
             return w.stack.push(f);
         }
         for &[a, b, o] in &w.edges {
@@ -361,16 +403,16 @@ impl<'a> Builder<'a> {
             (t.adj[1], t.adj[2]) = (w.cone[(i + 1) % m], w.cone[(i + m - 1) % m]);
         }
         for g in w.seen.drain(..) {
-            self.tris[g].dead = true;
-            w.pool.append(&mut self.tris[g].out); // keeps the face's capacity
+            w.pool.extend(self.outside(g));
+            (self.tris[g].dead, self.tris[g].out) = (true, NO_POINT);
             self.free.push(g);
         }
         w.planes.clear();
         w.planes.extend(w.cone.iter().map(|&c| self.tris[c].plane));
-        for q in w.pool.drain(..).filter(|q| q.0 != eye) {
+        for q in w.pool.drain(..).filter(|&q| q != eye) {
             self.assign(q, &w.cone, &w.planes);
         }
-        let with_points = w.cone.drain(..).filter(|&c| !self.tris[c].out.is_empty());
+        let with_points = w.cone.drain(..).filter(|&c| self.tris[c].out != NO_POINT);
         w.stack.extend(with_points);
     }
 
@@ -406,7 +448,7 @@ impl<'a> Builder<'a> {
         };
         w.stack.extend(0..4);
         while let Some(f) = w.stack.pop() {
-            if !self.tris[f].dead && !self.tris[f].out.is_empty() {
+            if !self.tris[f].dead && self.tris[f].out != NO_POINT {
                 self.add_point(f, &mut w);
             }
         }
@@ -539,22 +581,8 @@ fn grouped_by_start(edges: &[[u32; 2]], vertices: usize) -> (Vec<u32>, Vec<u32>)
     (ends, start)
 }
 
-/// The hull of a box's corners and its face centres (coplanar extras the hull must merge), a
-/// hull shaped as the box `half` for tests that compare the two.
-#[cfg(test)]
-pub(crate) fn box_hull(half: glam::Vec3) -> super::Shape {
-    let mut points = Vec::new();
-    for k in 0..8 {
-        let s = |bit: usize| if k & (1 << bit) != 0 { 1.0 } else { -1.0 };
-        points.push(half * glam::Vec3::new(s(0), s(1), s(2)));
-    }
-    for axis in [glam::Vec3::X, glam::Vec3::Y, glam::Vec3::Z] {
-        points.push(half * axis);
-        points.push(-half * axis);
-    }
-    super::Shape::convex_hull(&points).unwrap()
-}
-
 #[cfg(test)]
 #[path = "convex_hull_tests.rs"]
 mod tests;
+#[cfg(test)]
+pub(crate) use tests::box_hull;

@@ -152,3 +152,18 @@ fn volume_matches_parry3d_within_1e_4_relative() {
         assert!((ours - theirs).abs() <= 1e-4 * theirs, "{ours} vs {theirs}");
     }
 }
+
+/// The hull of a box's corners and its face centres (coplanar extras the hull must merge), a
+/// hull shaped as the box `half` for tests that compare the two.
+pub(crate) fn box_hull(half: glam::Vec3) -> crate::geometry::Shape {
+    let mut points = Vec::new();
+    for k in 0..8 {
+        let s = |bit: usize| if k & (1 << bit) != 0 { 1.0 } else { -1.0 };
+        points.push(half * glam::Vec3::new(s(0), s(1), s(2)));
+    }
+    for axis in [glam::Vec3::X, glam::Vec3::Y, glam::Vec3::Z] {
+        points.push(half * axis);
+        points.push(-half * axis);
+    }
+    crate::geometry::Shape::convex_hull(&points).unwrap()
+}
