@@ -177,10 +177,14 @@ fn least_penetration_axis(v: &[Vec3; 3], h: Vec3, face_only: bool) -> Option<(Ax
     let edges = [v[1] - v[0], v[2] - v[1], v[0] - v[2]];
     let mut face: Option<Axis> = None;
     let mut is_triangle_normal = false;
-    if let Some(n) = edges[0].cross(edges[1]).try_normalize() {
-        face = Some(overlap_on(n, v, h)?);
-        is_triangle_normal = true;
-    }
+    let triangle_normal = match edges[0].cross(edges[1]).try_normalize() {
+        Some(n) => {
+            face = Some(overlap_on(n, v, h)?);
+            is_triangle_normal = true;
+            face
+        }
+        None => None,
+    };
     for axis in Vec3::AXES {
         let candidate = overlap_on(axis, v, h)?;
         if face.is_none_or(|b| candidate.depth < b.depth) {
@@ -188,6 +192,9 @@ fn least_penetration_axis(v: &[Vec3; 3], h: Vec3, face_only: bool) -> Option<(Ax
             is_triangle_normal = false;
         }
     }
+    // Under the internal-edge rule the other axes only separate, never chosen: tested
+    // unnormalised (a separating axis separates at any length), no root or division each.
+    let separate_only = face_only && triangle_normal.is_some();
     let mut edge: Option<Axis> = None;
     for e in edges {
         for axis in Vec3::AXES {
@@ -196,13 +203,17 @@ fn least_penetration_axis(v: &[Vec3; 3], h: Vec3, face_only: bool) -> Option<(Ax
             if len2 <= EDGE_AXIS_MIN_SIN2 * e.length_squared() || len2 == 0.0 {
                 continue;
             }
-            keep_shallower(&mut edge, overlap_on(cross / len2.sqrt(), v, h)?);
+            if separate_only {
+                overlap_on(cross, v, h)?;
+            } else {
+                keep_shallower(&mut edge, overlap_on(cross / len2.sqrt(), v, h)?);
+            }
         }
     }
     // There is always a face axis: the box's three are never skipped.
     let face = face?;
-    if let (true, Some(n)) = (face_only, edges[0].cross(edges[1]).try_normalize()) {
-        return Some((overlap_on(n, v, h)?, true));
+    if let (true, Some(n)) = (face_only, triangle_normal) {
+        return Some((n, true));
     }
     let tolerance = SWITCH_ABS_FRACTION * h.max_element();
     match edge {
@@ -255,9 +266,10 @@ pub(crate) fn triangle_box_contact(
     // Box corners behind the triangle's plane, inside its outline.
     let top = v.iter().fold(f32::NEG_INFINITY, |m, x| m.max(x.dot(n)));
     if along_triangle_normal {
+        let area_normal = (v[1] - v[0]).cross(v[2] - v[0]);
         for (k, corner) in box_corners(h).into_iter().enumerate() {
             let depth = top - corner.dot(n);
-            if depth >= 0.0 && inside_outline(&v, corner) {
+            if depth >= 0.0 && inside_outline(&v, area_normal, corner) {
                 let feature = FeatureId::single(BOX_CORNER + k as u32).of_other_alone();
                 out.push(corner + n * (0.5 * depth), depth, feature);
             }
@@ -295,9 +307,9 @@ fn box_corners(h: Vec3) -> [Vec3; 8] {
     })
 }
 
-/// True when `p` projects (along the triangle's normal) inside the closed triangle `v`.
-fn inside_outline(v: &[Vec3; 3], p: Vec3) -> bool {
-    let normal = (v[1] - v[0]).cross(v[2] - v[0]);
+/// True when `p` projects (along the triangle's normal) inside the closed triangle `v`, whose
+/// area vector `(v1 − v0) × (v2 − v0)` is `normal`.
+fn inside_outline(v: &[Vec3; 3], normal: Vec3, p: Vec3) -> bool {
     (0..3).all(|k| {
         let (a, b) = (v[k], v[(k + 1) % 3]);
         (b - a).cross(p - a).dot(normal) >= 0.0
