@@ -177,7 +177,7 @@ fn least_penetration_axis(v: &[Vec3; 3], h: Vec3, face_only: bool) -> Option<(Ax
     let edges = [v[1] - v[0], v[2] - v[1], v[0] - v[2]];
     let mut face: Option<Axis> = None;
     let mut is_triangle_normal = false;
-    let triangle_normal = match edges[0].cross(edges[1]).try_normalize() {
+    let on_triangle_normal = match edges[0].cross(edges[1]).try_normalize() {
         Some(n) => {
             face = Some(overlap_on(n, v, h)?);
             is_triangle_normal = true;
@@ -194,7 +194,7 @@ fn least_penetration_axis(v: &[Vec3; 3], h: Vec3, face_only: bool) -> Option<(Ax
     }
     // Under the internal-edge rule the other axes only separate, never chosen: tested
     // unnormalised (a separating axis separates at any length), no root or division each.
-    let separate_only = face_only && triangle_normal.is_some();
+    let separate_only = face_only && on_triangle_normal.is_some();
     let mut edge: Option<Axis> = None;
     for e in edges {
         for axis in Vec3::AXES {
@@ -212,8 +212,8 @@ fn least_penetration_axis(v: &[Vec3; 3], h: Vec3, face_only: bool) -> Option<(Ax
     }
     // There is always a face axis: the box's three are never skipped.
     let face = face?;
-    if let (true, Some(n)) = (face_only, triangle_normal) {
-        return Some((n, true));
+    if let (true, Some(along)) = (face_only, on_triangle_normal) {
+        return Some((along, true));
     }
     let tolerance = SWITCH_ABS_FRACTION * h.max_element();
     match edge {

@@ -264,8 +264,8 @@ pub(crate) fn gjk(a: &ConvexPart, b: &ConvexPart) -> Gjk {
     gjk_within(a, b, f64::INFINITY)
 }
 
-/// [`gjk`], answering [`Gjk::Beyond`] as soon as a support plane shows the cores more than
-/// `limit` apart (module notes).
+/// Runs GJK on the cores of `a` and `b`, answering [`Gjk::Beyond`] as soon as a support plane
+/// shows them more than `limit` apart (module notes; infinity: to convergence).
 pub(crate) fn gjk_within(a: &ConvexPart, b: &ConvexPart, limit: f64) -> Gjk {
     let scale = f64::from(a.size() + b.size() + a.center().distance(b.center()));
     let overlap = (OVERLAP_FRACTION * scale).max(f64::MIN_POSITIVE);
