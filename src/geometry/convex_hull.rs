@@ -219,10 +219,15 @@ struct Tri {
     n: Vec3,
     d: f32,
     out: usize,
-    /// The plane as `(n, -d)`: `plane · (x, 1)` is the height of `x` above it.
-    plane: Vec4,
     dead: bool,
     mark: u32,
+}
+
+impl Tri {
+    /// The plane as `(n, −d)`: `plane · (x, 1)` is the height of `x` above it.
+    fn plane(&self) -> Vec4 {
+        self.n.extend(-self.d)
+    }
 }
 
 /// Buffers reused from eye to eye; an edge is `[from, to, face across]`.
@@ -293,7 +298,7 @@ impl<'a> Builder<'a> {
         for (v, adj) in tetra.into_iter().zip(adj) {
             b.add_tri(v, adj);
         }
-        let planes = [0, 1, 2, 3].map(|t| b.tris[t].plane);
+        let planes = [0, 1, 2, 3].map(|t| b.tris[t].plane());
         for q in (0..count).filter(|q| ![i, j, k, l].contains(q)) {
             b.assign(q, &[0, 1, 2, 3], &planes);
         }
@@ -311,7 +316,6 @@ impl<'a> Builder<'a> {
         let t = &mut self.tris[id];
         (t.v, t.adj, t.n, t.d, t.dead) = (v, adj, n, n.dot((a + b + c) / 3.0), false);
         t.out = NO_POINT;
-        t.plane = n.extend(-t.d);
         id
     }
 
@@ -408,7 +412,8 @@ impl<'a> Builder<'a> {
             self.free.push(g);
         }
         w.planes.clear();
-        w.planes.extend(w.cone.iter().map(|&c| self.tris[c].plane));
+        w.planes
+            .extend(w.cone.iter().map(|&c| self.tris[c].plane()));
         for q in w.pool.drain(..).filter(|&q| q != eye) {
             self.assign(q, &w.cone, &w.planes);
         }

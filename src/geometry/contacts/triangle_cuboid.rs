@@ -175,16 +175,12 @@ fn keep_shallower(best: &mut Option<Axis>, candidate: Axis) {
 /// (always, when `face_only` and the triangle has one: the internal-edge rule).
 fn least_penetration_axis(v: &[Vec3; 3], h: Vec3, face_only: bool) -> Option<(Axis, bool)> {
     let edges = [v[1] - v[0], v[2] - v[1], v[0] - v[2]];
-    let mut face: Option<Axis> = None;
-    let mut is_triangle_normal = false;
     let on_triangle_normal = match edges[0].cross(edges[1]).try_normalize() {
-        Some(n) => {
-            face = Some(overlap_on(n, v, h)?);
-            is_triangle_normal = true;
-            face
-        }
+        Some(n) => Some(overlap_on(n, v, h)?),
         None => None,
     };
+    let mut face = on_triangle_normal;
+    let mut is_triangle_normal = face.is_some();
     for axis in Vec3::AXES {
         let candidate = overlap_on(axis, v, h)?;
         if face.is_none_or(|b| candidate.depth < b.depth) {

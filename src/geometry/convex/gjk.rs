@@ -287,7 +287,7 @@ pub(crate) fn gjk_within(a: &ConvexPart, b: &ConvexPart, limit: f64) -> Gjk {
         if simplex.len > 0 {
             // How much closer to the origin the support plane along -v lies than v (times |v|):
             // converged when that is below the relative or the absolute resolution.
-            let progress = v2 - v.dot(w.w);
+            let progress = v2 - ahead;
             let repeated = simplex.points[..simplex.len].iter().any(|p| p.w == w.w);
             if repeated || progress <= (RELATIVE_TOLERANCE * v2).max(v2.sqrt() * resolution) {
                 break;
