@@ -201,4 +201,27 @@ mod tests {
         }
         assert!(within > 5_000 && beyond > 5_000, "{within} / {beyond}");
     }
+
+    /// Bad limits lose nothing: a NaN or infinite one gives the full answer, a negative one
+    /// drops only pairs farther apart than its magnitude (which every caller drops anyway).
+    #[test]
+    fn a_nan_infinite_or_negative_limit_gives_the_full_answer_or_drops_only_far_pairs() {
+        let cube = Shape::cuboid(Vec3::splat(0.5));
+        let a = ConvexPart::of_shape(&cube, Isometry::IDENTITY).unwrap();
+        for gap in [-0.2, 0.1, 0.7] {
+            let at = Isometry::from_translation(Vec3::new(0.0, 0.0, 1.0 + gap));
+            let b = ConvexPart::of_shape(&cube, at).unwrap();
+            let full = core_distance(&a, &b).unwrap();
+            assert!((full.distance - gap).abs() < 1e-5, "{gap}: {full:?}");
+            for limit in [f32::NAN, f32::INFINITY] {
+                assert_eq!(core_distance_within(&a, &b, limit), Some(full), "{limit}");
+            }
+            let negative = core_distance_within(&a, &b, -0.5);
+            if gap <= 0.5 {
+                assert_eq!(negative, Some(full), "{gap}");
+            } else {
+                assert!(negative.is_none_or(|d| d.distance > -0.5), "{gap}");
+            }
+        }
+    }
 }
