@@ -31,7 +31,7 @@ pub fn contact_trimesh_cuboid(
         mesh,
         |bv| bv.overlaps(&probe, &same_frame),
         |t, tri| {
-            let local = tri.vertices().map(|p| mesh_in_box.transform_point(p));
+            let local = tri.transformed(&mesh_in_box).vertices();
             triangle_box_contact(local, mesh.active_edges(t), h)
         },
     );
