@@ -14,8 +14,9 @@
 //!    as for two boxes, so a box resting on a triangle does not flicker between near-equal axes;
 //!    between face axes the triangle's normal wins ties.
 //! 3. **Points.** The part of the triangle inside the box (the triangle clipped by the box's six
-//!    face planes, Sutherland & Hodgman 1974), each vertex with its depth past the box's far side
-//!    along the normal; and, when the normal is the triangle's, the box corners behind the
+//!    face planes, Sutherland & Hodgman 1974), each vertex with its depth along the normal past
+//!    the box face the normal most opposes (the reference face of box–box clipping: a box
+//!    resting tilted on a triangle has its points at their own depths); and, when the normal is the triangle's, the box corners behind the
 //!    triangle's plane whose projection falls inside the triangle. The deepest point carries the
 //!    separating depth of step 1 (a clipped point can fall short of it when the triangle's
 //!    deepest corner lies outside the box's side).
@@ -68,14 +69,15 @@ const BOX_CORNER: u32 = 2 << 8;
 pub(crate) struct TriangleBoxContact {
     /// Unit normal from the triangle to the box.
     pub normal: Vec3,
-    /// Penetration along it (the separating depth).
+    /// Penetration along it: the separating depth, or along the triangle's normal the
+    /// deepest point's.
     pub depth: f32,
     points: [ContactPoint; MAX_TRIANGLE_BOX_POINTS],
     len: usize,
 }
 
 impl TriangleBoxContact {
-    /// The candidate points (box frame, midway between the surfaces), deepest carrying `depth`.
+    /// The candidate points (box frame, midway between the surfaces), the deepest at `depth`.
     pub fn points(&self) -> &[ContactPoint] {
         &self.points[..self.len]
     }
@@ -229,7 +231,16 @@ pub(crate) fn triangle_box_contact(
         (0..3).all(|k| active & (1 << k) == 0 || !edge_reaches(v[k], v[(k + 1) % 3], h));
     let (axis, along_triangle_normal) = least_penetration_axis(&v, h, internal_only)?;
     let n = axis.normal;
-    let r = h.dot(n.abs());
+    // A clipped point's depth is measured along the normal to the box's face the normal most
+    // opposes (the bottom of a box resting on the triangle), not to the box's support plane
+    // along the normal (`p·n + h·|n|`): those agree only while that face is square to the
+    // normal, and a box resting on a triangle tilted by θ read the deepest corner's depth at
+    // every point (wrong by up to θ times its width). On a mesh floor such a box floated on one
+    // corner, kept its tilt (no point told the solver which side was high), and rose while it
+    // slid with friction.
+    let face = n.abs().max_position();
+    let (face_cos, face_sign) = (n[face].abs(), n[face].signum());
+    let depth_of = |p: Vec3| (h[face] + face_sign * p[face]) / face_cos;
     let mut out = TriangleBoxContact {
         normal: n,
         depth: axis.depth,
@@ -237,7 +248,7 @@ pub(crate) fn triangle_box_contact(
         len: 0,
     };
 
-    // The triangle inside the box: each point is `p·n + r` past the box's far side along n.
+    // The triangle inside the box, each point with its depth past the box's face.
     let scale = v[0].abs().max(v[1].abs()).max(v[2].abs()).max_element() + h.max_element();
     let margin = CLIP_MARGIN_FRACTION * scale;
     let mut polygon = ClipPolygon::<MAX_TRIANGLE_CLIP_VERTICES>::from_corners(&v);
@@ -248,7 +259,7 @@ pub(crate) fn triangle_box_contact(
             .clipped(-e, h[i] + margin, plane + 1);
     }
     for (p, tag) in polygon.tagged() {
-        let depth = p.dot(n) + r;
+        let depth = depth_of(p);
         let feature = FeatureId::clipped(TRIANGLE_CLIPPED, tag.bits());
         // Where two of the box's planes cross the triangle's plane: the box's own edge.
         let feature = if tag.lines_from(FIRST_PLANE) {
@@ -283,9 +294,21 @@ pub(crate) fn triangle_box_contact(
         let feature = FeatureId::single(BOX_CORNER + k as u32).of_other_alone();
         out.push(corner + n * (0.5 * depth), depth, feature);
     }
-    // The deepest point (the one the merged manifold's reduction takes first) carries the
-    // separating depth.
-    if let Some(deepest) = deepest_corner(out.points()) {
+    // Along a box face or an edge axis, the deepest point (the one the merged manifold's
+    // reduction takes first) carries the separating depth: a clipped point can fall short of
+    // it when the triangle's deepest corner lies outside the box's side. Along the triangle's
+    // normal the points are exact (the box's corners over the triangle and the triangle inside
+    // the box, each at its own depth), and the separating depth is the box's deepest point
+    // below the triangle's *plane*, wherever it is: a box lying across several triangles of a
+    // floor, tilted, gave that depth to a point of every triangle under it.
+    // There the triangle's share of the contact (its weight in the mesh's merged normal) is
+    // as deep as its deepest point.
+    if along_triangle_normal {
+        out.depth = out
+            .points()
+            .iter()
+            .fold(f32::NEG_INFINITY, |d, p| d.max(p.depth));
+    } else if let Some(deepest) = deepest_corner(out.points()) {
         out.points[deepest].depth = axis.depth;
     }
     Some(out)
