@@ -29,6 +29,10 @@ use glam::Vec3;
 /// (cosine, ~11°): a steeper face would measure depths along a tilted plane.
 const REFERENCE_COSINE: f32 = 0.98;
 
+/// A reference face this square to the normal (cosine) measures its points' depths along it
+/// exactly (the rounding of a unit normal's last digits).
+const SQUARE_COSINE: f32 = 1.0 - 1e-6;
+
 /// Two edges count as parallel (a line contact with two ends) when the sine of their angle is
 /// at most this.
 const PARALLEL_SINE: f32 = 0.05;
@@ -100,13 +104,26 @@ pub(crate) fn manifold(
         };
         let (facing_a, facing_b) = (facing(&fa, n), facing(&fb, -n));
         // A point can sink no deeper along n than the pair does (EPA's depth is the deepest
-        // along its own normal); a tilted reference plane would overstate a far corner.
+        // along its own normal): a tilted reference plane would overstate a far corner. A
+        // reference square to n measures each point exactly, and the pair's depth may fall
+        // short of them: a mesh triangle's face normal taken at an inactive edge comes with
+        // the height of the closest pair's point, not of the part's lowest point over the
+        // triangle (a hull box tilted by 2° read a point beside a seam 0.7 mm shallow).
+        let square = |c: Option<f32>| c.is_some_and(|c| c >= SQUARE_COSINE);
+        let clamp = match (facing_a, facing_b) {
+            (Some(ca), Some(cb)) if ca >= cb => !square(facing_a),
+            (Some(_), None) => !square(facing_a),
+            (_, Some(_)) => !square(facing_b),
+            (None, None) => true,
+        };
         let mut keep = |p: ContactPoint| {
             if p.depth >= -margin && len < CLIP_CAPACITY {
-                points[len] = ContactPoint {
-                    depth: p.depth.min(deepest.depth),
-                    ..p
+                let depth = if clamp {
+                    p.depth.min(deepest.depth)
+                } else {
+                    p.depth
                 };
+                points[len] = ContactPoint { depth, ..p };
                 len += 1;
             }
         };
