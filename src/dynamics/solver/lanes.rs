@@ -254,7 +254,7 @@ impl PairVelocities {
     /// Writes the velocities back to slots `bodies`, where `writes` allows (the dynamic bodies
     /// of real lanes: padding lanes repeat lane 0's slots, and static bodies keep theirs); a
     /// side that writes no lane (a still ground) is not even unpacked.
-    pub fn store(self, bodies: &Slots, writes: &[[bool; LANES]; 2], states: &mut [BodyState]) {
+    pub fn store(&self, bodies: &Slots, writes: &[[bool; LANES]; 2], states: &mut [BodyState]) {
         let sides = [(self.va, self.wa), (self.vb, self.wb)];
         for (k, (v, w)) in sides.into_iter().enumerate() {
             if !writes[k].contains(&true) {
