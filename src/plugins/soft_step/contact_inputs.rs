@@ -103,7 +103,11 @@ pub(super) fn gather_contacts(
             .enumerate()
             .map(|(i, (c, _))| ((c.key >> 16) as u64, i as u32)),
     );
-    radsort::sort_by_key(order, |&(pair, _)| pair);
+    // Often in order already (a scene at rest keeps its pairs' order): checked first, as the
+    // stable sort would leave it.
+    if !order.is_sorted_by_key(|&(pair, _)| pair) {
+        radsort::sort_by_key(order, |&(pair, _)| pair);
+    }
     out.clear();
     sources.clear();
     let mut rank = 0u128;
