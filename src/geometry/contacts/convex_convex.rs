@@ -102,20 +102,20 @@ pub(crate) fn manifold(
                 .map(|m| m.dot(dir))
                 .filter(|&c| c >= REFERENCE_COSINE && polygon_area(f.points()) > min_area)
         };
-        let (facing_a, facing_b) = (facing(&fa, n), facing(&fb, -n));
+        // The reference face: whether it is B's, and how square it is to n.
+        let reference = match (facing(&fa, n), facing(&fb, -n)) {
+            (Some(ca), Some(cb)) if ca >= cb => Some((false, ca)),
+            (Some(ca), None) => Some((false, ca)),
+            (_, Some(cb)) => Some((true, cb)),
+            (None, None) => None,
+        };
         // A point can sink no deeper along n than the pair does (EPA's depth is the deepest
         // along its own normal): a tilted reference plane would overstate a far corner. A
         // reference square to n measures each point exactly, and the pair's depth may fall
         // short of them: a mesh triangle's face normal taken at an inactive edge comes with
         // the height of the closest pair's point, not of the part's lowest point over the
-        // triangle (a hull box tilted by 2° read a point beside a seam 0.7 mm shallow).
-        let square = |c: Option<f32>| c.is_some_and(|c| c >= SQUARE_COSINE);
-        let clamp = match (facing_a, facing_b) {
-            (Some(ca), Some(cb)) if ca >= cb => !square(facing_a),
-            (Some(_), None) => !square(facing_a),
-            (_, Some(_)) => !square(facing_b),
-            (None, None) => true,
-        };
+        // triangle (a hull box tilted by 2° read points beside a seam up to 0.88 mm shallow).
+        let clamp = reference.is_none_or(|(_, cosine)| cosine < SQUARE_COSINE);
         let mut keep = |p: ContactPoint| {
             if p.depth >= -margin && len < CLIP_CAPACITY {
                 let depth = if clamp {
@@ -127,14 +127,13 @@ pub(crate) fn manifold(
                 len += 1;
             }
         };
-        match (facing_a, facing_b) {
-            (Some(ca), Some(cb)) if ca >= cb => clip((&fa, &fb, false), n, radii, &mut keep),
-            (Some(_), None) => clip((&fa, &fb, false), n, radii, &mut keep),
-            (_, Some(_)) => clip((&fb, &fa, true), -n, radii, &mut keep),
-            (None, None) if fa.normal.is_none() && fb.normal.is_none() => {
+        match reference {
+            Some((false, _)) => clip((&fa, &fb, false), n, radii, &mut keep),
+            Some((true, _)) => clip((&fb, &fa, true), -n, radii, &mut keep),
+            None if fa.normal.is_none() && fb.normal.is_none() => {
                 parallel_lines(&fa, &fb, n, (a.rounding, b.rounding), &mut keep)
             }
-            (None, None) => {}
+            None => {}
         }
     }
     let found = &points[..len];

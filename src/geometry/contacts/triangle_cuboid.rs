@@ -16,10 +16,13 @@
 //! 3. **Points.** The part of the triangle inside the box (the triangle clipped by the box's six
 //!    face planes, Sutherland & Hodgman 1974), each vertex with its depth along the normal past
 //!    the box face the normal most opposes (the reference face of box–box clipping: a box
-//!    resting tilted on a triangle has its points at their own depths); and, when the normal is the triangle's, the box corners behind the
-//!    triangle's plane whose projection falls inside the triangle. The deepest point carries the
+//!    resting tilted on a triangle has its points at their own depths); and, when the normal
+//!    is the triangle's, the box corners behind the triangle's plane whose projection falls
+//!    inside the triangle. Along a box face or an edge axis the deepest point carries the
 //!    separating depth of step 1 (a clipped point can fall short of it when the triangle's
-//!    deepest corner lies outside the box's side).
+//!    deepest corner lies outside the box's side); along the triangle's normal the points are
+//!    exact, and that depth, the box's deepest point below the triangle's *plane*, may lie
+//!    over another triangle.
 //!
 //! The triangle is a two-sided surface: the box leaves through whichever side needs the shorter
 //! move, so a box pushed more than halfway through a triangle leaves through the far side.
@@ -299,10 +302,9 @@ pub(crate) fn triangle_box_contact(
     // it when the triangle's deepest corner lies outside the box's side. Along the triangle's
     // normal the points are exact (the box's corners over the triangle and the triangle inside
     // the box, each at its own depth), and the separating depth is the box's deepest point
-    // below the triangle's *plane*, wherever it is: a box lying across several triangles of a
-    // floor, tilted, gave that depth to a point of every triangle under it.
-    // There the triangle's share of the contact (its weight in the mesh's merged normal) is
-    // as deep as its deepest point.
+    // below the triangle's *plane*, wherever it is: handed on, a box lying tilted across a
+    // floor gave it to a point of every triangle under it. There the triangle's share of the
+    // contact (its weight in the mesh's merged normal) is its deepest point's depth.
     if along_triangle_normal {
         out.depth = out
             .points()

@@ -76,7 +76,7 @@ mod tests {
         // all four corners where a half-space read 35, 9, -9 and -35. Resting, it floated on
         // one corner, and sliding with friction it rose by 66 µm. A hull (the convex clip)
         // read no point deeper than the pair's closest points, and beside a seam those can lie
-        // above the part's lowest point over the triangle: 0.5 mm shallow.
+        // above the part's lowest point over the triangle: up to 0.88 mm shallow.
         let floor =
             Shape::TriMesh(MeshCollider::new(TriMesh::grid_floor(12.0, 24).unwrap()).unwrap());
         let mut rng = TestRng::new(37);
@@ -104,8 +104,8 @@ mod tests {
                     .expect("the box is in the floor");
                 for p in m.points() {
                     let truth = sunk_at(&pose, half, p.point.x, p.point.y);
-                    // The clip keeps the triangle up to 1e-5 of the coordinates' size past the box's
-                    // faces (a triangle lying on a face stays in), and such a point reads touching.
+                    // The clip keeps the triangle up to 1e-5 of the coordinates' size past the
+                    // box's faces (a triangle lying on a face stays in): such points read 0.
                     let grazing = p.depth == 0.0 && (-1e-4..0.0).contains(&truth);
                     if !grazing {
                         worst = worst.max((p.depth - truth).abs());
