@@ -196,8 +196,13 @@ impl ConvexHull {
 
 /// The index in `0..n` with the largest `key` (the first on a tie, 0 if none or all NaN).
 fn argmax(n: usize, key: impl Fn(usize) -> f32) -> usize {
+    max_at(n, key).0
+}
+
+/// [`argmax`] with the largest key.
+fn max_at(n: usize, key: impl Fn(usize) -> f32) -> (usize, f32) {
     let better = |b: (usize, f32), x: (usize, f32)| if x.1 > b.1 { x } else { b };
-    (0..n).map(|i| (i, key(i))).fold((0, f32::MIN), better).0
+    (0..n).map(|i| (i, key(i))).fold((0, f32::MIN), better)
 }
 
 /// Gregorius' tolerance for plane distances among `points` (see the module notes).
@@ -323,13 +328,7 @@ impl<'a> Builder<'a> {
     /// if by more than `eps`.
     fn assign(&mut self, q: usize, faces: &[usize], planes: &[Vec4]) {
         let at1 = self.p[q].extend(1.0);
-        let (best, height) = planes
-            .iter()
-            .enumerate()
-            .fold((0, f32::MIN), |b, (k, plane)| {
-                let h = plane.dot(at1);
-                if h > b.1 { (k, h) } else { b }
-            });
+        let (best, height) = max_at(planes.len(), |k| planes[k].dot(at1));
         if height > self.eps {
             let face = &mut self.tris[faces[best]];
             self.next[q] = face.out;

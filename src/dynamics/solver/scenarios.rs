@@ -176,6 +176,36 @@ impl Scene {
             self.step();
         }
     }
+
+    /// Lets the scene settle for 0.5 s, then sets body `b` moving at `v` and turning at `w`
+    /// and steps one more second: how it fared ([`Launch`]).
+    fn launch(&mut self, b: usize, (v, w): (Vec3, Vec3)) -> Launch {
+        self.run(0.5);
+        let rest = self.bodies[b].center.z;
+        (self.bodies[b].v, self.bodies[b].w) = (v, w);
+        let (mut rose, mut sank) = (0.0f32, 0.0f32);
+        for _ in 0..60 {
+            self.step();
+            let dz = self.bodies[b].center.z - rest;
+            (rose, sank) = (rose.max(dz), sank.max(-dz));
+        }
+        let end = &self.bodies[b];
+        Launch {
+            rest,
+            rose,
+            sank,
+            end: (end.center, end.v, end.w),
+        }
+    }
+}
+
+/// A launched body's resting height before it was launched, how far it rose above and sank
+/// below that height meanwhile, and its centre, velocity and spin at the end.
+struct Launch {
+    rest: f32,
+    rose: f32,
+    sank: f32,
+    end: (Vec3, Vec3, Vec3),
 }
 
 /// The body's local z axis in the world (a capsule's or cylinder's axis).

@@ -276,7 +276,7 @@ pub(crate) fn triangle_box_contact(
     // Box corners behind the triangle's plane, inside its outline.
     let top = v.iter().fold(f32::NEG_INFINITY, |m, x| m.max(x.dot(n)));
     if along_triangle_normal {
-        let area_normal = (v[1] - v[0]).cross(v[2] - v[0]);
+        let area_normal = Triangle::from(v).scaled_normal();
         for (k, corner) in box_corners(h).into_iter().enumerate() {
             let depth = top - corner.dot(n);
             if depth >= 0.0 && inside_outline(&v, area_normal, corner) {

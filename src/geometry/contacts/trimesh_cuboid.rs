@@ -86,16 +86,10 @@ mod tests {
             let axis = rng.vec3(-1.0, 1.0).with_z(0.0).normalize_or(Vec3::X);
             let tilt = Quat::from_axis_angle(axis, rng.range(0.0, 2f32.to_radians()));
             let rotation = tilt * Quat::from_rotation_z(rng.range(0.0, std::f32::consts::TAU));
-            let lowest = (0..8)
-                .map(|k| {
-                    Vec3::new(
-                        if k & 1 == 0 { -1.0 } else { 1.0 },
-                        if k & 2 == 0 { -1.0 } else { 1.0 },
-                        if k & 4 == 0 { -1.0 } else { 1.0 },
-                    )
-                })
-                .map(|s| (rotation * (half * s)).z)
-                .fold(f32::INFINITY, f32::min);
+            let lowest = Shape::cuboid(half)
+                .world_aabb(&Isometry::new(Vec3::ZERO, rotation))
+                .min
+                .z;
             // The lowest corner up to 1 mm into the floor.
             let center = rng.vec3(-3.0, 3.0).with_z(-lowest - rng.range(1e-5, 1e-3));
             let pose = Isometry::new(center, rotation);

@@ -27,9 +27,9 @@ fn supports() -> [(&'static str, Shape, Vec3); 4] {
     ]
 }
 
-/// `body` (1 kg) set on `support` and left 0.5 s, then launched at `v` and `w` for 1 s, the
-/// support spawned first or second: where it ends, how it moves, and how far it sank below its
-/// resting height meanwhile.
+/// `body` (1 kg) set on `support` and launched with `motion` (velocity and spin, see
+/// `Scene::launch`), the support spawned first or second: where it ends, how it moves, and how
+/// far it sank below its resting height meanwhile.
 fn launched(
     support: (&Shape, Vec3),
     body: &Shape,
@@ -45,7 +45,7 @@ fn launched_renamed(
     (support, at): (&Shape, Vec3),
     body: &Shape,
     height: f32,
-    (v, w): (Vec3, Vec3),
+    motion: (Vec3, Vec3),
     support_first: bool,
     renamed: Option<crate::geometry::FeatureId>,
 ) -> (Vec3, Vec3, Vec3, f32) {
@@ -64,17 +64,9 @@ fn launched_renamed(
     for k in [s, b] {
         scene.bodies[k].friction = 0.2;
     }
-    scene.run(0.5);
-    let resting = scene.bodies[b].center.z;
-    scene.bodies[b].v = v;
-    scene.bodies[b].w = w;
-    let mut lowest = resting;
-    for _ in 0..60 {
-        scene.step();
-        lowest = lowest.min(scene.bodies[b].center.z);
-    }
-    let end = &scene.bodies[b];
-    (end.center, end.v, end.w, resting - lowest)
+    let launch = scene.launch(b, motion);
+    let (center, v, w) = launch.end;
+    (center, v, w, launch.sank)
 }
 
 #[test]

@@ -84,16 +84,8 @@ fn box_launched_on(floor: Shape) -> (f32, f32, f32) {
     for k in [f, b] {
         scene.bodies[k].friction = 0.2;
     }
-    scene.run(0.5);
-    let rest = scene.bodies[b].center.z;
-    scene.bodies[b].v = Vec3::new(10.0, 0.0, 0.0);
-    let (mut rose, mut sank) = (0.0f32, 0.0f32);
-    for _ in 0..60 {
-        scene.step();
-        let dz = scene.bodies[b].center.z - rest;
-        (rose, sank) = (rose.max(dz), sank.max(-dz));
-    }
-    (rest, rose, sank)
+    let launch = scene.launch(b, (Vec3::new(10.0, 0.0, 0.0), Vec3::ZERO));
+    (launch.rest, launch.rose, launch.sank)
 }
 
 #[test]
