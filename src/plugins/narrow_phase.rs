@@ -44,7 +44,7 @@ use crate::geometry::contacts::{
     ContactScratch, ManifoldCache, NO_TRIANGLE, RoundSide, contact_with_scratch,
     speculative_contact_with_scratch,
 };
-use crate::geometry::{ContactManifold, Shape};
+use crate::geometry::{ContactManifold, Isometry, Shape};
 use crate::hierarchy::{BvTree, HierarchyStats, PairScratch, descend_pairs};
 use crate::plugins::broad_phase::BroadPhasePairs;
 use crate::plugins::joints::JointedPairs;
@@ -122,7 +122,44 @@ struct NarrowPhaseScratch {
     /// What the pair loop asks of each body, read from the world once a step (a body in a
     /// pile is in about eight pairs; the lookups were a tenth of a 1,000-ball pile's step).
     bodies: EntityHashMap<BodyFacts>,
+    /// The colliders of this step's bodies that are their own only collider, as
+    /// [`BodyFacts::leaf`] indexes them: kept empty between steps for its capacity.
+    leaves: Vec<Leaf<'static>>,
 }
+
+/// A collider as a pair test reads it, taken from the world once a step for a body that is
+/// its own only collider: two queries of the world per pair were a tenth of a falling pile's
+/// narrow phase.
+#[derive(Clone, Copy)]
+struct Leaf<'a> {
+    shape: &'a Shape,
+    pose: &'a Isometry,
+    /// Changed since the last step (a cached test of it is stale).
+    changed: bool,
+}
+
+impl<'a> Leaf<'a> {
+    /// Collider `e` of `nodes`, if it has one.
+    fn of(nodes: &'a Query<Node, Without<Quarantined>>, e: Entity) -> Option<Self> {
+        let (Some(collider), global, ..) = nodes.get(e).ok()? else {
+            return None;
+        };
+        Some(Self::new(collider, global))
+    }
+
+    fn new(collider: Ref<'a, Collider>, global: &'a GlobalPose) -> Self {
+        let changed = collider.is_changed();
+        let shape = &collider.into_inner().shape;
+        Self {
+            shape,
+            pose: &global.0,
+            changed,
+        }
+    }
+}
+
+/// Index of [`BodyFacts::leaf`] for a body without a leaf of its own (no collider, or parts).
+const NO_LEAF_OF_ITS_OWN: u32 = u32::MAX;
 
 /// A body's part in this step's pairs.
 #[derive(Clone, Copy, Debug)]
@@ -135,6 +172,8 @@ struct BodyFacts {
     compound: bool,
     /// Its own collision layers (a compound's parts have theirs: they are read per part).
     layers: CollisionLayers,
+    /// Its collider in this step's leaves, if it is a single collider.
+    leaf: u32,
 }
 
 impl Plugin for NarrowPhasePlugin {
@@ -287,28 +326,38 @@ fn compute_contacts(
     let jointed = jointed.as_deref().filter(|j| !j.is_empty());
     let mut bodies = std::mem::take(&mut scratch.bodies);
     bodies.clear();
+    // The last step's buffer, empty, lent for this step's borrows of the world.
+    let mut leaves: Vec<Leaf<'_>> = std::mem::take(&mut scratch.leaves);
     // A body's facts are returned as computed, not read back from the map: a copy loaded
     // from an entry just written in pieces waited for those stores to land.
     let mut facts = |e: Entity| {
         if let Some(known) = bodies.get(&e) {
-            return *known;
+            return (*known, leaves.get(known.leaf as usize).copied());
         }
         let (margin, dormant) = motion_of(e);
+        let (compound, leaf) = match nodes.get(e) {
+            Ok((Some(collider), global, _, None)) => (false, Some(Leaf::new(collider, global))),
+            node => (matches!(node, Ok((.., Some(_)))), None),
+        };
         let facts = BodyFacts {
             margin,
             dormant: sleeping && dormant,
-            compound: matches!(nodes.get(e), Ok((.., Some(_)))),
+            compound,
             layers: if any_layers {
                 layers_of_entity(e)
             } else {
                 CollisionLayers::default()
             },
+            leaf: leaf.map_or(NO_LEAF_OF_ITS_OWN, |leaf| {
+                leaves.push(leaf);
+                leaves.len() as u32 - 1
+            }),
         };
         bodies.insert(e, facts);
-        facts
+        (facts, leaf)
     };
     for &(a, b) in &pairs.pairs {
-        let (fa, fb) = (facts(a), facts(b));
+        let ((fa, leaf_a), (fb, leaf_b)) = (facts(a), facts(b));
         let simple = !fa.compound && !fb.compound;
         // Two colliders whose layers keep them apart are dropped first: their layers came
         // with the facts, where the other tests read more (a net of 10,000 balls on layers of
@@ -324,10 +373,14 @@ fn compute_contacts(
         }
         let margin = lookahead.pair(&fa.margin, &fb.margin);
         if simple {
+            let (Some(la), Some(lb)) = (leaf_a, leaf_b) else {
+                continue; // a body without a collider
+            };
+            let leaves = ((a, la), (b, lb));
             if sensing(a, b) {
-                scratch.test_sensor(&nodes, (a, b), (a, b), &mut overlaps);
+                scratch.test_sensor((a, b), leaves, &mut overlaps);
             } else {
-                scratch.test_leaves(&nodes, (a, b), (a, b), margin, &mut contacts, &mut debug);
+                scratch.test_leaves((a, b), leaves, margin, &mut contacts, &mut debug);
             }
             continue;
         }
@@ -355,18 +408,23 @@ fn compute_contacts(
             visits.collider_pairs.extend_from_slice(&scratch.leaf_pairs);
         }
         for i in 0..scratch.leaf_pairs.len() {
-            let leaves = scratch.leaf_pairs[i];
-            if !interacts(leaves.0, leaves.1) {
+            let (ea, eb) = scratch.leaf_pairs[i];
+            if !interacts(ea, eb) {
                 continue;
             }
-            if sensing(leaves.0, leaves.1) {
-                scratch.test_sensor(&nodes, (a, b), leaves, &mut overlaps);
+            let (Some(la), Some(lb)) = (Leaf::of(&nodes, ea), Leaf::of(&nodes, eb)) else {
+                continue;
+            };
+            let leaves = ((ea, la), (eb, lb));
+            if sensing(ea, eb) {
+                scratch.test_sensor((a, b), leaves, &mut overlaps);
                 continue;
             }
-            scratch.test_leaves(&nodes, (a, b), leaves, margin, &mut contacts, &mut debug);
+            scratch.test_leaves((a, b), leaves, margin, &mut contacts, &mut debug);
         }
     }
     scratch.bodies = bodies;
+    scratch.leaves = emptied(leaves);
     if visits.enabled {
         visits.finish(&mut scratch.tested_nodes);
     }
@@ -397,21 +455,16 @@ impl NarrowPhaseScratch {
     /// now) and lists it in `overlaps`.
     fn test_sensor(
         &mut self,
-        nodes: &Query<Node, Without<Quarantined>>,
         (a, b): (Entity, Entity),
-        (la, lb): (Entity, Entity),
+        ((ea, la), (eb, lb)): ((Entity, Leaf), (Entity, Leaf)),
         overlaps: &mut SensorOverlaps,
     ) {
-        let (Ok((Some(ca), ga, ..)), Ok((Some(cb), gb, ..))) = (nodes.get(la), nodes.get(lb))
-        else {
-            return;
-        };
-        if contact_with_scratch(&ca.shape, &ga.0, &cb.shape, &gb.0, &mut self.contact).is_some() {
+        if contact_with_scratch(la.shape, la.pose, lb.shape, lb.pose, &mut self.contact).is_some() {
             overlaps.pairs.push(SensorPair {
                 a,
                 b,
-                collider_a: la,
-                collider_b: lb,
+                collider_a: ea,
+                collider_b: eb,
             });
         }
     }
@@ -420,31 +473,26 @@ impl NarrowPhaseScratch {
     /// at their world poses, looking `margin` ahead; a mesh goes through its BVH.
     fn test_leaves(
         &mut self,
-        nodes: &Query<Node, Without<Quarantined>>,
         (a, b): (Entity, Entity),
-        (la, lb): (Entity, Entity),
+        ((ea, ca), (eb, cb)): ((Entity, Leaf), (Entity, Leaf)),
         margin: f32,
         contacts: &mut Contacts,
         debug: &mut OverlappingLeaves,
     ) {
-        let (Ok((Some(ca), ga, ..)), Ok((Some(cb), gb, ..))) = (nodes.get(la), nodes.get(lb))
-        else {
-            return;
-        };
         // The lower collider first, whatever order the broad phase found the pair in (its
         // order follows insertion, hence archetype order): which box gives the reference face,
         // which shape is grown by the margin, must not depend on an unrelated component.
-        let swap = lb < la;
+        let swap = eb < ea;
         let ((sa, pa), (sb, pb)) = if swap {
-            ((&cb.shape, &gb.0), (&ca.shape, &ga.0))
+            ((cb.shape, cb.pose), (ca.shape, ca.pose))
         } else {
-            ((&ca.shape, &ga.0), (&cb.shape, &gb.0))
+            ((ca.shape, ca.pose), (cb.shape, cb.pose))
         };
-        let involves_mesh = is_mesh(&ca.shape) || is_mesh(&cb.shape);
+        let involves_mesh = is_mesh(ca.shape) || is_mesh(cb.shape);
         // A costly pair that barely moved since its last test reuses it (not after a collider
         // changed), a mesh pair with the triangle pairs it found for the debug view.
-        let cacheable = worth_caching(sa, sb) && !ca.is_changed() && !cb.is_changed();
-        let key = if swap { (lb, la) } else { (la, lb) };
+        let cacheable = worth_caching(sa, sb) && !ca.changed && !cb.changed;
+        let key = if swap { (eb, ea) } else { (ea, eb) };
         let key = (key.0.to_bits(), key.1.to_bits());
         let cached = if cacheable {
             self.cache.get(key, (pa, pb), sb.bounding_radius(), margin)
@@ -487,22 +535,31 @@ impl NarrowPhaseScratch {
             contacts.pairs.push(ContactPair {
                 a,
                 b,
-                collider_a: la,
-                collider_b: lb,
+                collider_a: ea,
+                collider_b: eb,
                 manifold,
                 normal_impulse: 0.0,
                 impact_speed: 0.0,
                 rounding: [
-                    ca.shape.rounding_along(ga.0.rotation, manifold.normal),
-                    cb.shape.rounding_along(gb.0.rotation, manifold.normal),
+                    ca.shape.rounding_along(ca.pose.rotation, manifold.normal),
+                    cb.shape.rounding_along(cb.pose.rotation, manifold.normal),
                 ],
             });
             if debug.enabled && involves_mesh {
-                let overlap = leaf_overlap(la, &ca.shape, lb, &cb.shape, &self.contact);
+                let overlap = leaf_overlap(ea, ca.shape, eb, cb.shape, &self.contact);
                 debug.pairs.push(overlap);
             }
         }
     }
+}
+
+/// `v`'s buffer, emptied, for items of another lifetime: a `Vec` collected from its own
+/// iterator with items of the same size and alignment reuses its allocation (the standard
+/// library's in-place collection), so the buffer lent to a step's borrows is kept between
+/// steps without a reference outliving them.
+fn emptied<'a>(mut v: Vec<Leaf<'a>>) -> Vec<Leaf<'static>> {
+    v.clear();
+    v.into_iter().filter_map(|_| None).collect()
 }
 
 fn is_mesh(shape: &Shape) -> bool {
@@ -540,4 +597,28 @@ fn leaf_overlap(
     leaves.sort_unstable();
     leaves.dedup();
     LeafOverlap { a, b, leaves }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_leaves_buffer_lent_to_a_step_comes_back_with_its_allocation_and_no_items() {
+        let (shape, pose) = (Shape::sphere(1.0), Isometry::IDENTITY);
+        let leaf = Leaf {
+            shape: &shape,
+            pose: &pose,
+            changed: false,
+        };
+        let mut lent: Vec<Leaf<'_>> = Vec::with_capacity(64);
+        lent.extend([leaf; 10]);
+        let (buffer, capacity) = (lent.as_ptr() as usize, lent.capacity());
+        let kept = emptied(lent);
+        assert!(kept.is_empty());
+        assert_eq!(
+            (kept.as_ptr() as usize, kept.capacity()),
+            (buffer, capacity)
+        );
+    }
 }
