@@ -45,7 +45,7 @@ use crate::geometry::contacts::{
     ContactScratch, ManifoldCache, NO_TRIANGLE, RoundSide, contact_with_scratch,
     speculative_contact_with_scratch,
 };
-use crate::geometry::{ContactManifold, Isometry, Shape};
+use crate::geometry::{ContactManifold, Shape};
 use crate::hierarchy::{BvTree, HierarchyStats, PairScratch, descend_pairs};
 use crate::plugins::broad_phase::BroadPhasePairs;
 use crate::plugins::joints::JointedPairs;
@@ -59,9 +59,11 @@ use bevy_ecs::entity::EntityHashMap;
 use bevy_ecs::prelude::*;
 use std::time::Instant;
 
+mod leaves;
 mod outputs;
 mod visits;
 
+use leaves::{Leaf, NO_LEAF_OF_ITS_OWN, emptied};
 pub use outputs::{
     ContactPair, Contacts, LeafOverlap, NO_LEAF, OverlappingLeaves, SensorOverlaps, SensorPair,
 };
@@ -127,40 +129,6 @@ struct NarrowPhaseScratch {
     /// [`BodyFacts::leaf`] indexes them: kept empty between steps for its capacity.
     leaves: Vec<Leaf<'static>>,
 }
-
-/// A collider as a pair test reads it, taken from the world once a step for a body that is
-/// its own only collider: two queries of the world per pair were a tenth of a falling pile's
-/// narrow phase.
-#[derive(Clone, Copy)]
-struct Leaf<'a> {
-    shape: &'a Shape,
-    pose: &'a Isometry,
-    /// Changed since the last step (a cached test of it is stale).
-    changed: bool,
-}
-
-impl<'a> Leaf<'a> {
-    /// Collider `e` of `nodes`, if it has one.
-    fn of(nodes: &'a Query<Node, Without<Quarantined>>, e: Entity) -> Option<Self> {
-        let (Some(collider), global, ..) = nodes.get(e).ok()? else {
-            return None;
-        };
-        Some(Self::new(collider, global))
-    }
-
-    fn new(collider: Ref<'a, Collider>, global: &'a GlobalPose) -> Self {
-        let changed = collider.is_changed();
-        let shape = &collider.into_inner().shape;
-        Self {
-            shape,
-            pose: &global.0,
-            changed,
-        }
-    }
-}
-
-/// Index of [`BodyFacts::leaf`] for a body without a leaf of its own (no collider, or parts).
-const NO_LEAF_OF_ITS_OWN: u32 = u32::MAX;
 
 /// A body's part in this step's pairs.
 #[derive(Clone, Copy, Debug)]
@@ -554,16 +522,6 @@ impl NarrowPhaseScratch {
     }
 }
 
-/// `v`'s buffer, emptied, for items of another lifetime: a `Vec` collected from its own
-/// iterator with items of the same size and alignment reuses its allocation (the standard
-/// library's in-place collection), so the buffer lent to a step's borrows is kept between
-/// steps without a reference outliving them.
-#[allow(clippy::unnecessary_filter_map)] // the map is what changes the items' lifetime
-fn emptied<'a>(mut v: Vec<Leaf<'a>>) -> Vec<Leaf<'static>> {
-    v.clear();
-    v.into_iter().filter_map(|_| None).collect()
-}
-
 fn is_mesh(shape: &Shape) -> bool {
     matches!(shape, Shape::TriMesh(_))
 }
@@ -607,28 +565,4 @@ fn leaf_overlap(
     leaves.sort_unstable();
     leaves.dedup();
     LeafOverlap { a, b, leaves }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_leaves_buffer_lent_to_a_step_comes_back_with_its_allocation_and_no_items() {
-        let (shape, pose) = (Shape::sphere(1.0), Isometry::IDENTITY);
-        let leaf = Leaf {
-            shape: &shape,
-            pose: &pose,
-            changed: false,
-        };
-        let mut lent: Vec<Leaf<'_>> = Vec::with_capacity(64);
-        lent.extend([leaf; 10]);
-        let (buffer, capacity) = (lent.as_ptr() as usize, lent.capacity());
-        let kept = emptied(lent);
-        assert!(kept.is_empty());
-        assert_eq!(
-            (kept.as_ptr() as usize, kept.capacity()),
-            (buffer, capacity)
-        );
-    }
 }
