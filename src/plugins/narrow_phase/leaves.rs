@@ -38,7 +38,7 @@ impl<'a> Leaf<'a> {
     }
 }
 
-/// The index a body's facts hold in place of a leaf's, for a body without a leaf of its own (no collider, or parts).
+/// The index a body's facts hold for a body without a leaf of its own (no collider, or parts).
 pub(super) const NO_LEAF_OF_ITS_OWN: u32 = u32::MAX;
 
 /// `v`'s buffer, emptied, for items of another lifetime: a `Vec` collected from its own
