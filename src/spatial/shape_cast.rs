@@ -135,9 +135,34 @@ pub(super) fn against_mesh(
     let stack = &mut scratch.along;
     stack.clear();
     stack.extend(entry(&nodes[0].bv, max).map(|t| (0, t)));
+    // Hits within the tolerance of each other are one contact seen from several triangles: the
+    // more head-on normal wins (a flat caster landing across a seam touches the triangle
+    // beside it only at its edge, where the closest points lie side by side and the normal
+    // came out level: `(1, 0, 0)` for a cylinder dropped onto a tessellated floor), at the
+    // nearer of the two distances (never later than a triangle's own hit).
+    let reach_of = |best: Option<CastHit>| best.map_or(max, |b| (b.distance + tolerance).min(max));
+    let chosen = |hit: CastHit, best: CastHit| {
+        if (hit.distance - best.distance).abs() > tolerance {
+            return if hit.distance < best.distance {
+                hit
+            } else {
+                best
+            };
+        }
+        let distance = hit.distance.min(best.distance);
+        let head_on = if hit.normal.dot(local) < best.normal.dot(local) {
+            hit
+        } else {
+            best
+        };
+        CastHit {
+            distance,
+            ..head_on
+        }
+    };
     while let Some((index, at_entry)) = stack.pop() {
-        // Only a nearer hit than the best so far matters.
-        let limit = best.map_or(max, |b| b.distance);
+        // Only a nearer hit than the best so far matters (or a tie, for its normal).
+        let limit = reach_of(best);
         if at_entry > limit {
             continue;
         }
@@ -157,7 +182,7 @@ pub(super) fn against_mesh(
             let Some(tri) = mesh.mesh().triangle(t as usize) else {
                 continue;
             };
-            let limit = best.map_or(max, |b| b.distance);
+            let limit = reach_of(best);
             if entry(&tri.aabb(), limit).is_none() {
                 continue;
             }
@@ -166,10 +191,8 @@ pub(super) fn against_mesh(
                 let moved = Isometry::new(start.translation + local * t, start.rotation);
                 triangle_gap(&triangle, shape, &moved, local)
             });
-            if let Some(hit) = hit
-                && best.is_none_or(|b| hit.distance < b.distance)
-            {
-                best = Some(hit);
+            if let Some(hit) = hit {
+                best = Some(best.map_or(hit, |best| chosen(hit, best)));
             }
         }
     }

@@ -342,3 +342,71 @@ fn casts_at_a_2_degree_glance_hit_a_box_top_and_a_mesh_floor_within_1e_4_of_gap_
         );
     }
 }
+
+#[test]
+fn flat_bottoms_dropped_on_a_tessellated_floor_over_seams_and_corners_get_its_normal_within_1e_4_rad()
+ {
+    // A cylinder landing across a seam touched the triangle beside it only at its edge, and
+    // that triangle's hit, as near as the face's, came with a level normal, `(1, 0, 0)`.
+    let mut scratch = QueryScratch::new();
+    let mut rng = Rng::new(83);
+    let floor = TriMesh::grid_floor(20.0, 40).unwrap(); // 0.5 m cells, at z = 0
+    let floor = Shape::TriMesh(MeshCollider::new(floor).unwrap());
+    let casters = [
+        (Shape::cylinder(0.5, 0.3), 0.5),
+        (Shape::cone(0.5, 0.3), 0.5),
+        (
+            Shape::convex_hull(&box_corners(Vec3::new(0.3, 0.2, 0.25))).unwrap(),
+            0.25,
+        ),
+    ];
+    let mut checked = 0;
+    for (caster, below) in &casters {
+        for sample in 0..200 {
+            // Half on the grid's lines and corners (rims and faces meeting seams), half anywhere.
+            let (x, y) = if sample % 2 == 0 {
+                let on_grid =
+                    |r: &mut Rng| 0.5 * (r.below(8) as f32 - 4.0) + 0.3 * (r.below(3) as f32 - 1.0);
+                (on_grid(&mut rng), on_grid(&mut rng))
+            } else {
+                (rng.range(-2.0, 2.0), rng.range(-2.0, 2.0))
+            };
+            let turn = Quat::from_rotation_z(if sample % 4 < 2 {
+                0.0
+            } else {
+                rng.range(0.0, 3.0)
+            });
+            let cast = ShapeCast {
+                pose: Isometry::new(Vec3::new(x, y, 5.0), turn),
+                shape: caster,
+                direction: -Vec3::Z,
+                max_distance: 10.0,
+            };
+            let hit = cast_shape(&cast, &floor, &Isometry::IDENTITY, &mut scratch);
+            let hit = hit.unwrap_or_else(|| panic!("{caster:?} from ({x}, {y}) missed"));
+            let tilt = hit.normal.cross(Vec3::Z).length();
+            assert!(
+                tilt < 1e-4 && hit.normal.z > 0.0,
+                "{caster:?} from ({x}, {y}): normal {}",
+                hit.normal
+            );
+            assert!(
+                (hit.distance - (5.0 - below)).abs() < 1e-4,
+                "{}",
+                hit.distance
+            );
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 600);
+}
+
+/// The eight corners of a box of half extents `h`.
+fn box_corners(h: Vec3) -> Vec<Vec3> {
+    (0..8)
+        .map(|k| {
+            let sign = |bit: u32| if k & (1 << bit) != 0 { 1.0 } else { -1.0 };
+            h * Vec3::new(sign(0), sign(1), sign(2))
+        })
+        .collect()
+}
