@@ -7,6 +7,7 @@
 //! shape can be (to the far side of its box), and the answer is the sweep's, scaled back to a
 //! distance along the unit direction.
 
+use super::ray_convex::ray_at_convex;
 use crate::bounding::Aabb;
 use crate::bvh::QueryScratch;
 use crate::ccd::{SphereSweep, toi_sphere_shape};
@@ -117,9 +118,11 @@ pub struct CastHit {
 /// `aabb`). Solid shapes: a cast starting inside or touching hits at distance 0; meshes are
 /// surfaces (two-sided triangles), as everywhere in urto.
 ///
-/// Balls, half-spaces and rays against boxes are solved in closed form along the unit
-/// direction (a sweep's quadratic over a 100 m segment lost millimetres to rounding); a sphere
-/// against a box (a rounded box) and anything against a mesh go through the CCD sweeps.
+/// Balls, half-spaces and rays against boxes, cylinders, cones, ellipsoids and hulls are solved
+/// in closed form along the unit direction (a sweep's quadratic over a 100 m segment lost
+/// millimetres to rounding, and a sweep stops short by its tolerance: `ray_convex.rs`); a
+/// sphere against a box (a rounded box) or those shapes, and anything against a mesh, go
+/// through the CCD sweeps.
 pub fn cast_sphere(
     ray: &Ray,
     radius: f32,
@@ -134,7 +137,13 @@ pub fn cast_sphere(
             cast_at_plane(ray, radius, max_distance, pose.translation, normal)
         }
         Shape::Cuboid(c) if radius == 0.0 => ray_at_box(ray, max_distance, pose, c.half_extents),
-        _ => cast_by_sweep(ray, radius, max_distance, (shape, pose, aabb), scratch),
+        _ => {
+            let exact = (radius == 0.0).then(|| ray_at_convex(ray, max_distance, shape, pose));
+            match exact.flatten() {
+                Some(hit) => hit,
+                None => cast_by_sweep(ray, radius, max_distance, (shape, pose, aabb), scratch),
+            }
+        }
     }
 }
 

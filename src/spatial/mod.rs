@@ -32,6 +32,7 @@ pub mod collider_tree;
 pub mod index;
 pub mod layers;
 pub mod nearest;
+mod ray_convex;
 pub mod shape_cast;
 pub mod stable_ids;
 pub mod tree;
