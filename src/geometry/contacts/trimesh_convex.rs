@@ -11,7 +11,11 @@
 //! over the neighbour, which reports it. Read along this face's normal it would be a second,
 //! speculative point on the part's curved side ahead of where it rests, whose row (assuming
 //! the point keeps its downward speed for the whole step) brakes a rolling cylinder: 12 seams
-//! took 20 % of its speed, now 4 % (`scenarios/convex.rs`). Only flat seams: across a fold of
+//! took 20 % of its speed, now 4 % (`scenarios/convex.rs`). A part the seam sees side-on
+//! (more than 60° off its face normal: a lying cylinder's flat end over the seam), touching or
+//! not, is handed over too: read along the face from here its point lay at the floor's level.
+//! Where the face normal is taken, its side is the part's (its middle along the normal), not
+//! the sign of a contact normal lying along the face. Only flat seams: across a fold of
 //! a few degrees the neighbour may rise towards the part (a valley) or every face around a
 //! vertex may see it steeply (a low peak), and the seam's own reading is what holds it there.
 //!
@@ -74,7 +78,8 @@ fn triangle_contact(
     if d.distance > margin {
         return None;
     }
-    let d = match face_normal_at_inactive_edge(tri, active, d.on_a, d.normal) {
+    let side = side_of(tri, &d, part);
+    let d = match face_normal_at_inactive_edge(tri, active, d.on_a, side) {
         Some(up) if beside_a_flat_seam(tri, flat, &d, up) => return None,
         Some(up) => along_face(tri, up, &d),
         None => d,
@@ -82,14 +87,42 @@ fn triangle_contact(
     (d.distance <= margin).then(|| manifold(&face, part, &d, margin))
 }
 
-/// Whether the part is apart and beside a flat seam, over the neighbour, which reports it
-/// (module notes): the seam sees the part more steeply than
-/// [`COPLANAR_DEGREES`] (5°, ten times the fold a flat seam may have), and the closest pair
-/// lies only on flat edges (it lies on some edge: the face normal was taken).
+/// A contact normal at least this far off the face (cosine, 60°) runs along it: the part
+/// touches the triangle's edge side-on.
+const SIDEWAYS_COSINE: f32 = 0.5;
+
+/// Whether the part is beside a flat seam, over the neighbour, which reports it (module
+/// notes): the closest pair lies only on flat edges (it lies on some edge: the face normal was
+/// taken), and the seam sees the part, apart, more steeply than [`COPLANAR_DEGREES`] (5°, ten
+/// times the fold a flat seam may have), or, touching or not, side-on (a lying cylinder's flat
+/// end over a seam: read along the face from here, its point came out at the floor's level,
+/// 1 mm shallow where the log lay 1 mm deep).
 fn beside_a_flat_seam(tri: &Triangle, flat: u8, d: &SignedDistance, up: Vec3) -> bool {
-    d.distance > 0.0
-        && d.normal.dot(up) < COPLANAR_DEGREES.to_radians().cos()
-        && edges_holding(tri, d.on_a) & !flat == 0
+    let along = d.normal.dot(up);
+    let steep = d.distance > 0.0 && along < COPLANAR_DEGREES.to_radians().cos();
+    (steep || along.abs() < SIDEWAYS_COSINE) && edges_holding(tri, d.on_a) & !flat == 0
+}
+
+/// The side of the triangle the part is on, to choose the face normal taken at an inactive
+/// edge: the contact normal's, unless that runs along the face, where its sign is the
+/// rounding's; then the side of the part's middle along the face normal (midway between its
+/// extremes). A level normal picked the face normal below a floor, and the part was read from
+/// underneath: a log lying 1 mm into a tessellated incline with its flat end over a seam read
+/// 199 mm deep and was pushed through (14 mm into the incline as it rolled down).
+fn side_of(tri: &Triangle, d: &SignedDistance, part: &ConvexPart) -> Vec3 {
+    let Some(face) = tri.normal() else {
+        return d.normal;
+    };
+    if face.dot(d.normal).abs() >= SIDEWAYS_COSINE {
+        return d.normal;
+    }
+    let middle = 0.5 * (part.support(face) + part.support(-face));
+    let height = face.dot(middle - tri.a);
+    if height == 0.0 {
+        d.normal
+    } else {
+        face * height.signum()
+    }
 }
 
 /// The contact read along the face normal `up` (towards the part) when the surface continues
@@ -105,5 +138,45 @@ fn along_face(tri: &Triangle, up: Vec3, d: &SignedDistance) -> SignedDistance {
         distance: up.dot(d.on_b - tri.a),
         normal: up,
         ..*d
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::TriMesh;
+    use crate::geometry::contacts::{ContactScratch, contact_with_scratch};
+    use glam::Quat;
+
+    #[test]
+    fn a_log_on_a_tessellated_incline_with_its_ends_over_seams_reads_every_point_at_its_depth_within_1e_5()
+     {
+        // Its flat ends lie over the grid's seams: the triangles beyond them, touched side-on,
+        // read it from underneath (199 mm deep) or at the floor's level (1 mm shallow).
+        let tilt = Quat::from_rotation_y(-20f32.to_radians());
+        let normal = tilt * Vec3::Z;
+        let grid = TriMesh::grid_floor(40.0, 80).unwrap(); // 0.5 m cells
+        let floor = Shape::TriMesh(MeshCollider::new(grid).unwrap());
+        let floor_pose = Isometry::new(Vec3::ZERO, tilt);
+        let (log, radius, depth) = (Shape::cylinder(1.0, 0.1), 0.1, 1e-3);
+        let lying = Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
+        let mut scratch = ContactScratch::default();
+        for i in 0..600 {
+            // Rolled down the incline by 5 mm a pose, turned as it rolls.
+            let along = -0.005 * i as f32;
+            let turn = tilt * Quat::from_rotation_y(-along / radius) * lying;
+            let at = tilt * Vec3::X * along + normal * (radius - depth);
+            let pose = Isometry::new(at, turn);
+            let m = contact_with_scratch(&log, &pose, &floor, &floor_pose, &mut scratch);
+            let m = m.unwrap_or_else(|| panic!("pose {i}: no contact"));
+            assert!(
+                m.normal.dot(-normal) > 1.0 - 1e-6,
+                "pose {i}: normal {}",
+                m.normal
+            );
+            for p in m.points() {
+                assert!((p.depth - depth).abs() < 1e-5, "pose {i}: {m:?}");
+            }
+        }
     }
 }
