@@ -238,7 +238,7 @@ fn ray_targets() -> Vec<(&'static str, Shape, Option<SharedShape>, glam::Quat)> 
 /// aimed within 0.5 m of a turned shape's centre, urto's `cast_sphere` with radius 0 (closed
 /// forms, `spatial/ray_convex.rs`) against parry's `cast_ray_and_get_normal` (solid).
 fn ray_convex(c: &mut Criterion) {
-    use parry3d::query::{Ray as ParryRay, RayCast};
+    use parry3d::query::Ray as ParryRay;
     use urto::bvh::QueryScratch;
     use urto::spatial::{Ray, cast_sphere};
     let mut r = Rng::new(47);
