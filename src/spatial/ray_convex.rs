@@ -112,7 +112,7 @@ fn plane(inside: &mut Inside, o: Vec3, d: Vec3, n: Vec3, offset: f32) {
 /// Clips to `a t² + b t + c <= 0`, whose gradient at a point is `gradient`; where the set is two
 /// rays (a cone's two nappes), the piece meeting the interval first. In `f64`: near a cone's
 /// apex or at a glance the coefficients are differences of nearly equal numbers (in `f32` a
-/// ray passing 0.1 mm from an apex was found 0.07 mm inside it).
+/// ray passing 0.1 mm beside an apex hit it, 0.07 mm off its surface).
 fn quadric(inside: &mut Inside, [a, b, c]: [f64; 3], gradient: impl Fn(f32) -> Vec3) {
     if a == 0.0 {
         // Linear: b t + c <= 0.
