@@ -136,7 +136,6 @@ pub fn cast_sphere(
             let normal = pose.transform_vector(h.normal);
             cast_at_plane(ray, radius, max_distance, pose.translation, normal)
         }
-        Shape::Cuboid(c) if radius == 0.0 => ray_at_box(ray, max_distance, pose, c.half_extents),
         _ => {
             let exact = (radius == 0.0).then(|| ray_at_convex(ray, max_distance, shape, pose));
             match exact.flatten() {
@@ -211,46 +210,6 @@ pub(crate) fn cast_at_plane(
     (distance <= max).then(|| CastHit {
         distance,
         point: ray.at(distance) - normal * radius,
-        normal,
-    })
-}
-
-/// A ray at the box `[-half, half]` placed at `pose`: the slab test in the box's frame, the
-/// normal that of the last slab entered (at an edge, one of its two faces).
-fn ray_at_box(ray: &Ray, max: f32, pose: &Isometry, half: Vec3) -> Option<CastHit> {
-    let o = pose.inverse_transform_point(ray.origin);
-    let d = pose.inverse_transform_vector(ray.direction);
-    let (mut near, mut far, mut axis) = (f32::NEG_INFINITY, max, None);
-    for k in 0..3 {
-        if d[k] == 0.0 {
-            if o[k].abs() > half[k] {
-                return None;
-            }
-            continue;
-        }
-        let (t1, t2) = ((-half[k] - o[k]) / d[k], (half[k] - o[k]) / d[k]);
-        let (enter, leave) = (t1.min(t2), t1.max(t2));
-        if enter > near {
-            (near, axis) = (enter, Some(k));
-        }
-        far = far.min(leave);
-    }
-    if near > far || far < 0.0 {
-        return None;
-    }
-    let inside = near <= 0.0;
-    let normal = match axis {
-        Some(k) if !inside => {
-            let mut n = Vec3::ZERO;
-            n[k] = -d[k].signum();
-            pose.transform_vector(n)
-        }
-        _ => -ray.direction,
-    };
-    let distance = near.max(0.0);
-    Some(CastHit {
-        distance,
-        point: ray.at(distance),
         normal,
     })
 }

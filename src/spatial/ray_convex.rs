@@ -1,19 +1,18 @@
-//! Rays at cylinders, cones, ellipsoids and convex hulls in closed form: each solid is an
-//! intersection of half-spaces and one quadric, so the ray's part inside it is an interval
+//! Rays at boxes, cylinders, cones, ellipsoids and convex hulls in closed form: each solid is
+//! an intersection of half-spaces and at most one quadric, so the ray's part inside it is an interval
 //! clipped by each in turn (Cyrus & Beck 1978 for the planes; Ericson, *Real-Time Collision
 //! Detection*, §5.3 for the quadrics), entered where the last constraint is entered.
 //!
 //! These rays went through the CCD sweeps (conservative advancement on GJK distances), which
 //! stop within a tolerance of the surface by design (a sweep must never be late): a ray 8 m
 //! from its target stopped up to 1e-4 from the surface (1e-5 of the path), 5.6e-3 short along
-//! a ray glancing off a hull at 1°, where rays at boxes and balls are exact. Here the answer is
+//! a ray glancing off a hull at 1°, where rays at boxes (the slab test, now the planes below)
+//! and balls were exact. Here the answer is
 //! the surface itself, up to rounding: within 4e-7 of the path over 8,000 rays, half of them
 //! glancing (the tests below).
 //!
-//! Each quadric is solved from the ray's closest approach to the shape's centre (the parameter
-//! shifted there), so that a target far along the ray keeps its precision, as `cast_at_ball`,
-//! and in `f64` (near a cone's apex or at a glance its coefficients are differences of nearly
-//! equal numbers). Anything these forms cannot answer (a flat ellipsoid, a NaN from numbers
+//! Each quadric is solved in `f64` (near a cone's apex, at a glance or far along the ray its
+//! coefficients are differences of nearly equal numbers). Anything these forms cannot answer (a flat ellipsoid, a NaN from numbers
 //! past `f32`) is left to the sweep.
 
 use super::cast::{CastHit, Ray};
@@ -43,8 +42,8 @@ impl Inside {
     }
 }
 
-/// The first hit of `ray` within `max` on a cylinder, cone, ellipsoid or hull at `pose`, or
-/// `None` for another shape. A ray starting inside hits at 0, its normal against the ray.
+/// The first hit of `ray` within `max` on a box, cylinder, cone, ellipsoid or hull at `pose`,
+/// or `None` for another shape. A ray starting inside hits at 0, its normal against the ray.
 pub(crate) fn ray_at_convex(
     ray: &Ray,
     max: f32,
@@ -53,15 +52,13 @@ pub(crate) fn ray_at_convex(
 ) -> Option<Option<CastHit>> {
     let o = pose.inverse_transform_point(ray.origin());
     let d = pose.inverse_transform_vector(ray.direction());
-    // From the closest approach to the centre: `t = shift + s`.
-    let shift = -o.dot(d);
-    let o = o + d * shift;
     let mut inside = Inside {
-        near: -shift,
-        far: max - shift,
+        near: 0.0,
+        far: max,
         normal: None,
     };
     match shape {
+        Shape::Cuboid(c) => cuboid(&mut inside, o, d, c.half_extents),
         Shape::Cylinder(c) => cylinder(&mut inside, o, d, c),
         Shape::Cone(c) => cone(&mut inside, o, d, c),
         // A flat ellipsoid (a zero semi-axis, a disc) has no quadric to scale by: the sweep's.
@@ -75,16 +72,14 @@ pub(crate) fn ray_at_convex(
     if inside.is_empty() {
         return Some(None);
     }
-    let distance = inside.near + shift;
+    let distance = inside.near;
     // A surface normal faces the ray; none does at a cone's apex (its gradient vanishes), and a
-    // ray starting inside has none: the normal is then against the ray.
+    // ray starting inside (or on the surface) entered nothing: the normal is then against it.
     let facing = |n: &Vec3| n.dot(d) < 0.0;
     let normal = (inside.normal)
-        .filter(|_| distance > 0.0)
         .and_then(Vec3::try_normalize)
         .filter(facing)
         .map_or(-ray.direction(), |n| pose.transform_vector(n));
-    let distance = distance.max(0.0);
     Some(Some(CastHit {
         distance,
         point: ray.at(distance),
@@ -119,7 +114,8 @@ fn quadric(inside: &mut Inside, [a, b, c]: [f64; 3], gradient: impl Fn(f32) -> V
         if b > 0.0 {
             inside.far = inside.far.min((-c / b) as f32);
         } else if b < 0.0 {
-            inside_enter(inside, (-c / b) as f32, &gradient);
+            let t = (-c / b) as f32;
+            inside.enter(t, || gradient(t));
         } else if c > 0.0 {
             inside.far = f32::NEG_INFINITY;
         }
@@ -138,18 +134,27 @@ fn quadric(inside: &mut Inside, [a, b, c]: [f64; 3], gradient: impl Fn(f32) -> V
     let (t1, t2) = (r1.min(r2), r1.max(r2));
     if a > 0.0 {
         inside.far = inside.far.min(t2 as f32);
-        inside_enter(inside, t1 as f32, &gradient);
+        let t = t1 as f32;
+        inside.enter(t, || gradient(t));
     } else if t1 as f32 >= inside.near {
         // Inside before t1 and after t2: the interval starts in the first piece.
         inside.far = inside.far.min(t1 as f32);
     } else {
-        inside_enter(inside, t2 as f32, &gradient);
+        let t = t2 as f32;
+        inside.enter(t, || gradient(t));
     }
 }
 
-/// [`Inside::enter`] at `t` with the gradient there.
-fn inside_enter(inside: &mut Inside, t: f32, gradient: &impl Fn(f32) -> Vec3) {
-    inside.enter(t, || gradient(t));
+/// The box `[-half, half]`: its three slabs (a face's normal has no negative zeros, so the
+/// normal turned to the world is the one the slab test gave before this module).
+fn cuboid(inside: &mut Inside, o: Vec3, d: Vec3, half: Vec3) {
+    for k in 0..3 {
+        for sign in [1.0, -1.0] {
+            let mut n = Vec3::ZERO;
+            n[k] = sign;
+            plane(inside, o, d, n, half[k]);
+        }
+    }
 }
 
 fn cylinder(inside: &mut Inside, o: Vec3, d: Vec3, c: &Cylinder) {
