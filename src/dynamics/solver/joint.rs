@@ -14,13 +14,14 @@
 //! | fixed | 3 (anchors together) | 3 (frames aligned) | — |
 //! | spherical | 3 | — (a swing cone and a twist limit if asked) | — |
 //! | revolute | 3 | 2 (axes aligned) | angle of B's frame about A's axis |
-//! | prismatic | 2 (across the axis) | 3 | travel of B's anchor along A's axis |
+//! | prismatic | 2 (across the axis) | 3 | travel of B's anchor from A's along the axis |
 //! | distance | — | — | distance between the anchors |
 //!
 //! Per substep a joint is warm started with its accumulated impulses, then solved in each pass:
 //! motor, limits, then the rows that hold it together (Box2D's order: the hard rows last, so
 //! they win). The position errors are measured from the bodies' motion within the step
-//! (`dp`, `dq`, as the contacts do), so the anchors turn with their bodies. In the biased pass
+//! (`dp`, `dq`, as the contacts do), so the anchors turn with their bodies. A slider's rail
+//! rides on the heavier of its bodies (why: `slider_rail` in `joint_extra.rs`). In the biased pass
 //! the errors are closed softly ([`SoftStepSettings::joint_hertz`](super::SoftStepSettings));
 //! the relax passes are rigid and unbiased; a limit not yet reached is speculative, as a
 //! contact is: it lets the coordinate close exactly its gap this substep. A motor is a soft

@@ -186,17 +186,18 @@ impl JointExtra {
             JointKind::Prismatic { .. } => {
                 rows.angular = Some(lock());
                 rows.angular_inverse_mass = self.lock_inverse_mass;
+                let (rail, arms) = slider_rail(m, (fa, fb), (r_a, r_b), separation);
                 let slide = |dir: Vec3| {
                     let row = AxisRow {
                         linear: dir,
-                        angular_a: (r_a + separation).cross(dir),
-                        angular_b: r_b.cross(dir),
+                        angular_a: arms.0.cross(dir),
+                        angular_b: arms.1.cross(dir),
                         pivot: None,
                     };
                     (row, dir.dot(separation))
                 };
-                rows.across = Some([slide(fa * Vec3::Y), slide(fa * Vec3::Z)]);
-                rows.axis = Some(slide(axis));
+                rows.across = Some([slide(rail * Vec3::Y), slide(rail * Vec3::Z)]);
+                rows.axis = Some(slide(rail * Vec3::X));
             }
             JointKind::Distance { .. } => {
                 let length = separation.length();
@@ -373,6 +374,33 @@ fn held_if(mut row: AxisRow, carries: bool, m: &PairMasses, point: &PointRows) -
 fn hold(row: &mut AxisRow, pending: &mut bool, m: &PairMasses, point: &PointRows) {
     if std::mem::take(pending) {
         *row = row.held_at(m, point.anchors, &point.inverse_mass);
+    }
+}
+
+/// The frame a slider's rail rides on, and the arms its rows turn the bodies by.
+///
+/// A slider keeps `C = d · s` at zero across its rail (and measures its travel along it), where
+/// `s = c_b + r_b − c_a − r_a` runs anchor to anchor and `d` is one of the rail's directions.
+/// If `d` turns with A, `Ċ = d · (v_b + ω_b × r_b − v_a − ω_a × r_a) + (ω_a × d) · s`, and
+/// `(ω_a × d) · s = −ω_a · (s × d)`: A's arm is `r_a + s`, B's is `r_b`. If `d` turns with B,
+/// the last term is `(ω_b × d) · s`: A's arm is `r_a`, B's `r_b − s`. Held rigidly the two are
+/// the same joint (the angular rows keep the frames aligned), but a soft row gives where its
+/// arm is long: a body sliding 6 m along a rail fixed in the world, with the rail on the body,
+/// was held at the world's anchor 6 m from its centre, and the torque that took tilted it
+/// until it sagged 195 mm under gravity. So the rail rides on the heavier body (on B when B is
+/// strictly heavier, the world and static bodies included), whose arm the long one then is.
+#[inline]
+fn slider_rail(
+    m: &PairMasses,
+    (fa, fb): (Quat, Quat),
+    (r_a, r_b): (Vec3, Vec3),
+    separation: Vec3,
+) -> (Quat, (Vec3, Vec3)) {
+    let [wa, wb] = m.inverse_mass.map(Vec3::max_element);
+    if wb < wa {
+        (fb, (r_a, r_b - separation))
+    } else {
+        (fa, (r_a + separation, r_b))
     }
 }
 

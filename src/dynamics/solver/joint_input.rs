@@ -103,7 +103,8 @@ pub enum JointKind {
         /// Drives the angle.
         motor: Option<JointMotor>,
     },
-    /// Keeps the frames aligned and B's anchor on A's axis; B slides along it.
+    /// Keeps the frames aligned and the anchors on a line along the axis; B slides along it
+    /// (the travel is B's anchor from A's: which body is named first does not matter otherwise).
     Prismatic {
         /// Bounds on the travel (m).
         limit: Option<JointLimit>,

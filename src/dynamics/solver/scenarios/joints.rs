@@ -1,10 +1,11 @@
 //! Joints on scenes with analytic answers: a pendulum's period, a hanging chain's stretch, a
 //! motor against a known load, a hinge limit under a 10:1 mass ratio, a 1:100 chain swinging
-//! for a minute, a slider and a rope; a ball joint's cone and twist limits
+//! for a minute, a rope; sliders (`sliders.rs`), a ball joint's cone and twist limits
 //! (`ball_joint_limits.rs`) and joints the solver cannot use (`faults.rs`).
 
 mod ball_joint_limits;
 mod faults;
+mod sliders;
 
 use super::*;
 use crate::dynamics::solver::joint::twist_angle;
@@ -404,43 +405,6 @@ fn a_hinge_limit_holds_within_half_a_degree_under_a_10_to_1_mass_ratio() {
         "past the limit by {} deg",
         worst.to_degrees()
     );
-}
-
-#[test]
-fn a_slider_on_a_30_degree_rail_stops_at_its_limit_and_stays_on_the_rail_within_1_mm() {
-    let mut scene = Scene::default();
-    let base = anchor(&mut scene, Vec3::ZERO);
-    let rail = Vec3::new(30f32.to_radians().cos(), 0.0, -30f32.to_radians().sin());
-    let block = scene.add(
-        Shape::cuboid(Vec3::splat(0.1)),
-        Vec3::ZERO,
-        Quat::IDENTITY,
-        2.0,
-    );
-    let slider = JointKind::Prismatic {
-        limit: Some(JointLimit {
-            min: -1.0,
-            max: 2.0,
-        }),
-        motor: None,
-    };
-    join(
-        &mut scene,
-        (base, block),
-        (Vec3::ZERO, Vec3::ZERO),
-        rail,
-        slider,
-    );
-    scene.run(3.0);
-    let c = scene.bodies[block].center;
-    let along = c.dot(rail);
-    let across = (c - rail * along).length();
-    assert!((along - 2.0).abs() < 0.01, "stopped at {along} m");
-    assert!(across < 1e-3, "{across} m off the rail");
-    let turned = scene.bodies[block]
-        .orientation
-        .angle_between(Quat::IDENTITY);
-    assert!(turned < 1e-3, "turned {turned} rad");
 }
 
 /// A 1 kg ball of radius 0.1 at `at`, tied to a fixed point at `pivot` by a distance joint
