@@ -179,14 +179,34 @@ impl<'a> NormalPass<'a> {
             pair.push(self.batch.inverse_mass, n, &row.turn, applied);
             let first = p.max_normal_impulse.simd_eq(zero) & total.simd_gt(zero);
             if first.any() {
-                let closing = self.batch.closing_acceleration;
-                let speed = impact_speed(before.along(n, row), s, closing);
-                p.relative_velocity = first.select(speed, p.relative_velocity);
+                let untouched = points
+                    .iter()
+                    .fold(first, |lanes, q| lanes & q.max_normal_impulse.simd_eq(zero));
+                if untouched.any() {
+                    self.time_impacts(points, before, untouched);
+                }
             }
+            let p = &mut points[i];
             p.normal_impulse = total;
             p.max_normal_impulse = p.max_normal_impulse.max(total);
         }
         unsettled
+    }
+
+    /// The impact speeds of all the points of the `lanes` whose contact first pushes in the
+    /// step, read from the velocities `before` the pass (`contact_normals.rs`, "One moment per
+    /// impact"; the scalar `time_impact`).
+    #[cold]
+    #[inline(never)]
+    fn time_impacts(&self, points: &mut [PointX4], before: &PairVelocities, lanes: Lanes) {
+        let [na, nb] = self.turned;
+        let n = self.batch.normal;
+        for q in points {
+            let s = q.base_separation + self.moved + q.anchor_b.dot(nb) - q.anchor_a.dot(na);
+            let vn = before.along(n, &q.row(&q.normal_row, n));
+            let speed = impact_speed(vn, s, self.batch.closing_acceleration);
+            q.relative_velocity = lanes.select(speed, q.relative_velocity);
+        }
     }
 }
 

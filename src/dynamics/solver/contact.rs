@@ -115,13 +115,14 @@ pub struct ConstraintPoint {
     /// Largest normal impulse of the step, warm start included (restitution skips points that
     /// never pushed).
     pub max_normal_impulse: f32,
-    /// Normal relative velocity when the point began to push (at the step's start for a point
-    /// already pushing): the approach speed restitution reverses. Taken at the substep of
-    /// impact, not the step's start, so a bounce does not lose the speed gravity added during
-    /// the step before it (and a body struck by another in the step passes the blow on), and
-    /// from the velocities before the pass's impulses on the contact, so the points of a face
-    /// landing flat all read the same speed (read after the points solved before them, they
-    /// bounced differently and spun the body).
+    /// Normal relative velocity when the contact began to push (at the step's start for a
+    /// contact already pushing): the approach speed restitution reverses. Taken at the substep
+    /// of impact, not the step's start, so a bounce does not lose the speed gravity added
+    /// during the step before it (and a body struck by another in the step passes the blow
+    /// on), from the velocities before the pass's impulses on the contact, and for all its
+    /// points at once, so the points of a face landing flat all read the same speed (read
+    /// after the points solved before them, or a substep after the first pushed, they bounced
+    /// differently and spun the body: `contact_normals.rs`, "One moment per impact").
     pub relative_velocity: f32,
     /// The features that made the point: last step's impulses of the same features seed it
     /// (`warm_start.rs`).

@@ -6,7 +6,7 @@
 use super::*;
 use crate::geometry::contacts::speculative_contact;
 use crate::geometry::{Isometry, Shape};
-use glam::{Quat, Vec3};
+use glam::{Quat, Vec2, Vec3};
 
 const G: Vec3 = Vec3::new(0.0, 0.0, -9.81);
 const DT: f32 = 1.0 / 60.0;
