@@ -98,6 +98,12 @@ impl WarmStartCache {
             let side = MatchedSide::of(c, &orientation);
             seed_points(c, old_points, &side, (scale, match_distance));
             let (normal, tangents) = (c.normal, c.tangents);
+            if c.friction == 0.0 {
+                // Friction switched off since the last step: its rows are not solved, so a
+                // kept impulse would never be bounded again (a box sliding at 2.55 m/s whose
+                // friction was set to 0 accelerated backwards at μ g for ever).
+                continue;
+            }
             if let (Some(patch), Some((f, twist))) = (&mut c.patch, old.patch) {
                 patch.tangent_impulse = on_tangents(f, normal, tangents, scale);
                 patch.twist_impulse = twist * scale;
@@ -162,7 +168,9 @@ fn seed_points(
         if let Some(p) = matched {
             cp.normal_impulse = p.normal_impulse.max(0.0) * scale;
             cp.max_normal_impulse = cp.normal_impulse;
-            cp.tangent_impulse = on_tangents(p.friction_impulse, normal, tangents, scale);
+            if c.friction > 0.0 {
+                cp.tangent_impulse = on_tangents(p.friction_impulse, normal, tangents, scale);
+            }
         }
     }
 }
