@@ -131,12 +131,14 @@ pub struct Spring {
 /// The pair uses the average of its two bodies' values; absent means
 /// [`ContactSettings::default_restitution`](crate::ContactSettings).
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
+#[component(summary_tick)]
 pub struct Restitution(pub f32);
 
 /// Coulomb friction coefficient (0 = ice). The pair uses the geometric mean of its two bodies'
 /// values, so ice on anything slides; absent means
 /// [`ContactSettings::default_friction`](crate::ContactSettings).
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
+#[component(summary_tick)]
 pub struct Friction(pub f32);
 
 /// Rolling resistance (m): the lever arm `b` of the torque, at most `b` times the normal force,

@@ -117,6 +117,13 @@ pub(crate) struct TouchingPairs {
     sensing: Vec<Pair>,
 }
 
+impl TouchingPairs {
+    /// The touching pairs of sleeping or static bodies (each `(a, b)` with `a < b`).
+    pub(crate) fn dormant(&self) -> &[Pair] {
+        &self.dormant
+    }
+}
+
 /// Whether the bodies of a pair are both static or asleep.
 use crate::plugins::narrow_phase::Dormancy;
 

@@ -12,7 +12,7 @@
 //! comparison per column of a table nobody wrote to, row by row only where one was written
 //! (and always for `Transform`, `ChildOf`, `Children` and `Quarantined`, which have no summary
 //! tick). A settled body game code wrote to (moved, turned, reshaped, given a velocity, mass or
-//! force, stripped of its collider) loses the marker, so the scans see its change, and settles
+//! force, layers, friction or restitution, stripped of its collider) loses the marker, so the scans see its change, and settles
 //! again at the end of the step; one that stopped being static loses it for good. Compounds do
 //! not settle: a part's change re-fits its root's volume in mid-step, after the check.
 
@@ -110,6 +110,9 @@ type Watched<'a> = (
         Option<Ref<'a, ChildOf>>,
         Option<Ref<'a, Children>>,
         Option<Ref<'a, Quarantined>>,
+        Option<Ref<'a, CollisionLayers>>,
+        Option<Ref<'a, Friction>>,
+        Option<Ref<'a, Restitution>>,
     ),
 );
 
@@ -161,8 +164,8 @@ pub(crate) fn unsettle_written(
 /// last check; reads no row of a table whose columns' summary ticks say none was.
 fn written_rows(table: WatchedTable<'_, '_>, rows: &mut Vec<u8>, written: &mut Vec<Entity>) {
     let (entities, (a0, a1, a2, a3, a4, a5, a6, a7), (b0, b1, b2, b3, b4, b5, b6, b7), c) = table;
-    let (c0, c1, c2, c3, c4, c5) = c;
-    let columns: [Option<ContiguousComponentTicksRef<'_>>; 22] = [
+    let (c0, c1, c2, c3, c4, c5, c6, c7, c8) = c;
+    let columns: [Option<ContiguousComponentTicksRef<'_>>; 25] = [
         written_ticks(a0),
         written_ticks(a1),
         written_ticks(a2),
@@ -185,6 +188,9 @@ fn written_rows(table: WatchedTable<'_, '_>, rows: &mut Vec<u8>, written: &mut V
         written_ticks(c3),
         written_ticks(c4),
         written_ticks(c5),
+        written_ticks(c6),
+        written_ticks(c7),
+        written_ticks(c8),
     ];
     if columns.iter().all(Option::is_none) {
         return;

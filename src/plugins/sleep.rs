@@ -20,8 +20,11 @@
 //! response and the solver), when game code moves or turns it, sets its velocity or angular
 //! velocity, pushes it with a [`Force`], [`Torque`], [`ForceAtPoint`] or [`Impulse`], writes or
 //! removes its [`Mass`], [`Density`] or [`GravityScale`], changes its collider or removes its
-//! [`Sleeping`] marker, when gravity changes, or when a contact of it ends (a body it
-//! touched moved away or disappeared); its whole island wakes with it (members are kept per
+//! [`Sleeping`] marker, writes its [`Friction`] or [`Restitution`], when gravity changes,
+//! when a contact of it ends (a body it touched moved away or disappeared), when a static body
+//! it touches is moved, turned, reshaped, stripped of its collider, made a sensor or given new
+//! layers, friction or restitution, or when it loses its collider or becomes a sensor
+//! (`wake_on_scenery`); its whole island wakes with it (members are kept per
 //! island in [`SleepingIslands`], as Box2D v3's `island.c` keeps them), before the next step
 //! simulates anything.
 
@@ -32,6 +35,7 @@ use crate::plugins::core::PrepareWake;
 use crate::plugins::joints::ActiveJoint;
 use crate::plugins::narrow_phase::Contacts;
 use crate::plugins::required_resources::RequireResource;
+use crate::plugins::wake_on_scenery::wake_on_scenery_changes;
 use crate::plugins::wake_on_writes::wake_on_game_changes;
 use crate::schedule::{PhysicsSchedule, PhysicsSet};
 use crate::settings::{PhysicsTimestep, SleepSettings};
@@ -53,7 +57,12 @@ impl Plugin for SleepPlugin {
             .init_required::<SleepingIslands>()
             .add_systems(
                 PhysicsSchedule,
-                (wake_on_game_changes, wake_the_sleepless, wake_islands)
+                (
+                    wake_on_game_changes,
+                    wake_on_scenery_changes,
+                    wake_the_sleepless,
+                    wake_islands,
+                )
                     .chain()
                     .run_if(sleep_enabled)
                     .in_set(PrepareWake),

@@ -43,7 +43,8 @@ type SleeperColumns<'a> = (
 );
 
 /// What a body is made of and hangs from: any write to one of these wakes it (mass, density,
-/// gravity scale, locks, collider, layers, inertia, drags, parent, children).
+/// gravity scale, locks, collider, layers, inertia, drags, parent, children, friction,
+/// restitution).
 type MadeOf<'a> = (
     Option<Ref<'a, Mass>>,
     Option<Ref<'a, Density>>,
@@ -56,6 +57,8 @@ type MadeOf<'a> = (
     Option<Ref<'a, AngularDrag>>,
     Option<Ref<'a, ChildOf>>,
     Option<Ref<'a, Children>>,
+    Option<Ref<'a, Friction>>,
+    Option<Ref<'a, Restitution>>,
 );
 
 /// One sleeping table's data as [`SleeperColumns`] yields it.
@@ -172,7 +175,7 @@ fn check_table(table: SleeperTable<'_, '_>, rows: &mut Vec<u8>, woken: &mut Vec<
 }
 
 /// The change ticks of the make-up columns some row of which was written.
-fn remade_ticks<'w>(made_of: MadeOfTable<'w, '_>) -> [Option<ContiguousComponentTicksRef<'w>>; 11] {
+fn remade_ticks<'w>(made_of: MadeOfTable<'w, '_>) -> [Option<ContiguousComponentTicksRef<'w>>; 13] {
     let (
         mass,
         density,
@@ -185,6 +188,8 @@ fn remade_ticks<'w>(made_of: MadeOfTable<'w, '_>) -> [Option<ContiguousComponent
         angular_drag,
         parent,
         children,
+        friction,
+        restitution,
     ) = made_of;
     [
         written_ticks(mass),
@@ -198,6 +203,8 @@ fn remade_ticks<'w>(made_of: MadeOfTable<'w, '_>) -> [Option<ContiguousComponent
         written_ticks(angular_drag),
         written_ticks(parent),
         written_ticks(children),
+        written_ticks(friction),
+        written_ticks(restitution),
     ]
 }
 

@@ -4,6 +4,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 mod game_changes;
+mod support_changes;
 
 use bevy_app::App;
 use bevy_ecs::message::Messages;
@@ -334,7 +335,7 @@ type Write = fn(&mut EntityWorldMut);
 /// summary ticks, so this checks that no write goes unseen and that one write does not wake
 /// its table.
 #[test]
-fn each_of_19_writes_wakes_only_the_body_written_among_60_sleepers_in_three_tables() {
+fn each_of_21_writes_wakes_only_the_body_written_among_60_sleepers_in_three_tables() {
     let mut app = sleepy_app();
     let balls: Vec<Entity> = (0..60)
         .map(|i| {
@@ -371,7 +372,7 @@ fn each_of_19_writes_wakes_only_the_body_written_among_60_sleepers_in_three_tabl
     // the ball has changes it in place (`Force`, `LinearDrag`, `Mass` and `CollisionLayers` on
     // balls `i % 3 == 2`),
     // one it lacks is inserted (the ball moves to a table of its own).
-    let writes: [(usize, Write); 19] = [
+    let writes: [(usize, Write); 21] = [
         (20, |e| e.get_mut::<Position>().unwrap().0.x += 0.1),
         (21, |e| {
             e.get_mut::<Rotation>().unwrap().0 = Quat::from_rotation_z(0.3)
@@ -420,6 +421,12 @@ fn each_of_19_writes_wakes_only_the_body_written_among_60_sleepers_in_three_tabl
         }),
         (53, |e| {
             e.remove::<CollisionLayers>();
+        }),
+        (37, |e| {
+            e.insert(Friction(0.1));
+        }),
+        (38, |e| {
+            e.insert(Restitution(0.9));
         }),
     ];
     for (i, &(ball, write)) in writes.iter().enumerate() {

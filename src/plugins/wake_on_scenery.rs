@@ -1,0 +1,72 @@
+//! Waking sleepers whose support changed. A sleeping body's own writes wake it
+//! (`wake_on_writes`); this wakes the sleepers touching a static body game code moved, turned,
+//! reshaped, stripped of its collider, made a sensor (or solid again), or gave new layers,
+//! friction or restitution, and a sleeper that lost its collider or became a sensor (its
+//! island wakes with it). Without it, a box asleep on a floor the game moved down by a metre
+//! hung in the air, as it did on a floor whose collider was removed or that became a sensor:
+//! the pair of a sleeper and a static body is dormant (`collision_messages`), never tested
+//! again until one of them wakes.
+//!
+//! The statics written to are found among the *unsettled* ones only (`settle`: a write takes a
+//! static's marker off before this runs), so a level of a million untouched statics costs no
+//! scan; the dormant pairs are read only in a step in which something changed.
+
+use crate::components::*;
+use crate::plugins::collision_messages::TouchingPairs;
+use crate::plugins::settle::Unsettled;
+use crate::plugins::sleep::Waker;
+use bevy_ecs::entity::EntityHashSet;
+use bevy_ecs::prelude::*;
+
+/// Statics game code wrote something to that a body resting on them feels.
+type SceneryWritten = (
+    With<Static>,
+    Unsettled,
+    Or<(
+        Changed<Position>,
+        Changed<Rotation>,
+        Changed<Collider>,
+        Changed<CollisionLayers>,
+        Changed<Friction>,
+        Changed<Restitution>,
+    )>,
+);
+
+/// Wakes the sleepers touching a changed static or a changed sleeper, and the changed
+/// sleepers themselves (module docs).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn wake_on_scenery_changes(
+    written: Query<Entity, SceneryWritten>,
+    made_sensors: Query<Entity, Added<Sensor>>,
+    (mut uncollided, mut unsensed): (RemovedComponents<Collider>, RemovedComponents<Sensor>),
+    touching: Option<Res<TouchingPairs>>,
+    mut sleepers: Query<&mut SleepState, With<Sleeping>>,
+    mut waker: Waker,
+    mut changed: Local<EntityHashSet>,
+) {
+    changed.clear();
+    changed.extend(written.iter().chain(made_sensors.iter()));
+    changed.extend(uncollided.read().chain(unsensed.read()));
+    if changed.is_empty() {
+        return;
+    }
+    let mut wake = |e: Entity, waker: &mut Waker| {
+        if let Ok(mut state) = sleepers.get_mut(e) {
+            waker.wake(e, Some(&mut state));
+        }
+    };
+    for &e in changed.iter() {
+        wake(e, &mut waker);
+    }
+    let Some(touching) = touching else {
+        return;
+    };
+    for &(a, b) in touching.dormant() {
+        if changed.contains(&a) {
+            wake(b, &mut waker);
+        }
+        if changed.contains(&b) {
+            wake(a, &mut waker);
+        }
+    }
+}
