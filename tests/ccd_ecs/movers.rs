@@ -349,3 +349,48 @@ fn balls_spawned_on_one_point_fly_apart_at_least_half_as_far_as_without_ccd() {
         );
     }
 }
+
+/// A ball of radius `r` at `speed` along x into an equal ball at rest, both of restitution `e`
+/// and no friction, the gap between them offset by `phase` of a step's travel: the two
+/// velocities along x and the two centres after 0.5 s.
+fn into_a_resting_ball(r: f32, speed: f32, e: f32, phase: f32) -> (f32, f32, f32, f32) {
+    let mut app = common::app();
+    app.insert_resource(Gravity::new(Vec3::ZERO).unwrap());
+    let ball = |x: f32, v: f32| {
+        (
+            Collider::sphere(r),
+            Position::new(x, 0.0, 0.0),
+            Velocity::new(v, 0.0, 0.0),
+            Restitution(e),
+            Friction(0.0),
+        )
+    };
+    let gap = (1.37 + phase) * speed / 60.0 + 0.3;
+    let cue = app.world_mut().spawn(ball(0.0, speed)).id();
+    let struck = app.world_mut().spawn(ball(2.0 * r + gap, 0.0)).id();
+    urto::step(app.world_mut(), 30).unwrap();
+    let (c, s) = (at(&app, cue).x, at(&app, struck).x);
+    (velocity(&app, cue).x, velocity(&app, struck).x, c, s)
+}
+
+/// Balls of 2.5 cm and 10 cm, and pool balls (5.7 cm, e = 0.95), at 12–400 m/s into an equal
+/// ball at rest hand it their speed as Newton's law of restitution says (`(1 − e) v / 2` and
+/// `(1 + e) v / 2`) within 1 % of `v`, and the struck ball stays ahead. The sweep of a fast
+/// ball against the ball it struck took that ball's motion in the step from its final
+/// velocity, not the solve's (it had moved at half the speed the bounce then gave it): it was
+/// put behind the cue ball, which passed through it, and the two leapfrogged each step.
+#[test]
+fn a_ball_at_12_to_400_m_s_into_an_equal_resting_one_hands_on_its_speed_within_1_percent() {
+    for (r, e) in [(0.025, 1.0), (0.1, 1.0), (0.0286, 0.95)] {
+        for speed in [12.0, 16.0, 40.0, 120.0, 400.0] {
+            for phase in [0.0, 0.3, 0.7] {
+                let (vc, vs, c, s) = into_a_resting_ball(r, speed, e, phase);
+                let case = format!("r {r}, e {e}, {speed} m/s, phase {phase}");
+                let (want_c, want_s) = ((1.0 - e) * speed / 2.0, (1.0 + e) * speed / 2.0);
+                assert!((vc - want_c).abs() < 0.01 * speed, "{case}: cue at {vc}");
+                assert!((vs - want_s).abs() < 0.01 * speed, "{case}: struck at {vs}");
+                assert!(s - c > 2.0 * r - 1e-3, "{case}: cue at {c}, struck at {s}");
+            }
+        }
+    }
+}

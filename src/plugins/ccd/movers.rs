@@ -33,6 +33,7 @@ use crate::components::*;
 use crate::geometry::Isometry;
 use crate::geometry::contacts::ContactScratch;
 use crate::plugins::joints::JointedPairs;
+use crate::plugins::soft_step::SoftStepSolver;
 use crate::settings::PhysicsTimestep;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
@@ -88,6 +89,7 @@ pub(super) fn gather_movers(
     bodies: Query<(Mover, Has<Sleeping>), AnyMovingRoot>,
     starts: Res<super::CcdScratch>,
     timestep: Res<PhysicsTimestep>,
+    solved: Option<Res<SoftStepSolver>>,
     mut table: ResMut<MoverTable>,
 ) {
     let t = &mut *table;
@@ -132,8 +134,16 @@ pub(super) fn gather_movers(
         else {
             continue;
         };
-        // A sleeper is held still; the others moved by their last velocity.
-        let displacement = if asleep { Vec3::ZERO } else { v.0 * dt };
+        // A sleeper is held still; the others moved as the rigid-body solver moved them (a
+        // ball struck in the step moved at half the speed the bounce then gave it: taken from
+        // its final velocity, it was put behind the ball that struck it, which then passed
+        // through it), or, after the lecture's response, by their last velocity.
+        let solved = solved.as_ref().and_then(|s| s.step_displacement(body));
+        let displacement = if asleep {
+            Vec3::ZERO
+        } else {
+            solved.unwrap_or(v.0 * dt)
+        };
         let swept = Aabb::from_points([center - displacement, center]).expanded(radius);
         // Most bodies are far from every fast one (a box with a NaN meets nothing either).
         if !swept.intersects(&reach) || t.fast_bodies.binary_search(&body).is_ok() {

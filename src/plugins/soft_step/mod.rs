@@ -121,6 +121,15 @@ pub struct SoftStepSolver {
 }
 
 impl SoftStepSolver {
+    /// How far body `e`'s centre of mass moved in the last step's solve (`None` for a body the
+    /// solver did not move: static, asleep, or not in the step). What continuous collision
+    /// sweeps a fast body against: the other body's real motion, which the solve may have
+    /// changed midway (a ball struck in the step, then bounced), not its final velocity's.
+    pub(crate) fn step_displacement(&self, e: Entity) -> Option<Vec3> {
+        let slot = self.slots.slot(e)?;
+        self.bodies.states.get(slot).map(|s| s.delta_position)
+    }
+
     /// Each joint of the last step with what it held over the last substep.
     pub fn joint_loads(&self) -> impl Iterator<Item = (Entity, HeldLoad)> + '_ {
         let h = self.solver.substep();
