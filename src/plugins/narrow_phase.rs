@@ -43,7 +43,7 @@ use crate::bvh::QueryStats;
 use crate::components::*;
 use crate::geometry::contacts::{
     ContactScratch, ManifoldCache, NO_TRIANGLE, RoundSide, contact_with_scratch,
-    speculative_contact_with_scratch,
+    speculative_contact_with_scratch, sphere_sphere_on_approach,
 };
 use crate::geometry::{ContactManifold, Shape};
 use crate::hierarchy::{BvTree, HierarchyStats, PairScratch, descend_pairs};
@@ -57,6 +57,7 @@ use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
 use bevy_ecs::entity::EntityHashMap;
 use bevy_ecs::prelude::*;
+use glam::Vec3;
 use std::time::Instant;
 
 mod leaves;
@@ -349,7 +350,9 @@ fn compute_contacts(
             if sensing(a, b) {
                 scratch.test_sensor((a, b), leaves, &mut overlaps);
             } else {
-                scratch.test_leaves((a, b), leaves, margin, &mut contacts, &mut debug);
+                let motion = lookahead.relative_motion(&fa.margin, &fb.margin);
+                let ahead = (margin, motion);
+                scratch.test_leaves((a, b), leaves, ahead, &mut contacts, &mut debug);
             }
             continue;
         }
@@ -389,7 +392,9 @@ fn compute_contacts(
                 scratch.test_sensor((a, b), leaves, &mut overlaps);
                 continue;
             }
-            scratch.test_leaves((a, b), leaves, margin, &mut contacts, &mut debug);
+            // A compound's parts also turn with it: no straight motion to meet along.
+            let ahead = (margin, Vec3::ZERO);
+            scratch.test_leaves((a, b), leaves, ahead, &mut contacts, &mut debug);
         }
     }
     scratch.bodies = bodies;
@@ -439,12 +444,13 @@ impl NarrowPhaseScratch {
     }
 
     /// Tests collider `leaves.0` (of body `roots.0`) against collider `leaves.1` (of `roots.1`)
-    /// at their world poses, looking `margin` ahead; a mesh goes through its BVH.
+    /// at their world poses, looking `margin` ahead, B moving by `motion` relative to A over
+    /// the step; a mesh goes through its BVH.
     fn test_leaves(
         &mut self,
         (a, b): (Entity, Entity),
         ((ea, ca), (eb, cb)): ((Entity, Leaf), (Entity, Leaf)),
-        margin: f32,
+        (margin, motion): (f32, Vec3),
         contacts: &mut Contacts,
         debug: &mut OverlappingLeaves,
     ) {
@@ -495,6 +501,16 @@ impl NarrowPhaseScratch {
                 m
             }
         };
+        // Two balls closing: the normal where they will meet, not where they are.
+        if let (Shape::Sphere(ra), Shape::Sphere(rb), Some(apart)) = (sa, sb, &m)
+            && apart.points().iter().all(|p| p.depth < 0.0)
+        {
+            let motion = if swap { -motion } else { motion };
+            let (ca, cb) = (pa.translation, pb.translation);
+            if let Some(meeting) = sphere_sphere_on_approach(ca, ra, cb, rb, motion) {
+                m = Some(meeting);
+            }
+        }
         if swap {
             scratch.flip_hits();
             m = m.map(ContactManifold::flipped);

@@ -97,7 +97,7 @@ pub use speculative::{
 };
 pub use sphere_cuboid::contact_sphere_cuboid;
 pub use sphere_halfspace::contact_sphere_halfspace;
-pub use sphere_sphere::contact_sphere_sphere;
+pub use sphere_sphere::{contact_sphere_sphere, sphere_sphere_on_approach};
 pub use triangle_capsule::contact_triangle_capsule;
 pub use triangle_cuboid::{contact_triangle_cuboid, contact_triangle_cuboid_with_edges};
 pub use triangle_distance::closest_points_triangle_triangle;

@@ -219,6 +219,14 @@ impl Lookahead {
         }
     }
 
+    /// How far B moves relative to A over the step as the solver would move them alone (their
+    /// velocities and gravity's pull, straight): where a speculative contact of two balls looks
+    /// for their meeting (`sphere_sphere_on_approach`).
+    pub fn relative_motion(&self, a: &BodyMotion, b: &BodyMotion) -> Vec3 {
+        let fall = 0.5 * self.euler * self.dt * self.dt;
+        (b.velocity - a.velocity) * self.dt + (b.pull - a.pull) * fall
+    }
+
     /// The margin a pair is tested with: both fixed distances, plus how far the two can close
     /// in a step by their relative velocity and pull and their turning; at most the sum of
     /// their own margins (which the broad phase grew their volumes by), to the bit.
