@@ -208,6 +208,12 @@ impl ContactManifold {
         )
     }
 
+    /// The same normal and depths, each point moved by `point`.
+    #[must_use]
+    pub(crate) fn with_points_moved(&self, point: impl Fn(Vec3) -> Vec3) -> Self {
+        self.mapped(|n| n, point)
+    }
+
     /// The normal and the points mapped, depths kept.
     fn mapped(&self, normal: impl Fn(Vec3) -> Vec3, point: impl Fn(Vec3) -> Vec3) -> Self {
         let mut out = Self::new(normal(self.normal));

@@ -107,12 +107,13 @@ fn a_cylinder_rolling_across_a_tessellated_floor_keeps_its_line_within_2_mm_per_
 }
 
 #[test]
-fn a_log_rolling_down_a_20_degree_tessellated_incline_stays_on_it_within_1_5_mm_at_two_thirds_g_sin_theta_within_1_percent()
+fn a_log_rolling_down_a_20_degree_tessellated_incline_stays_on_it_within_0_5_mm_at_two_thirds_g_sin_theta_within_1_percent()
  {
     // A 2 m log of radius 0.1 m, its flat ends over the grid's seams: the triangles beyond them,
     // touched side-on by its ends, read it from underneath (a level normal's sign), 199 mm deep,
-    // and it sank 14 mm into the incline as it rolled (a user-style probe). Left: it still dips
-    // by up to 1.2 mm for a few steps after crossing some seams parallel to it (measured; on a
+    // and it sank 14 mm into the incline as it rolled (a user-style probe). It then dipped by up
+    // to 1.2 mm for a few steps after crossing some seams parallel to it, until its mesh points
+    // were moved under its axis (`trimesh_convex::under_the_axis`): 0.23 mm now (on a
     // half-space 0.04 mm).
     let (theta, radius) = (20f32.to_radians(), 0.1);
     let tilt = Quat::from_rotation_y(-theta);
@@ -131,7 +132,7 @@ fn a_log_rolling_down_a_20_degree_tessellated_incline_stays_on_it_within_1_5_mm_
         let height = (scene.bodies[log].center - start).dot(normal);
         off_plane = off_plane.max(height.abs());
     }
-    assert!(off_plane < 1.5e-3, "{off_plane} m off the incline's plane");
+    assert!(off_plane < 5e-4, "{off_plane} m off the incline's plane");
     let downhill = -(tilt * Vec3::X);
     let travelled = (scene.bodies[log].center - start).dot(downhill);
     let expected = 0.5 * 9.81 * theta.sin() / 1.5 * 1.5 * 1.5;

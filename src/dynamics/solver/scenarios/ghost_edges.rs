@@ -99,3 +99,56 @@ fn a_box_sliding_at_10_m_s_with_friction_on_a_tessellated_floor_keeps_its_height
     assert!((rest - plane_rest).abs() < 1e-6, "{context}");
     assert!(rose < 5e-6 && sank < 5e-6, "{context}");
 }
+
+/// A cylinder (radius 0.3 m, 0.8 m long, 1 kg, friction `mu`) lying on `floor`, its axis turned
+/// `yaw` from the y axis, launched across it at `speed` (rolling already when `rolling`): how
+/// far its centre rose above and sank below its radius over 2 s, and its final speed.
+fn roll_across(floor: Shape, yaw: f32, (speed, rolling): (f32, bool), mu: f32) -> (f32, f32, f32) {
+    let mut scene = Scene::default();
+    let f = scene.add(floor, Vec3::ZERO, Quat::IDENTITY, 0.0);
+    let lying = Quat::from_rotation_z(yaw) * Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
+    let dir = Quat::from_rotation_z(yaw) * Vec3::X;
+    let c = scene.add(
+        Shape::cylinder(0.4, 0.3),
+        Vec3::new(-5.0, 0.1, 0.3),
+        lying,
+        1.0,
+    );
+    for body in [f, c] {
+        scene.bodies[body].friction = mu;
+    }
+    scene.bodies[c].v = dir * speed;
+    if rolling {
+        scene.bodies[c].w = Vec3::Z.cross(dir * speed) / 0.3;
+    }
+    let (mut rose, mut sank) = (0.0f32, 0.0f32);
+    for _ in 0..120 {
+        scene.step();
+        let dz = scene.bodies[c].center.z - 0.3;
+        (rose, sank) = (rose.max(dz), sank.max(-dz));
+    }
+    (rose, sank, scene.bodies[c].v.length())
+}
+
+#[test]
+fn a_cylinder_rolling_across_a_tessellated_floor_at_any_angle_stays_within_0_2_mm_of_its_height() {
+    // Before its mesh points were moved under its axis (`trimesh_convex::under_the_axis`), a
+    // point from a triangle beyond a seam, ahead of the line it rolls on, read as sinking as it
+    // turned: across the grid's lines at 0.3 rad it hopped 3.5 mm and lost 2 % of its speed;
+    // launched sliding at 5 m/s, 2.6 mm.
+    let grid =
+        || Shape::TriMesh(MeshCollider::new(TriMesh::grid_floor(40.0, 80).unwrap()).unwrap());
+    for yaw in [0.0, 0.3, 0.7] {
+        for (launch, mu) in [((3.0, true), 1.0), ((5.0, false), 0.1)] {
+            let (rose, sank, speed) = roll_across(grid(), yaw, launch, mu);
+            let plane = roll_across(Shape::half_space(Vec3::Z), yaw, launch, mu);
+            let case = format!(
+                "yaw {yaw}, launched {launch:?}: rose {rose}, sank {sank}, {speed} m/s; half-space {plane:?}"
+            );
+            assert!(rose < 2e-4 && sank < 2e-4, "{case}");
+            // Rolling, it keeps its speed; sliding, it ends rolling at v / (1 + 1/2).
+            let expected = if launch.1 { launch.0 } else { launch.0 / 1.5 };
+            assert!((speed / expected - 1.0).abs() < 5e-3, "{case}");
+        }
+    }
+}
