@@ -5,9 +5,9 @@ use super::*;
 
 const PATCH: FrictionModel = FrictionModel::Patch;
 
-/// The angular speed of a unit cube (half-size 0.5 m, 1 kg) spun at `spin` rad/s about the
-/// vertical on the ground after `seconds`, with friction `mu` and `model`.
-fn spun_box(model: FrictionModel, mu: f32, spin: f32, seconds: f32) -> f32 {
+/// A unit cube (half-size 0.5 m, 1 kg) on the ground, both with friction `mu`, solved with
+/// `model`: the scene, the ground and the cube.
+fn cube_on_the_ground(model: FrictionModel, mu: f32) -> (Scene, usize, usize) {
     let mut scene = Scene::default();
     scene.solver.settings.friction = model;
     let ground = scene.ground(Vec3::Z);
@@ -20,6 +20,13 @@ fn spun_box(model: FrictionModel, mu: f32, spin: f32, seconds: f32) -> f32 {
     for body in [ground, b] {
         scene.bodies[body].friction = mu;
     }
+    (scene, ground, b)
+}
+
+/// The angular speed of a unit cube spun at `spin` rad/s about the vertical on the ground after
+/// `seconds`, with friction `mu` and `model`.
+fn spun_box(model: FrictionModel, mu: f32, spin: f32, seconds: f32) -> f32 {
+    let (mut scene, _, b) = cube_on_the_ground(model, mu);
     scene.run(0.5);
     scene.bodies[b].w = Vec3::new(0.0, 0.0, spin);
     scene.run(seconds);
@@ -132,17 +139,7 @@ fn a_box_sliding_at_5_to_20_m_s_slows_at_mu_g_within_0_1_percent_per_point_and_p
 /// A unit cube sliding at 5 m/s on the ground with friction 0.5 for 0.2 s, then with its
 /// friction (and the ground's) set to 0: its speed 1 s later, with `model`.
 fn slide_then_lose_friction(model: FrictionModel) -> (f32, f32) {
-    let mut scene = Scene::default();
-    scene.solver.settings.friction = model;
-    let ground = scene.ground(Vec3::Z);
-    let b = scene.add(
-        Shape::cuboid(Vec3::splat(0.5)),
-        Vec3::new(0.0, 0.0, 0.5),
-        Quat::IDENTITY,
-        1.0,
-    );
-    scene.bodies[ground].friction = 0.5;
-    scene.bodies[b].friction = 0.5;
+    let (mut scene, ground, b) = cube_on_the_ground(model, 0.5);
     scene.run(0.2);
     scene.bodies[b].v = Vec3::new(5.0, 0.0, 0.0);
     scene.run(0.2);

@@ -70,24 +70,21 @@ fn slide_along_a_fixed_rail(
     (b.center, b.orientation.angle_between(Quat::IDENTITY))
 }
 
+/// Asserts that a block the slider carried ended at `x` along the rail within `within`, on the
+/// rail within 1 mm and turned by under 1 mrad (`(at, turned)` as the slide left it).
+fn on_the_rail_at(case: &str, (at, turned): (Vec3, f32), x: f32, within: f32) {
+    assert!((at.x - x).abs() < within, "{case}: at {at}");
+    let off = Vec3::new(0.0, at.y, at.z).length();
+    assert!(off < 1e-3, "{case}: {off} m off the rail");
+    assert!(turned < 1e-3, "{case}: turned {turned} rad");
+}
+
 #[test]
 fn a_block_sliding_6_m_along_a_fixed_rail_stays_on_it_within_1_mm_whichever_end_it_is() {
     for block_first in [false, true] {
-        let (at, turned) = slide_along_a_fixed_rail(block_first, None, 3.0);
+        let end = slide_along_a_fixed_rail(block_first, None, 3.0);
         // Nothing along the rail resists: 2 m/s for 3 s.
-        assert!(
-            (at.x - 6.0).abs() < 0.01,
-            "block first {block_first}: at {at}"
-        );
-        let off = Vec3::new(0.0, at.y, at.z).length();
-        assert!(
-            off < 1e-3,
-            "block first {block_first}: {off} m off the rail"
-        );
-        assert!(
-            turned < 1e-3,
-            "block first {block_first}: turned {turned} rad"
-        );
+        on_the_rail_at(&format!("block first {block_first}"), end, 6.0, 0.01);
     }
 }
 
@@ -95,22 +92,8 @@ fn a_block_sliding_6_m_along_a_fixed_rail_stays_on_it_within_1_mm_whichever_end_
 fn a_slider_limit_stops_the_block_at_the_same_place_within_1_cm_whichever_end_it_is() {
     // The travel is B's anchor from A's along the axis: +x of the block when the base is A,
     // −x when the block is A. A bound of 1 m on the travel ahead stops it 1 m out either way.
-    for (block_first, bound) in [(false, (-5.0, 1.0)), (true, (-1.0, 5.0))] {
-        let (min, max) = bound;
-        let (at, turned) =
-            slide_along_a_fixed_rail(block_first, Some(JointLimit { min, max }), 2.0);
-        assert!(
-            (at.x - 1.0).abs() < 0.01,
-            "block first {block_first}: stopped at {at}"
-        );
-        let off = Vec3::new(0.0, at.y, at.z).length();
-        assert!(
-            off < 1e-3,
-            "block first {block_first}: {off} m off the rail"
-        );
-        assert!(
-            turned < 1e-3,
-            "block first {block_first}: turned {turned} rad"
-        );
+    for (block_first, (min, max)) in [(false, (-5.0, 1.0)), (true, (-1.0, 5.0))] {
+        let end = slide_along_a_fixed_rail(block_first, Some(JointLimit { min, max }), 2.0);
+        on_the_rail_at(&format!("block first {block_first}"), end, 1.0, 0.01);
     }
 }
