@@ -45,7 +45,7 @@ use crate::geometry::contacts::{
     ContactScratch, ManifoldCache, NO_TRIANGLE, RoundSide, contact_with_scratch,
     speculative_contact_with_scratch, sphere_sphere_on_approach,
 };
-use crate::geometry::{ContactManifold, Shape};
+use crate::geometry::{ContactManifold, Isometry, Shape};
 use crate::hierarchy::{BvTree, HierarchyStats, PairScratch, descend_pairs};
 use crate::plugins::broad_phase::BroadPhasePairs;
 use crate::plugins::joints::JointedPairs;
@@ -475,8 +475,14 @@ impl NarrowPhaseScratch {
             None
         };
         let scratch = &mut self.contact;
-        let mut m = match cached {
-            Some(m) => {
+        let closing = if swap { -motion } else { motion };
+        let meeting = balls_meeting((sa, pa), (sb, pb), margin, closing);
+        let mut m = match (meeting, cached) {
+            (Some(meeting), _) => {
+                scratch.begin_query(); // no triangle pairs: a ball pair's hits are none
+                Some(meeting)
+            }
+            (None, Some(m)) => {
                 // The stored triangle pairs are kept only while recording: no second lookup
                 // otherwise (most cached pairs are plain convex ones, with none).
                 let hits = if debug.enabled {
@@ -487,7 +493,7 @@ impl NarrowPhaseScratch {
                 scratch.set_hits(hits);
                 m
             }
-            None => {
+            (None, None) => {
                 let m = if margin > 0.0 {
                     speculative_contact_with_scratch(sa, pa, sb, pb, margin, scratch)
                 } else {
@@ -501,16 +507,6 @@ impl NarrowPhaseScratch {
                 m
             }
         };
-        // Two balls closing: the normal where they will meet, not where they are.
-        if let (Shape::Sphere(ra), Shape::Sphere(rb), Some(apart)) = (sa, sb, &m)
-            && apart.points().iter().all(|p| p.depth < 0.0)
-        {
-            let motion = if swap { -motion } else { motion };
-            let (ca, cb) = (pa.translation, pb.translation);
-            if let Some(meeting) = sphere_sphere_on_approach(ca, ra, cb, rb, motion) {
-                m = Some(meeting);
-            }
-        }
         if swap {
             scratch.flip_hits();
             m = m.map(ContactManifold::flipped);
@@ -536,6 +532,27 @@ impl NarrowPhaseScratch {
             }
         }
     }
+}
+
+/// Two balls within `margin` of each other and closing, B moving by `motion` relative to A:
+/// their contact where they will meet, not where they are (`sphere_sphere_on_approach`);
+/// `None` for any other pair, and for balls that do not meet that soon (their closest
+/// points' contact stands).
+fn balls_meeting(
+    (sa, pa): (&Shape, &Isometry),
+    (sb, pb): (&Shape, &Isometry),
+    margin: f32,
+    motion: Vec3,
+) -> Option<ContactManifold> {
+    let (Shape::Sphere(ra), Shape::Sphere(rb)) = (sa, sb) else {
+        return None;
+    };
+    let (ca, cb) = (pa.translation, pb.translation);
+    let reach = ra.radius + rb.radius + margin;
+    if !(margin > 0.0 && (cb - ca).length_squared() <= reach * reach) {
+        return None;
+    }
+    sphere_sphere_on_approach(ca, ra, cb, rb, motion)
 }
 
 fn is_mesh(shape: &Shape) -> bool {

@@ -145,14 +145,13 @@ impl<'a> NormalPass<'a> {
     ) -> Lanes {
         let zero = Lanes::ZERO;
         let [bias_rate, soft_mass, soft_impulse] = self.softness;
-        let [na, nb] = self.turned;
         let (n, settled) = (self.batch.normal, Lanes::splat(SETTLED_SPEED));
         let mut unsettled = zero.simd_ne(zero);
         let count = points.len();
         for k in 0..count {
             let i = if backwards { count - 1 - k } else { k };
             let p = &mut points[i];
-            let s = p.base_separation + self.moved + p.anchor_b.dot(nb) - p.anchor_a.dot(na);
+            let s = self.separation(p);
             let apart = s.simd_gt(zero);
             let push_out = if self.use_bias {
                 (bias_rate * s).max(self.most_push)
@@ -193,16 +192,23 @@ impl<'a> NormalPass<'a> {
         unsettled
     }
 
+    /// The current separation of point `p` in each lane (`ContactConstraint::separation`'s,
+    /// four at a time).
+    #[inline(always)]
+    fn separation(&self, p: &PointX4) -> Lanes {
+        let [na, nb] = self.turned;
+        p.base_separation + self.moved + p.anchor_b.dot(nb) - p.anchor_a.dot(na)
+    }
+
     /// The impact speeds of all the points of the `lanes` whose contact first pushes in the
     /// step, read from the velocities `before` the pass (`contact_normals.rs`, "One moment per
     /// impact"; the scalar `time_impact`).
     #[cold]
     #[inline(never)]
     fn time_impacts(&self, points: &mut [PointX4], before: &PairVelocities, lanes: Lanes) {
-        let [na, nb] = self.turned;
         let n = self.batch.normal;
         for q in points {
-            let s = q.base_separation + self.moved + q.anchor_b.dot(nb) - q.anchor_a.dot(na);
+            let s = self.separation(q);
             let vn = before.along(n, &q.row(&q.normal_row, n));
             let speed = impact_speed(vn, s, self.batch.closing_acceleration);
             q.relative_velocity = lanes.select(speed, q.relative_velocity);

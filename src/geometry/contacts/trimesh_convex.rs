@@ -21,6 +21,7 @@
 //!
 //! The triangle contacts are merged into one manifold as `mesh_manifold.rs` explains.
 
+use super::closest_segment_points::closest_point_on_segment;
 use super::convex_convex::manifold;
 use super::mesh_scratch::ContactScratch;
 use super::trimesh_cuboid::carried_box;
@@ -75,10 +76,11 @@ fn under_the_axis(m: ContactManifold, shape: &Shape, pose: &Isometry) -> Contact
     if shape.rounding_along(pose.rotation, m.normal) == 0.0 {
         return m;
     }
-    let (axis, n) = (pose.rotation * Vec3::Z, m.normal);
+    let half = pose.rotation * Vec3::Z * c.half_height;
+    let (bottom, top) = (pose.translation - half, pose.translation + half);
+    let n = m.normal;
     m.with_points_moved(|p| {
-        let along = (p - pose.translation).dot(axis);
-        let core = pose.translation + axis * along.clamp(-c.half_height, c.half_height);
+        let core = closest_point_on_segment(bottom, top, p);
         core + n * (p - core).dot(n)
     })
 }
