@@ -120,18 +120,22 @@ fn pick(
 }
 
 /// The deepest point; among points as deep within [`DEPTH_TIE`] (a face resting flat, whose
-/// depths differ by rounding), the one farthest from the points' mean, a corner of the
-/// polygon. By depth alone, rounding picked the first, which on a tessellated floor could be
-/// where a seam crosses the box's side: the manifold then kept that point instead of the corner
-/// beside it, and took other points each step as the box slid.
+/// depths differ by rounding), the one farthest from the points' mean, a corner of the polygon.
+/// By depth alone, rounding picked the first, which on a tessellated floor could be where a
+/// seam crosses the box's side: the manifold then kept that point instead of the corner beside
+/// it, and took other points each step as the box slid. A regular polygon within 1 mrad of
+/// flat ([`round_and_flat`]) starts from a corner that stays put instead.
 pub(crate) fn deepest_corner(points: &[ContactPoint]) -> Option<usize> {
     let deepest = argmax(points, |p| p.depth)?;
+    if let Some(corner) = round_and_flat(points, points[deepest].depth) {
+        return Some(corner);
+    }
     let floor = points[deepest].depth - DEPTH_TIE;
     let tied = points.iter().filter(|p| p.depth >= floor).count();
     if tied < 3 {
         return Some(deepest);
     }
-    let mean = points.iter().map(|p| p.point).sum::<Vec3>() / points.len() as f32;
+    let mean = mean_point(points);
     let spread = |p: &ContactPoint| {
         if p.depth >= floor {
             (p.point - mean).length_squared()
@@ -142,9 +146,56 @@ pub(crate) fn deepest_corner(points: &[ContactPoint]) -> Option<usize> {
     argmax(points, spread).or(Some(deepest))
 }
 
+/// For a polygon of five or more corners all as far from their mean (within [`SPREAD_TIE`]:
+/// a cylinder's or cone's cap) and all within [`FLAT_SLOPE`] of its radius of the deepest
+/// `depth`: the corner of the lowest feature number (then the lowest index). Else `None`.
+///
+/// A cone's base rocking by 0.07 mrad on a 30° slope had its deepest corner pass from one to
+/// its neighbour, and the manifold switch between the corners at 0°, 90°, 180° and 270° and
+/// those at 45°, 135°, …: each switch lost the friction impulses' warm start, and it crept
+/// 84 mm in 10 s. The lowest number is no ranking, only a choice that stays put while the
+/// corners do (a cap met square on numbers its corners, `support.rs`; a cap tilted by more,
+/// whose corners turn with the tilt, is never this flat).
+fn round_and_flat(points: &[ContactPoint], depth: f32) -> Option<usize> {
+    if points.len() < 5 {
+        return None;
+    }
+    let mean = mean_point(points);
+    let spread = |p: &ContactPoint| (p.point - mean).length_squared();
+    let (near, far) = points
+        .iter()
+        .map(spread)
+        .fold((f32::INFINITY, 0.0f32), |(lo, hi), s| {
+            (lo.min(s), hi.max(s))
+        });
+    let flat = depth - FLAT_SLOPE * far.sqrt();
+    let round = near >= far * (1.0 - SPREAD_TIE) && far > 0.0;
+    let corner = points
+        .iter()
+        .enumerate()
+        .min_by_key(|&(i, p)| (p.feature.0, i))
+        .map(|(i, _)| i);
+    corner.filter(|_| round && points.iter().all(|p| p.depth >= flat))
+}
+
+/// The mean of the points' positions.
+fn mean_point(points: &[ContactPoint]) -> Vec3 {
+    points.iter().map(|p| p.point).sum::<Vec3>() / points.len() as f32
+}
+
 /// Depths this close to the deepest tie with it (m): rounding on a flat contact, far below
 /// any tilt a solver resolves.
 const DEPTH_TIE: f32 = 1e-6;
+
+/// A regular polygon whose depths all lie within this fraction of its radius of the deepest
+/// (tilted by less than 1 mrad) reads as flat, as a cylinder's cap met square on does
+/// (`support.rs`): the corner it starts from is then at most `FLAT_SLOPE` of the radius
+/// shallower than the deepest.
+const FLAT_SLOPE: f32 = 1e-3;
+
+/// Squared distances from the mean within this fraction of each other: the corners of a
+/// regular polygon, equal but for rounding.
+const SPREAD_TIE: f32 = 1e-4;
 
 /// Index of the first point maximising `key` (NaN keys never win), or `None` when empty or
 /// every key is NaN.
@@ -162,6 +213,7 @@ fn argmax(points: &[ContactPoint], key: impl Fn(&ContactPoint) -> f32) -> Option
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::FeatureId;
 
     fn at(x: f32, y: f32, depth: f32) -> ContactPoint {
         ContactPoint::new(Vec3::new(x, y, 0.0), depth)
@@ -249,5 +301,40 @@ mod tests {
             at(0.0, 1.0, -0.03),
         ];
         assert_eq!(spread_points(&corner, Vec3::Z).1, 3);
+    }
+
+    #[test]
+    fn a_cap_tilted_under_1_mrad_keeps_the_same_four_corners_whichever_way_it_rocks() {
+        // A cap of radius 0.5, its eight corners named 101..108 as a cap met square on
+        // names them, tilted by 0.07 mrad towards each corner in turn.
+        let cap = |tilt: f32, towards: f32| -> Vec<ContactPoint> {
+            (0..8)
+                .map(|k| {
+                    let a = k as f32 * std::f32::consts::FRAC_PI_4;
+                    let depth = 1e-4 + 0.5 * tilt * (a - towards).cos();
+                    let p = at(0.5 * a.cos(), 0.5 * a.sin(), depth);
+                    p.with_feature(FeatureId(101 + k))
+                })
+                .collect()
+        };
+        let kept = |points: &[ContactPoint]| {
+            let (idx, n) = spread_points(points, Vec3::Z);
+            let mut ids: Vec<u32> = idx[..n].iter().map(|&i| points[i].feature.0).collect();
+            ids.sort_unstable();
+            ids
+        };
+        let square = kept(&cap(0.0, 0.0));
+        assert_eq!(square.len(), 4);
+        for k in 0..8 {
+            let towards = k as f32 * std::f32::consts::FRAC_PI_4 + 0.1;
+            assert_eq!(
+                kept(&cap(7e-5, towards)),
+                square,
+                "rocking towards corner {k}"
+            );
+        }
+        // Tilted by 5 mrad it is not flat: the deepest corner comes first.
+        let tilted = cap(5e-3, 3.0 * std::f32::consts::FRAC_PI_4);
+        assert_eq!(spread_points(&tilted, Vec3::Z).0[0], 3);
     }
 }
