@@ -139,6 +139,56 @@ fn a_body_weighs_its_volume_by_default_a_given_mass_wins_and_removing_it_restore
     assert!(close(mass(&app, boulder) / mass(&app, pebble), 8000.0));
 }
 
+#[test]
+fn removing_a_collider_from_a_part_or_the_body_reweighs_it_within_1e_5() {
+    // A probe found the mass, centre of mass and inertia kept from before the removal.
+    use bevy_ecs::hierarchy::ChildOf;
+    use std::f32::consts::PI;
+    let mut app = common::app();
+    let world = app.world_mut();
+    let root = world
+        .spawn((
+            Collider::cuboid(0.5, 0.5, 0.5),
+            Position::new(0.0, 0.0, 5.0),
+            Velocity::default(),
+            Density(2.0),
+        ))
+        .id();
+    let part = world
+        .spawn((
+            Collider::sphere(0.25),
+            Position::new(1.0, 0.0, 0.0),
+            ChildOf(root),
+        ))
+        .id();
+    urto::step(app.world_mut(), 1).unwrap();
+    let mass = |app: &App| get::<ComputedMass>(app, root).value();
+    let close = |a: f32, b: f32| (a - b).abs() <= 1e-5 * b.abs().max(1.0);
+    let ball = 2.0 * 4.0 / 3.0 * PI * 0.25f32.powi(3);
+    assert!(close(mass(&app), 2.0 + ball), "{}", mass(&app));
+    app.world_mut().entity_mut(part).remove::<Collider>();
+    urto::step(app.world_mut(), 1).unwrap();
+    let inertia: Inertia = get(&app, root);
+    assert!(close(mass(&app), 2.0), "{}", mass(&app));
+    assert!(close(inertia.local_center_of_mass.length(), 0.0));
+    // A cube of 2 kg and side 1: m (1 + 1) / 12 about each axis.
+    assert!(close(inertia.principal.x, 2.0 / 6.0), "{inertia:?}");
+    // Put back on the part, taken off the body: the ball alone, its centre 1 m out.
+    app.world_mut()
+        .entity_mut(part)
+        .insert(Collider::sphere(0.25));
+    app.world_mut().entity_mut(root).remove::<Collider>();
+    urto::step(app.world_mut(), 1).unwrap();
+    let inertia: Inertia = get(&app, root);
+    assert!(close(mass(&app), ball), "{}", mass(&app));
+    assert!(close(inertia.local_center_of_mass.x, 1.0), "{inertia:?}");
+    // Without any collider: the default mass, and nothing to turn (infinite inertia).
+    app.world_mut().entity_mut(part).remove::<Collider>();
+    urto::step(app.world_mut(), 1).unwrap();
+    assert_eq!(mass(&app), 1.0);
+    assert!(get::<Inertia>(&app, root).principal.x.is_infinite());
+}
+
 /// A ball of radius 0.5 and `mass` kg (I = 0.1 m kg m²) at `at`.
 fn ball(app: &mut App, at: Vec3, mass: f32) -> Entity {
     let body = (Collider::sphere(0.5), Position(at), Velocity::default());

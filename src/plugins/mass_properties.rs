@@ -94,7 +94,8 @@ type PartData<'a> = (
 );
 
 /// Recomputes the computed mass and inertia of bodies whose collider, mass, density or parts
-/// changed (or whose [`Mass`], [`Density`] or [`Quarantined`] marker was removed).
+/// changed (or whose [`Collider`], [`Mass`], [`Density`] or [`Quarantined`] marker was removed,
+/// from the body or from a part).
 #[allow(clippy::too_many_arguments)]
 fn compute_mass_properties(
     mut root_queries: ParamSet<(ChangedRoots, Roots)>,
@@ -102,6 +103,7 @@ fn compute_mass_properties(
     mut unset_mass: RemovedComponents<Mass>,
     mut unset_density: RemovedComponents<Density>,
     mut released: RemovedComponents<Quarantined>,
+    mut stripped: RemovedComponents<Collider>,
     parents: Query<&ChildOf>,
     parts: Query<PartData>,
     mut buffers: ResMut<MassBuffers>,
@@ -113,9 +115,11 @@ fn compute_mass_properties(
     // A body let out of quarantine may have been fixed while it was left out.
     let unset = unset_mass.read().chain(unset_density.read());
     b.dirty.extend(unset.chain(released.read()));
-    if !changed_parts.is_empty() {
+    // A collider removed from a body or a part changes its root's mass (a despawned part's
+    // parent sees its `Children` change; a despawned body needs nothing).
+    if !changed_parts.is_empty() || !stripped.is_empty() {
         b.roots.clear();
-        for part in &changed_parts {
+        for part in changed_parts.iter().chain(stripped.read()) {
             let root = root_of(part, &parents, &mut b.roots, &mut b.path);
             b.dirty.push(root);
         }
