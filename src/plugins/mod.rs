@@ -37,6 +37,7 @@ mod step_app;
 mod table_ticks;
 pub mod transform_sync;
 pub mod validation;
+mod wake_on_joints;
 mod wake_on_scenery;
 mod wake_on_writes;
 

@@ -24,9 +24,13 @@
 //! when a contact of it ends (a body it touched moved away or disappeared), when a static body
 //! it touches is moved, turned, reshaped, stripped of its collider, made a sensor or given new
 //! layers, friction or restitution, or when it loses its collider or becomes a sensor
-//! (`wake_on_scenery`); its whole island wakes with it (members are kept per
-//! island in [`SleepingIslands`], as Box2D v3's `island.c` keeps them), before the next step
-//! simulates anything.
+//! (`wake_on_scenery`), when a joint of it is added, written to, disabled, removed or loses a
+//! body, or the static it hangs from is moved or loses its collider (`wake_on_joints`); its
+//! whole island wakes with it (members are kept per island in [`SleepingIslands`], as Box2D
+//! v3's `island.c` keeps them), before the next step simulates anything. The same changes made
+//! to an awake body count its stillness from zero, so that it cannot fall asleep on the step
+//! they are made; and an island pulled by gravity that touches nothing holding it never sleeps
+//! ([`crate::dynamics::islands`]).
 
 use crate::components::*;
 use crate::dynamics::islands::{IslandBuilder, Stillness, islands_to_sleep};
@@ -35,10 +39,11 @@ use crate::plugins::core::PrepareWake;
 use crate::plugins::joints::ActiveJoint;
 use crate::plugins::narrow_phase::Contacts;
 use crate::plugins::required_resources::RequireResource;
+use crate::plugins::wake_on_joints::wake_on_joint_changes;
 use crate::plugins::wake_on_scenery::wake_on_scenery_changes;
 use crate::plugins::wake_on_writes::wake_on_game_changes;
 use crate::schedule::{PhysicsSchedule, PhysicsSet};
-use crate::settings::{PhysicsTimestep, SleepSettings};
+use crate::settings::{Gravity, PhysicsTimestep, SleepSettings};
 use crate::stats::PhysicsStats;
 use bevy_app::prelude::*;
 use bevy_ecs::entity::EntityHashMap;
@@ -60,6 +65,7 @@ impl Plugin for SleepPlugin {
                 (
                     wake_on_game_changes,
                     wake_on_scenery_changes,
+                    wake_on_joint_changes,
                     wake_the_sleepless,
                     wake_islands,
                 )
@@ -212,6 +218,7 @@ type Candidate<'a> = (
     &'a ComputedMass,
     Option<&'a mut AngularVelocity>,
     &'a BoundingVolume,
+    (Option<&'a GravityScale>, Option<&'a LockedAxes>),
 );
 type CandidateFilter = (
     Without<Sleeping>,
@@ -221,6 +228,24 @@ type CandidateFilter = (
     Without<Spring>,
     Without<SleepingDisabled>,
 );
+
+/// Awake bodies whose make-up game code wrote to since the last step: what wakes a sleeper
+/// (`wake_on_writes`' `MadeOf`) counts their stillness from zero, so that a write on the step a
+/// body would fall asleep is not slept through (a box given a gravity scale of −1 then stayed
+/// on its floor, asleep). Read only for bodies still long enough to sleep.
+type Remade = Or<(
+    Changed<GravityScale>,
+    Changed<Mass>,
+    Changed<Density>,
+    Changed<LockedAxes>,
+    Changed<Collider>,
+    Changed<CollisionLayers>,
+    Changed<LinearDrag>,
+    Changed<AngularDrag>,
+    Changed<Friction>,
+    Changed<Restitution>,
+    Added<Sensor>,
+)>;
 
 /// Bodies that never sleep and keep what they touch awake: bodies on springs (their pull is not
 /// in the contacts the islands are built from) and bodies with [`SleepingDisabled`].
@@ -260,17 +285,29 @@ fn fall_asleep(
     mut bodies: Query<Candidate, CandidateFilter>,
     sleepers: Query<&SleepState, With<Sleeping>>,
     never_sleep: Query<(), NeverSleeps>,
+    remade: Query<(), Remade>,
     contacts: Option<Res<Contacts>>,
     joints: Query<&Joint, ActiveJoint>,
     settings: Res<SleepSettings>,
     timestep: Res<PhysicsTimestep>,
+    gravity: Option<Res<Gravity>>,
     mut islands: ResMut<SleepingIslands>,
     mut scratch: Local<IslandScratch>,
     mut stats: ResMut<PhysicsStats>,
     mut commands: Commands,
 ) {
     let s = &mut *scratch;
-    count_stillness(&mut bodies, &settings, timestep.dt(), s);
+    let gravity = gravity.map_or(Vec3::ZERO, |g| g.acceleration());
+    count_stillness(&mut bodies, &settings, (timestep.dt(), gravity), s);
+    for (i, &e) in s.awake.iter().enumerate() {
+        let state = &mut s.stillness[i];
+        if state.still_for >= settings.time && remade.contains(e) {
+            state.still_for = 0.0;
+            if let Ok((_, mut sleep, ..)) = bodies.get_mut(e) {
+                sleep.restart();
+            }
+        }
+    }
     stats.set_counter("sleep/awake_bodies", s.awake.len() as f64);
     stats.set_counter("sleep/sleeping_islands", islands.members.len() as f64);
     if !s.stillness.iter().any(|b| b.still_for >= settings.time) {
@@ -289,11 +326,14 @@ fn fall_asleep(
             link_contact(s, (pair.b, pair.a), &sleepers, &never_sleep);
         }
     }
-    // Jointed bodies are one island: they fall asleep and wake together.
+    // Jointed bodies are one island: they fall asleep and wake together. A joint to the
+    // world holds its body.
     for joint in &joints {
         if let Some(b) = joint.body_b_entity() {
             link_contact(s, (joint.body_a, b), &sleepers, &never_sleep);
             link_contact(s, (b, joint.body_a), &sleepers, &never_sleep);
+        } else if let Some(&Slot::Awake(i)) = s.slots.get(&joint.body_a) {
+            s.stillness[i].held = true;
         }
     }
     islands_to_sleep(&mut s.islands, &s.stillness, settings.time, &mut s.asleep);
@@ -303,7 +343,7 @@ fn fall_asleep(
             continue;
         }
         let key = s.keys[s.islands.root(i)];
-        if let Ok((_, mut sleep, (p, r), mut v, _, mut w, _)) = bodies.get_mut(e) {
+        if let Ok((_, mut sleep, (p, r), mut v, _, mut w, ..)) = bodies.get_mut(e) {
             sleep.at = p.0;
             sleep.orientation = r.0;
             sleep.island = key;
@@ -331,18 +371,18 @@ fn index_slots(s: &mut IslandScratch) {
 
 /// Lists the awake dynamic bodies with their stillness (counting it on, [`StillTest`]: within
 /// `speed × time` of where the body's current window began, never faster than four times the
-/// speed), and the kinematic ones.
+/// speed) and whether `gravity` pulls them, and the kinematic ones.
 fn count_stillness(
     bodies: &mut Query<Candidate, CandidateFilter>,
     settings: &SleepSettings,
-    dt: f32,
+    (dt, gravity): (f32, Vec3),
     s: &mut IslandScratch,
 ) {
     s.awake.clear();
     s.kinematic.clear();
     s.stillness.clear();
     let test = StillTest::new(settings.speed, settings.time);
-    for (e, mut sleep, (p, r), v, m, w, volume) in bodies.iter_mut() {
+    for (e, mut sleep, (p, r), v, m, w, volume, (scale, locks)) in bodies.iter_mut() {
         let spin = w.as_ref().map_or(0.0, |w| w.0.length());
         if m.inverse() == 0.0 {
             let moving = v.0 != Vec3::ZERO || spin != 0.0;
@@ -365,15 +405,19 @@ fn count_stillness(
         }
         sleep.set_if_neq(next);
         s.awake.push(e);
+        let pull =
+            gravity * scale.map_or(1.0, |g| g.0) * LockedAxes::of(locks).free_translation_axes();
         s.stillness.push(Stillness {
             still_for,
-            restless: false,
+            pulled: pull != Vec3::ZERO,
+            ..Stillness::default()
         });
     }
 }
 
 /// The contact of `body` with `other`, seen from `body`'s side: links two awake bodies, joins a
-/// sleeping island, or makes `body` restless next to a body that never sleeps.
+/// sleeping island, or makes `body` restless next to a body that never sleeps; a static,
+/// kinematic or sleeping `other` holds `body`.
 fn link_contact(
     s: &mut IslandScratch,
     (body, other): (Entity, Entity),
@@ -385,14 +429,21 @@ fn link_contact(
     };
     match s.slots.get(&other) {
         Some(&Slot::Awake(j)) => s.islands.link(i, j),
-        Some(&Slot::Kinematic { moving }) => s.stillness[i].restless |= moving,
+        Some(&Slot::Kinematic { moving }) => {
+            s.stillness[i].restless |= moving;
+            s.stillness[i].held = true;
+        }
         None => {
             if let Ok(sleep) = sleepers.get(other) {
                 if sleep.island != 0 {
                     s.joins[i] = sleep.island;
                 }
+                s.stillness[i].held = true;
             } else if never_sleep.contains(other) {
                 s.stillness[i].restless = true;
+            } else {
+                // Static scenery (or a body out of the step: quarantined, a part).
+                s.stillness[i].held = true;
             }
         }
     }

@@ -19,7 +19,7 @@ use bevy_ecs::entity::EntityHashSet;
 use bevy_ecs::prelude::*;
 
 /// Statics game code wrote something to that a body resting on them feels.
-type SceneryWritten = (
+pub(crate) type SceneryWritten = (
     With<Static>,
     Unsettled,
     Or<(

@@ -4,6 +4,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 mod game_changes;
+mod holds_and_last_steps;
 mod support_changes;
 
 use bevy_app::App;
