@@ -305,11 +305,13 @@ impl JointConstraint {
     }
 
     /// What the joint applied over the last substep of the step: its accumulated impulses
-    /// over the substep `h`.
-    pub fn load(&self, h: f32) -> HeldLoad {
+    /// over the substep `h`, the point rows' with `pivoted`, the linear impulse its limit,
+    /// motor or swing rows carried at the anchors ([`super::joint_rows::Pivot::point`]).
+    pub(super) fn load(&self, h: f32, pivoted: Vec3) -> HeldLoad {
         let j = &self.impulses;
         let axial = j.motor + j.lower - j.upper;
-        let mut force = j.point.length() + Vec3::new(j.across[0], j.across[1], 0.0).length();
+        let point = j.point + pivoted;
+        let mut force = point.length() + Vec3::new(j.across[0], j.across[1], 0.0).length();
         let mut torque = j.angular.length() + j.swing.abs();
         if self.turns {
             torque += axial.abs();

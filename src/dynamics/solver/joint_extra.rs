@@ -212,6 +212,17 @@ impl JointExtra {
         self.rows = rows;
     }
 
+    /// The linear impulse on B that the rows held at the anchors carry with impulses `j`
+    /// ([`Pivot::point`](super::joint_rows::Pivot::point)), beyond the point rows' own.
+    pub(super) fn pivoted_impulse(&self, j: &JointImpulses) -> Vec3 {
+        let share = |row: &Option<(AxisRow, f32)>, impulse: f32| {
+            row.as_ref()
+                .and_then(|(row, _)| row.pivot)
+                .map_or(Vec3::ZERO, |pivot| pivot.point * impulse)
+        };
+        share(&self.rows.axis, j.motor + j.lower - j.upper) + share(&self.rows.swing, -j.swing)
+    }
+
     /// Applies the accumulated impulses of the extra rows.
     pub(super) fn apply_impulses(
         &self,

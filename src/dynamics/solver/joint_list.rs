@@ -9,11 +9,12 @@
 //! (the ECS gives them by key).
 
 use super::body::{BodyState, SolverBodies};
-use super::joint::{JointConstraint, JointImpulses, JointInput};
+use super::joint::{HeldLoad, JointConstraint, JointImpulses, JointInput};
 use super::joint_batch::JointBatch;
 use super::joint_extra::{JointExtra, Pass};
 use super::ordered_batches::OrderedBatches;
 use super::softness::Softness;
+use glam::Vec3;
 
 /// The step's joints (see the module doc).
 #[derive(Clone, Debug, Default)]
@@ -32,6 +33,16 @@ impl JointList {
     /// The step's joints, with their impulses.
     pub(super) fn joints(&self) -> &[JointConstraint] {
         &self.joints
+    }
+
+    /// What each joint applied over the last substep `h`, by its key: its rows' impulses with
+    /// the linear share of its rows held at the anchors.
+    pub(super) fn loads(&self, h: f32) -> impl Iterator<Item = (u64, HeldLoad)> + '_ {
+        self.joints.iter().map(move |j| {
+            let extra = j.extra.and_then(|e| self.extras.get(e as usize));
+            let pivoted = extra.map_or(Vec3::ZERO, |e| e.pivoted_impulse(&j.impulses));
+            (j.key, j.load(h, pivoted))
+        })
     }
 
     /// Prepares the step's joints over `bodies`, each seeded with its impulses of the last
@@ -291,7 +302,7 @@ impl JointList {
 mod tests {
     use super::*;
     use crate::dynamics::solver::{BodyInput, JointFrame, JointKind, JointLimit};
-    use glam::{Quat, Vec3};
+    use glam::Quat;
 
     #[test]
     fn joints_refilled_over_last_steps_equal_fresh_ones_on_every_value() {

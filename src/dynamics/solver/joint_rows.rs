@@ -105,6 +105,10 @@ pub struct AxisRow {
 pub struct Pivot {
     /// `Δv_a, Δω_a, Δv_b, Δω_b` per unit impulse.
     pub response: [Vec3; 4],
+    /// The point rows' answer `P` per unit impulse (on B; A takes `−P`): the force a joint
+    /// holds includes it (a hinge's limit holding a level arm carries three quarters of the
+    /// arm's weight this way).
+    pub point: Vec3,
     /// The row's velocity change per unit impulse.
     pub k: f32,
 }
@@ -135,6 +139,7 @@ impl Pivot {
                 keep(m.dynamic[1], dw_b),
             ],
             k: u_b.dot(dw_b) - u_a.dot(dw_a),
+            point: p,
         }
     }
 }

@@ -282,9 +282,14 @@ impl Solver {
     }
 
     /// The joints of the last step, with their impulses (in the order given; see
-    /// [`JointConstraint::load`] for the force each applied).
+    /// [`Self::joint_loads`] for the force each applied).
     pub fn joints(&self) -> &[JointConstraint] {
         self.joints.joints()
+    }
+
+    /// What each joint of the last step applied over its last substep, by the joint's key.
+    pub fn joint_loads(&self) -> impl Iterator<Item = (u64, HeldLoad)> + '_ {
+        self.joints.loads(self.substep)
     }
 
     /// The last step's substep (s).

@@ -132,11 +132,9 @@ impl SoftStepSolver {
 
     /// Each joint of the last step with what it held over the last substep.
     pub fn joint_loads(&self) -> impl Iterator<Item = (Entity, HeldLoad)> + '_ {
-        let h = self.solver.substep();
         self.solver
-            .joints()
-            .iter()
-            .map(move |j| (Entity::from_bits(j.key), j.load(h)))
+            .joint_loads()
+            .map(|(key, load)| (Entity::from_bits(key), load))
     }
 
     /// A solver with these settings (unusable ones step with the defaults; see

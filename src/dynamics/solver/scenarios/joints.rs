@@ -5,6 +5,7 @@
 
 mod ball_joint_limits;
 mod faults;
+mod loads;
 mod sliders;
 
 use super::*;
