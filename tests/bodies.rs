@@ -1,7 +1,7 @@
 //! What a body weighs and what pushes it, through the ECS: mass from the colliders' volume at a
 //! density (by default 1 kg/m³), a `Mass` that overrides it and comes undone, impulses (linear,
 //! at a point, angular, on a sleeper, bad ones), a per-body gravity scale, and a cone standing
-//! on its base or falling over from its apex.
+//! on its base or falling over from its apex, and a 2D game's locked stack coming to rest.
 
 mod common;
 
@@ -449,4 +449,57 @@ fn translation_locks_hold_a_body_on_its_axes_bit_for_bit_and_removing_them_frees
     app.world_mut().entity_mut(hanging).remove::<LockedAxes>();
     urto::step(app.world_mut(), 30).unwrap();
     assert!(p(&app, hanging).z < 4.0, "still at {}", p(&app, hanging));
+}
+
+#[test]
+fn a_2d_stack_locked_to_the_xy_plane_rests_under_1_mm_per_s_and_sleeps_within_2_s() {
+    // A 2D game's lock (translation along z, turning about x and y) with gravity along −y:
+    // a contact normal in the plane got friction directions out of it, and per point the two
+    // rows never settled: the top box slid at up to 3 cm/s and turned at 0.1 rad/s for ever
+    // (a user-style probe; with gravity along −z and the lock along y it rested).
+    let lock = LockedAxes::new()
+        .lock_translation_z()
+        .lock_rotation_x()
+        .lock_rotation_y();
+    let stack = |sleeping: bool| {
+        let mut app = common::app();
+        app.insert_resource(Gravity::new(Vec3::new(0.0, -9.81, 0.0)).unwrap());
+        if !sleeping {
+            app.insert_resource(SleepSettings {
+                enabled: false,
+                ..Default::default()
+            });
+        }
+        let world = app.world_mut();
+        world.spawn((Collider::half_space(Vec3::Y), Static));
+        let boxes = [
+            (Vec3::new(0.4, 0.3, 0.5), Vec3::new(0.0, 0.3, 0.0)),
+            (Vec3::new(0.3, 0.2, 0.3), Vec3::new(0.2, 0.81, 0.0)),
+        ]
+        .map(|(h, at)| {
+            let shape = Collider::cuboid(h.x, h.y, h.z);
+            world
+                .spawn((shape, Position(at), Velocity::default(), lock))
+                .id()
+        });
+        (app, boxes)
+    };
+    let (mut app, boxes) = stack(false);
+    urto::step(app.world_mut(), 480).unwrap();
+    let (mut v, mut w) = (0.0f32, 0.0f32);
+    for _ in 0..120 {
+        urto::step(app.world_mut(), 1).unwrap();
+        for e in boxes {
+            v = v.max(get::<Velocity>(&app, e).0.length());
+            w = w.max(get::<AngularVelocity>(&app, e).0.length());
+        }
+    }
+    assert!(v < 1e-3 && w < 1e-3, "{v} m/s, {w} rad/s");
+    let (mut app, boxes) = stack(true);
+    urto::step(app.world_mut(), 120).unwrap();
+    assert!(
+        boxes
+            .iter()
+            .all(|&e| app.world().get::<Sleeping>(e).is_some())
+    );
 }
