@@ -344,6 +344,52 @@ fn casts_at_a_2_degree_glance_hit_a_box_top_and_a_mesh_floor_within_1e_4_of_gap_
 }
 
 #[test]
+fn convex_casts_gliding_down_at_slopes_of_0_02_to_0_5_land_on_a_box_top_within_4e_5_of_the_path() {
+    // A cast stopped once its gap was within the tolerance (1e-5 of the sizes), which along
+    // a path closing the gap at a slope of 0.06 left it up to 0.3 mm short (a user-style
+    // probe); it now ends within the tolerance along the path itself.
+    let mut scratch = QueryScratch::new();
+    let target = (Shape::cuboid(Vec3::ONE), Isometry::IDENTITY);
+    let pyramid = [
+        (-1.0, -1.0, -1.0),
+        (1.0, -1.0, -1.0),
+        (1.0, 1.0, -1.0),
+        (-1.0, 1.0, -1.0),
+    ]
+    .map(|(x, y, z)| Vec3::new(x, y, z) * 0.4);
+    let apex = Vec3::new(0.0, 0.0, 0.4);
+    let hull = Shape::convex_hull(&[pyramid.as_slice(), &[apex]].concat()).unwrap();
+    let casters = [
+        (Shape::cylinder(0.3, 0.5), 0.3),
+        (Shape::cone(0.3, 0.5), 0.3),
+        (Shape::ellipsoid(Vec3::new(0.5, 0.4, 0.25)), 0.25),
+        (hull, 0.4),
+    ];
+    for slope in [0.02f32, 0.06, 0.1, 0.14, 0.5] {
+        let angle = slope.asin();
+        let direction = Vec3::new(angle.cos(), 0.0, -angle.sin());
+        for gap in [0.05f32, 0.3] {
+            let expected = gap / slope;
+            for (caster, below) in &casters {
+                // The lowest point `gap` above the top face, landing 0.1 m in from its edge.
+                let start = Vec3::new(-0.9 - expected * angle.cos(), 0.0, 1.0 + gap + below);
+                let cast = ShapeCast {
+                    pose: Isometry::from_translation(start),
+                    shape: caster,
+                    direction,
+                    max_distance: 40.0,
+                };
+                let d = cast_shape(&cast, &target.0, &target.1, &mut scratch).map(|h| h.distance);
+                assert!(
+                    d.is_some_and(|d| (d - expected).abs() < 4e-5),
+                    "{caster:?} at slope {slope}, gap {gap}: {d:?} vs {expected}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
 fn flat_bottoms_dropped_on_a_tessellated_floor_over_seams_and_corners_get_its_normal_within_1e_4_rad()
  {
     // A cylinder landing across a seam touched the triangle beside it only at its edge, and
