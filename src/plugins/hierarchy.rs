@@ -19,6 +19,7 @@ use crate::hierarchy::{refit_order, topmost_marked};
 use crate::plugins::broad_phase::IndexBodies;
 use crate::plugins::core::PrepareIndex;
 use crate::plugins::required_resources::RequireResource;
+use crate::plugins::restored_state::restore_removed_state;
 use crate::plugins::settle::Unsettled;
 use crate::plugins::validation::quarantine;
 use crate::schedule::{BroadPhaseSystems, PhysicsSchedule, PhysicsSet, SubstepSchedule};
@@ -70,6 +71,13 @@ impl Plugin for HierarchyPlugin {
                     .chain()
                     .run_if(any_with_component::<BoundingVolume>)
                     .in_set(PrepareIndex)
+                    .before(IndexBodies),
+            )
+            .add_systems(
+                PhysicsSchedule,
+                restore_removed_state
+                    .in_set(PrepareIndex)
+                    .before(propagate_poses::<Without<Velocity>>)
                     .before(IndexBodies),
             );
     }

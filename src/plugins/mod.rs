@@ -27,6 +27,7 @@ pub mod narrow_phase;
 mod proxy_table;
 mod required_resources;
 pub mod response;
+mod restored_state;
 pub mod rotation;
 mod settings_check;
 pub(crate) mod settle;
