@@ -21,8 +21,9 @@
 //! never queries pays nothing and one that queries pays once per step, whatever the number of
 //! queries. It sees the world as the last step left it; bodies a game moves or spawns between
 //! steps are seen after the next step, or at once after [`SpatialQuery::refresh`]. Roots are
-//! read at their [`Position`] and [`Rotation`], parts of compound bodies at their
-//! [`GlobalPose`]. Quarantined colliders are never hit.
+//! read at their [`Position`] and [`Rotation`], parts of compound bodies at theirs composed
+//! with their ancestors' (as the hierarchy stage composes their [`GlobalPose`], which is the
+//! last step's until the next). Quarantined colliders are never hit.
 //!
 //! Static scenery is not read at each step. A [`Static`] root body nobody wrote to since the
 //! last step is *settled* (the marker the step's change scans leave out, see `settle.rs`), and
@@ -201,6 +202,7 @@ pub struct SpatialQuery<'w, 's> {
     colliders: Query<'w, 's, QueryCollider, Moving>,
     still: Query<'w, 's, QueryCollider, Still>,
     asleep: Query<'w, 's, QueryCollider, Asleep>,
+    nodes: Query<'w, 's, Node>,
     revision: Option<Res<'w, StillRevision>>,
     stats: Option<Res<'w, PhysicsStats>>,
 }
@@ -211,6 +213,7 @@ struct Lookup<'a, 'w, 's> {
     colliders: &'a Query<'w, 's, QueryCollider, Moving>,
     still: &'a Query<'w, 's, QueryCollider, Still>,
     asleep: &'a Query<'w, 's, QueryCollider, Asleep>,
+    nodes: &'a Query<'w, 's, Node>,
 }
 
 /// The groups' numbers in the index ids' two low bits.
@@ -253,16 +256,55 @@ impl Lookup<'_, '_, '_> {
 impl ColliderLookup for Lookup<'_, '_, '_> {
     fn collider(&self, id: u32) -> Option<(&Shape, Isometry)> {
         let row = self.row(id)?;
-        Some((&row.1.shape, pose_of(&row)))
+        Some((&row.1.shape, pose_of(&row, self.nodes)))
     }
 }
 
-/// Where a collider is: a root at its position, a part at its global pose.
-fn pose_of((_, _, global, position, rotation, child, _): &QueryItemOf) -> Isometry {
+/// A node of the scene graph: what a part's pose is composed of.
+type Node = (
+    &'static Position,
+    Option<&'static Rotation>,
+    Option<&'static ChildOf>,
+);
+
+/// The deepest chain of parts composed for a query; a deeper part is read at its
+/// [`GlobalPose`] (a `ChildOf` loop ends here too).
+const MAX_CHAIN: usize = 16;
+
+/// Where a collider is now: a root at its position; a part at its own and its ancestors'
+/// positions, composed from the root down as the hierarchy stage composes its global pose, so
+/// that it follows a root the game moved before a [`SpatialQuery::refresh`]. Read at its
+/// global pose, the last step's, a part stayed where it was until the next step: a ray at the
+/// part's new place missed it, one at its old place hit it (a user-style probe). A broken or
+/// too deep chain falls back on the global pose.
+fn pose_of(row: &QueryItemOf, nodes: &Query<Node>) -> Isometry {
+    let (e, _, global, position, rotation, child, _) = *row;
     match (child, position, rotation) {
         (false, Some(p), Some(r)) => Isometry::new(p.0, r.0),
+        (true, Some(_), _) => composed(e, nodes).unwrap_or(global.0),
         _ => global.0,
     }
+}
+
+/// Part `e`'s pose composed from its chain of [`ChildOf`] up to its root (`None` when a link
+/// is missing or the chain is longer than [`MAX_CHAIN`]).
+fn composed(e: Entity, nodes: &Query<Node>) -> Option<Isometry> {
+    let mut chain = [Isometry::IDENTITY; MAX_CHAIN];
+    let (mut len, mut at) = (0, e);
+    loop {
+        let (p, r, parent) = nodes.get(at).ok()?;
+        *chain.get_mut(len)? = crate::components::pose(p, r);
+        len += 1;
+        match parent {
+            Some(parent) => at = parent.parent(),
+            None => break,
+        }
+    }
+    let mut world = Isometry::IDENTITY;
+    for local in chain[..len].iter().rev() {
+        world = world * *local;
+    }
+    Some(world)
 }
 
 type QueryItemOf<'a> = (
@@ -307,17 +349,17 @@ impl SpatialQuery<'_, '_> {
     fn read_groups(&self, state: &mut IndexState, stale: [bool; 2]) {
         let (index, ids) = (&mut state.index, &mut state.ids);
         let counts = &mut state.refreshes;
-        match read_group(index, &mut ids[0], &self.colliders, MOVING) {
+        match read_group(index, &mut ids[0], &self.colliders, &self.nodes, MOVING) {
             IndexUpdate::Refitted => counts.refits += 1,
             IndexUpdate::Updated => counts.updates += 1,
             IndexUpdate::Rebuilt => counts.rebuilds += 1,
         }
         if stale[0] {
-            read_group(index, &mut ids[1], &self.still, SETTLED);
+            read_group(index, &mut ids[1], &self.still, &self.nodes, SETTLED);
             counts.still_reads += 1;
         }
         if stale[1] {
-            read_group(index, &mut ids[2], &self.asleep, SLEEPING);
+            read_group(index, &mut ids[2], &self.asleep, &self.nodes, SLEEPING);
             counts.sleeping_reads += 1;
         }
     }
@@ -340,6 +382,7 @@ impl SpatialQuery<'_, '_> {
             colliders: &self.colliders,
             still: &self.still,
             asleep: &self.asleep,
+            nodes: &self.nodes,
         };
         query(index, &lookup, &|id| lookup.accepts(id, filter))
     }
@@ -500,12 +543,17 @@ fn read_group<F: QueryFilter>(
     index: &mut SpatialIndex,
     ids: &mut StableIds<Entity>,
     query: &Query<QueryCollider, F>,
+    nodes: &Query<Node>,
     group: u32,
 ) -> IndexUpdate {
     ids.begin();
-    let colliders = query
-        .iter()
-        .map(|row| ((ids.id(row.0) << 2) | group, &row.1.shape, pose_of(&row)));
+    let colliders = query.iter().map(|row| {
+        (
+            (ids.id(row.0) << 2) | group,
+            &row.1.shape,
+            pose_of(&row, nodes),
+        )
+    });
     let update = match group {
         MOVING => index.update(colliders),
         SETTLED => index.update_still(colliders),

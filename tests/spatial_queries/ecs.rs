@@ -389,3 +389,55 @@ fn layers_switched_every_step_for_200_steps_leave_the_broad_phase_exact_and_no_n
         assert!(finite, "step {step}");
     }
 }
+
+#[test]
+fn a_compound_moved_by_the_game_is_hit_at_its_new_place_after_refresh_before_any_step() {
+    // Its parts were read at their global poses, the last step's: after the game moved the
+    // root and refreshed, a ray at the part's new place missed it and one at its old place hit
+    // it, until the next step (a user-style probe).
+    use bevy_ecs::hierarchy::ChildOf;
+    use bevy_ecs::system::RunSystemOnce;
+    let mut app = common::app();
+    let root = app
+        .world_mut()
+        .spawn((
+            Collider::sphere(0.5),
+            Position::new(0.0, 0.0, 10.0),
+            Velocity::default(),
+            GravityScale(0.0),
+        ))
+        .id();
+    let part = app
+        .world_mut()
+        .spawn((
+            Collider::cuboid(0.5, 0.5, 0.5),
+            Position::new(3.0, 0.0, 0.0),
+            ChildOf(root),
+        ))
+        .id();
+    urto::step(app.world_mut(), 1).unwrap();
+    // Moved 20 m along y and turned a quarter about z: the part's centre goes to (0, 23, 10).
+    app.world_mut().entity_mut(root).insert((
+        Position::new(0.0, 20.0, 10.0),
+        Rotation(glam::Quat::from_rotation_z(std::f32::consts::FRAC_PI_2)),
+    ));
+    let hits = app
+        .world_mut()
+        .run_system_once(|q: SpatialQuery| {
+            q.refresh();
+            let all = SpatialQueryFilter::default();
+            let down = |x: f32, y: f32| {
+                let hit = q.cast_ray(Vec3::new(x, y, 20.0), -Vec3::Z, 30.0, &all);
+                hit.unwrap().map(|h| (h.entity, h.distance))
+            };
+            (down(0.0, 23.0), down(3.0, 0.0))
+        })
+        .unwrap();
+    // The box's top at z = 10.5: 9.5 m down from z = 20.
+    let (new_place, old_place) = hits;
+    assert!(
+        new_place.is_some_and(|(e, d)| e == part && (d - 9.5).abs() < 1e-4),
+        "{new_place:?}"
+    );
+    assert_eq!(old_place, None);
+}
