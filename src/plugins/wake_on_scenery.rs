@@ -1,8 +1,8 @@
 //! Waking sleepers whose support changed. A sleeping body's own writes wake it
 //! (`wake_on_writes`); this wakes the sleepers touching a static body game code moved, turned,
 //! reshaped, stripped of its collider, made a sensor (or solid again), or gave new layers,
-//! friction or restitution, and a sleeper that lost its collider or became a sensor (its
-//! island wakes with it). Without it, a box asleep on a floor the game moved down by a metre
+//! friction or restitution, the sleepers jointed to such a static, and a sleeper that lost its
+//! collider or became a sensor (its island wakes with it). Without it, a box asleep on a floor the game moved down by a metre
 //! hung in the air, as it did on a floor whose collider was removed or that became a sensor:
 //! the pair of a sleeper and a static body is dormant (`collision_messages`), never tested
 //! again until one of them wakes.
@@ -13,6 +13,7 @@
 
 use crate::components::*;
 use crate::plugins::collision_messages::TouchingPairs;
+use crate::plugins::joints::ActiveJoint;
 use crate::plugins::settle::Unsettled;
 use crate::plugins::sleep::Waker;
 use bevy_ecs::entity::EntityHashSet;
@@ -40,6 +41,7 @@ pub(crate) fn wake_on_scenery_changes(
     made_sensors: Query<Entity, Added<Sensor>>,
     (mut uncollided, mut unsensed): (RemovedComponents<Collider>, RemovedComponents<Sensor>),
     touching: Option<Res<TouchingPairs>>,
+    joints: Query<&Joint, ActiveJoint>,
     mut sleepers: Query<&mut SleepState, With<Sleeping>>,
     mut waker: Waker,
     mut changed: Local<EntityHashSet>,
@@ -57,6 +59,17 @@ pub(crate) fn wake_on_scenery_changes(
     };
     for &e in changed.iter() {
         wake(e, &mut waker);
+    }
+    // A ball asleep on a rope from a static hook hung on where the hook had been moved or
+    // despawned (a user-style probe).
+    for j in &joints {
+        let b = j.body_b_entity();
+        if let Some(b) = b.filter(|_| changed.contains(&j.body_a)) {
+            wake(b, &mut waker);
+        }
+        if b.is_some_and(|b| changed.contains(&b)) {
+            wake(j.body_a, &mut waker);
+        }
     }
     let Some(touching) = touching else {
         return;
