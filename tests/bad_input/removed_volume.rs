@@ -2,6 +2,13 @@
 
 use super::*;
 
+/// A static 10 × 10 × 1 m slab, its top at z = 0.
+fn slab(app: &mut bevy_app::App) -> bevy_ecs::entity::Entity {
+    let shape = Collider::cuboid(5.0, 5.0, 0.5);
+    let at = Position(Vec3::new(0.0, 0.0, -0.5));
+    app.world_mut().spawn((shape, at, Static)).id()
+}
+
 /// Removing a component is input too: a ground slab whose `BoundingVolume` a game removes and
 /// puts back between steps is indexed again (both broad-phase syncs of a step read the removal;
 /// the second once left it out for good), and the ball on it stays within 1 cm of rest.
@@ -9,14 +16,7 @@ use super::*;
 fn a_ground_whose_volume_is_removed_and_put_back_holds_its_ball_within_1cm_for_1s() {
     let mut app = common::app();
     app.insert_resource(Gravity::EARTH_Z_UP);
-    let ground = app
-        .world_mut()
-        .spawn((
-            Collider::cuboid(5.0, 5.0, 0.5),
-            Position(Vec3::new(0.0, 0.0, -0.5)),
-            Static,
-        ))
-        .id();
+    let ground = slab(&mut app);
     let ball = common::ball(&mut app, Vec3::new(0.0, 0.0, 0.5));
     // Awake: a sleeping ball would rest on nothing.
     app.insert_resource(SleepSettings {
@@ -45,14 +45,7 @@ fn a_stack_whose_volumes_and_poses_are_removed_stays_within_1cm_for_2s() {
         enabled: false,
         ..Default::default()
     });
-    let slab = app
-        .world_mut()
-        .spawn((
-            Collider::cuboid(5.0, 5.0, 0.5),
-            Position(Vec3::new(0.0, 0.0, -0.5)),
-            Static,
-        ))
-        .id();
+    let slab = slab(&mut app);
     let stack: Vec<_> = (0..3)
         .map(|k| common::crate_box(&mut app, 0.5 + k as f32))
         .collect();

@@ -82,25 +82,9 @@ fn a_ball_asleep_on_a_rope_cut_disabled_or_unhooked_falls_over_4_m_within_1_s() 
     assert!((z(&app, ball) - 5.0).abs() < 0.01, "z = {}", z(&app, ball));
 }
 
-/// A unit box on a static slab (top at z = 0), and the step in which it falls asleep.
-fn box_on_a_slab() -> (App, Entity, Entity) {
-    let mut app = common::app();
-    app.insert_resource(Gravity::EARTH_Z_UP);
-    let slab = app
-        .world_mut()
-        .spawn((
-            Collider::cuboid(5.0, 5.0, 0.5),
-            Position::new(0.0, 0.0, -0.5),
-            Static,
-        ))
-        .id();
-    let b = common::crate_box(&mut app, 0.5);
-    (app, slab, b)
-}
-
 #[test]
 fn a_write_on_the_step_a_box_would_fall_asleep_acts_within_1_s_as_a_step_earlier() {
-    let (mut app, _, b) = box_on_a_slab();
+    let (mut app, _, b) = box_on_a_slab(0.5);
     let mut last_awake = 0;
     while !asleep(&app, b) {
         assert!(last_awake < 300, "the box never sleeps");
@@ -155,7 +139,7 @@ fn a_write_on_the_step_a_box_would_fall_asleep_acts_within_1_s_as_a_step_earlier
     ];
     for (edit, apply, expected) in edits {
         for at in [last_awake - 1, last_awake] {
-            let (mut app, slab, b) = box_on_a_slab();
+            let (mut app, slab, b) = box_on_a_slab(0.5);
             urto::step(app.world_mut(), at).unwrap();
             assert!(!asleep(&app, b));
             apply(app.world_mut(), slab, b);

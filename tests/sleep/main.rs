@@ -18,6 +18,25 @@ fn sleepy_app() -> App {
     common::on_ground(common::app())
 }
 
+/// A unit box on a static 10 × 10 × 1 m slab (top at z = 0), both with `friction`, at rest on
+/// it; the app (gravity 9.8 along −z), the slab and the box.
+fn box_on_a_slab(friction: f32) -> (App, Entity, Entity) {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    let slab = app
+        .world_mut()
+        .spawn((
+            Collider::cuboid(5.0, 5.0, 0.5),
+            Position::new(0.0, 0.0, -0.5),
+            Static,
+            Friction(friction),
+        ))
+        .id();
+    let b = common::crate_box(&mut app, 0.5);
+    app.world_mut().entity_mut(b).insert(Friction(friction));
+    (app, slab, b)
+}
+
 fn asleep(app: &App, e: Entity) -> bool {
     app.world().get::<Sleeping>(e).is_some()
 }

@@ -7,19 +7,7 @@ use super::*;
 /// A unit box asleep on a static 10 × 10 × 1 m slab (top at z = 0), both with `friction`;
 /// `slab` and `box` entities.
 fn box_asleep_on_a_slab(friction: f32) -> (App, Entity, Entity) {
-    let mut app = common::app();
-    app.insert_resource(Gravity::EARTH_Z_UP);
-    let slab = app
-        .world_mut()
-        .spawn((
-            Collider::cuboid(5.0, 5.0, 0.5),
-            Position::new(0.0, 0.0, -0.5),
-            Static,
-            Friction(friction),
-        ))
-        .id();
-    let b = common::crate_box(&mut app, 0.5);
-    app.world_mut().entity_mut(b).insert(Friction(friction));
+    let (mut app, slab, b) = box_on_a_slab(friction);
     urto::step(app.world_mut(), 90).unwrap();
     assert!(asleep(&app, b), "the box sleeps on the slab");
     (app, slab, b)
