@@ -23,7 +23,10 @@
 //! steps are seen after the next step, or at once after [`SpatialQuery::refresh`]. Roots are
 //! read at their [`Position`] and [`Rotation`], parts of compound bodies at theirs composed
 //! with their ancestors' (as the hierarchy stage composes their [`GlobalPose`], which is the
-//! last step's until the next). Quarantined colliders are never hit.
+//! last step's until the next). A body the game moves through its `Transform` is seen after
+//! the next step only, even after a refresh: the step reads `Transform` writes into
+//! [`Position`] (`transform_sync`); write [`Position`] and [`Rotation`] to be seen at once.
+//! Quarantined colliders are never hit.
 //!
 //! Static scenery is not read at each step. A [`Static`] root body nobody wrote to since the
 //! last step is *settled* (the marker the step's change scans leave out, see `settle.rs`), and

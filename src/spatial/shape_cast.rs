@@ -5,9 +5,9 @@
 //! - **Ball, box, capsule casters** take their own casts ([`cast_sphere`], [`cast_box`],
 //!   [`cast_capsule`]): closed forms and exact distances.
 //! - **Cylinder, cone, ellipsoid and hull casters**, by target:
-//!   - a ball: the ball swept the other way against the caster at rest (`ccd`'s exact sweeps);
 //!   - a half-space: the caster's support point along the plane's inward normal, one division;
-//!   - a convex shape: conservative advancement (Mirtich 1996) on the GJK/EPA signed distance,
+//!   - a convex shape, a ball included: conservative advancement (Mirtich 1996) on the GJK/EPA
+//!     signed distance,
 //!     stepping to where the gap's tangent meets zero (the gap of a translating convex pair is
 //!     convex in the travel, so the step is safe; see `advance_convex`);
 //!   - a mesh: its hierarchy walked along the path of the caster's bounding sphere, nearest
@@ -22,8 +22,7 @@
 //! towards the caster.
 
 use super::box_cast::{
-    ADVANCE_TOLERANCE, BoxCast, Gap, advance_convex, against_ball, against_convex, against_plane,
-    cast_box,
+    ADVANCE_TOLERANCE, BoxCast, Gap, advance_convex, against_convex, against_plane, cast_box,
 };
 use super::capsule_cast::{CapsuleCast, cast_capsule};
 use super::cast::{CastHit, Ray, cast_sphere};
@@ -99,7 +98,10 @@ fn convex_cast(
     scratch: &mut QueryScratch,
 ) -> Option<CastHit> {
     match target {
-        Shape::Sphere(s) => against_ball((shape, pose), motion, at.translation, s, scratch),
+        // A ball is a convex target like the others: the advancement on the exact gap ends
+        // within its tolerance along the path. Swept the other way round, as continuous
+        // collision sweeps a ball, it stopped within the sweep's coarser tolerance, up to 0.3
+        // mm of gap and 5 mm of path short at a glance (a user-style probe).
         Shape::HalfSpace(h) => {
             let part = ConvexPart::of_shape(shape, *pose)?;
             let inward = -at.transform_vector(h.normal);
