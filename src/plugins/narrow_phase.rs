@@ -38,15 +38,14 @@
 //! of compound pairs tested, entered and pruned; each is filled only while enabled (the rerun
 //! recording enables them on request), so the narrow phase pays nothing for them otherwise.
 
-use crate::bounding::Aabb;
 use crate::bvh::QueryStats;
 use crate::components::*;
 use crate::geometry::contacts::{
     ContactScratch, ManifoldCache, NO_TRIANGLE, RoundSide, contact_with_scratch,
-    speculative_contact_with_scratch, sphere_sphere_on_approach,
+    speculative_contact_with_scratch,
 };
-use crate::geometry::{ContactManifold, Isometry, Shape};
-use crate::hierarchy::{BvTree, HierarchyStats, PairScratch, descend_pairs};
+use crate::geometry::{ContactManifold, Shape};
+use crate::hierarchy::{HierarchyStats, PairScratch, descend_pairs};
 use crate::plugins::broad_phase::BroadPhasePairs;
 use crate::plugins::joints::JointedPairs;
 use crate::plugins::required_resources::RequireResource;
@@ -60,14 +59,18 @@ use bevy_ecs::prelude::*;
 use glam::Vec3;
 use std::time::Instant;
 
+mod ecs_tree;
 mod leaves;
 mod outputs;
+mod pair_rules;
 mod visits;
 
+use ecs_tree::{EcsTree, Node};
 use leaves::{Leaf, NO_LEAF_OF_ITS_OWN, emptied};
 pub use outputs::{
     ContactPair, Contacts, LeafOverlap, NO_LEAF, OverlappingLeaves, SensorOverlaps, SensorPair,
 };
+use pair_rules::{balls_meeting, is_mesh, worth_caching};
 pub use visits::HierarchyVisits;
 use visits::VisitRecorder;
 
@@ -162,50 +165,6 @@ impl Plugin for NarrowPhasePlugin {
                     .after(ComputeContacts)
                     .in_set(SubstepSet::NarrowPhase),
             );
-    }
-}
-
-type Node<'a> = (
-    Option<Ref<'a, Collider>>,
-    &'a GlobalPose,
-    &'a BoundingVolume,
-    Option<&'a Children>,
-);
-
-/// A body's hierarchy, seen through the ECS, for the pair descent of [`crate::hierarchy`];
-/// its volumes grown by `grow` (half a pair's speculative margin: two volumes each grown by
-/// half of it meet when the parts are within the margin).
-struct EcsTree<'q, 'w, 's, 'd> {
-    nodes: &'q Query<'w, 's, Node<'d>, Without<Quarantined>>,
-    grow: f32,
-}
-
-impl EcsTree<'_, '_, '_, '_> {
-    fn grown(&self, b: Aabb) -> Aabb {
-        if self.grow > 0.0 && b.is_valid() {
-            b.expanded(self.grow)
-        } else {
-            b
-        }
-    }
-}
-
-impl BvTree for EcsTree<'_, '_, '_, '_> {
-    type Node = Entity;
-
-    fn subtree_bv(&self, n: Entity) -> Aabb {
-        self.grown(self.nodes.get(n).map_or(Aabb::EMPTY, |(_, _, bv, _)| bv.0))
-    }
-
-    fn own_bv(&self, n: Entity) -> Option<Aabb> {
-        let (collider, global, ..) = self.nodes.get(n).ok()?;
-        collider.map(|c| self.grown(c.shape.world_aabb(&global.0)))
-    }
-
-    fn children(&self, n: Entity, out: &mut Vec<Entity>) {
-        if let Ok((.., Some(children))) = self.nodes.get(n) {
-            out.extend(children.iter());
-        }
     }
 }
 
@@ -532,50 +491,6 @@ impl NarrowPhaseScratch {
             }
         }
     }
-}
-
-/// Two balls within `margin` of each other and closing, B moving by `motion` relative to A:
-/// their contact where they will meet, not where they are (`sphere_sphere_on_approach`);
-/// `None` for any other pair, and for balls that do not meet that soon (their closest
-/// points' contact stands).
-fn balls_meeting(
-    (sa, pa): (&Shape, &Isometry),
-    (sb, pb): (&Shape, &Isometry),
-    margin: f32,
-    motion: Vec3,
-) -> Option<ContactManifold> {
-    let (Shape::Sphere(ra), Shape::Sphere(rb)) = (sa, sb) else {
-        return None;
-    };
-    let (ca, cb) = (pa.translation, pb.translation);
-    let reach = ra.radius + rb.radius + margin;
-    if !(margin > 0.0 && (cb - ca).length_squared() <= reach * reach) {
-        return None;
-    }
-    sphere_sphere_on_approach(ca, ra, cb, rb, motion)
-}
-
-fn is_mesh(shape: &Shape) -> bool {
-    matches!(shape, Shape::TriMesh(_))
-}
-
-/// Whether a pair's test costs more than a cache lookup: a mesh against anything, else two
-/// shapes neither of which is a sphere or a half-space (closed forms of a few dozen operations)
-/// and not two capsules (closest points of two segments). Two boxes take about 4,600
-/// instructions (axes, clipping, four points chosen), the GJK/EPA shapes 12,000–25,000; a
-/// lookup a few hundred. Never with an ellipsoid: where it touches depends on how it is turned
-/// (a point under an ellipsoid rocking on its flattest side runs `(a² − c²)/c` per radian, 1.6
-/// m for one of 0.6 × 0.4 × 0.2 m), which a kept contact cannot follow: it lagged by up to
-/// 2.7 mm, and the push there rocked such an ellipsoid lying on a box harder and harder (26 mm
-/// of drift in 20 s with sleeping off, 0.06 mm tested each step).
-fn worth_caching(a: &Shape, b: &Shape) -> bool {
-    let closed_form = |s: &Shape| matches!(s, Shape::Sphere(_) | Shape::HalfSpace(_));
-    let capsules = matches!((a, b), (Shape::Capsule(_), Shape::Capsule(_)));
-    let ellipsoid = |s: &Shape| matches!(s, Shape::Ellipsoid(_));
-    if ellipsoid(a) || ellipsoid(b) {
-        return false;
-    }
-    is_mesh(a) || is_mesh(b) || !(closed_form(a) || closed_form(b) || capsules)
 }
 
 /// The leaf pairs of the last query's triangle hits.
