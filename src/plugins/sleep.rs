@@ -298,16 +298,7 @@ fn fall_asleep(
 ) {
     let s = &mut *scratch;
     let gravity = gravity.map_or(Vec3::ZERO, |g| g.acceleration());
-    count_stillness(&mut bodies, &settings, (timestep.dt(), gravity), s);
-    for (i, &e) in s.awake.iter().enumerate() {
-        let state = &mut s.stillness[i];
-        if state.still_for >= settings.time && remade.contains(e) {
-            state.still_for = 0.0;
-            if let Ok((_, mut sleep, ..)) = bodies.get_mut(e) {
-                sleep.restart();
-            }
-        }
-    }
+    count_stillness(&mut bodies, &remade, &settings, (timestep.dt(), gravity), s);
     stats.set_counter("sleep/awake_bodies", s.awake.len() as f64);
     stats.set_counter("sleep/sleeping_islands", islands.members.len() as f64);
     if !s.stillness.iter().any(|b| b.still_for >= settings.time) {
@@ -371,9 +362,11 @@ fn index_slots(s: &mut IslandScratch) {
 
 /// Lists the awake dynamic bodies with their stillness (counting it on, [`StillTest`]: within
 /// `speed × time` of where the body's current window began, never faster than four times the
-/// speed) and whether `gravity` pulls them, and the kinematic ones.
+/// speed; from zero for a body still long enough to sleep but `remade`) and whether `gravity`
+/// pulls them, and the kinematic ones.
 fn count_stillness(
     bodies: &mut Query<Candidate, CandidateFilter>,
+    remade: &Query<(), Remade>,
     settings: &SleepSettings,
     (dt, gravity): (f32, Vec3),
     s: &mut IslandScratch,
@@ -392,8 +385,11 @@ fn count_stillness(
         let (start, reach) = ((sleep.at, sleep.orientation), volume.reach());
         // A turning body's surface moves at up to |ω| times its reach.
         let speed = v.0.length().max(spin * reach);
-        let (still_for, restart) =
+        let (mut still_for, restart) =
             test.step(sleep.still_for, (start, (p.0, r.0)), speed, reach, dt);
+        if still_for >= settings.time && remade.contains(e) {
+            still_for = 0.0;
+        }
         let mut next = SleepState {
             still_for,
             ..*sleep
