@@ -21,6 +21,7 @@ use super::{
 use crate::geometry::{
     Capsule, ContactManifold, ContactPoint, Cuboid, Isometry, Shape, Sphere, length_or_zero,
 };
+use glam::Vec3;
 
 /// The shape grown exactly by `margin` (a ball's or a capsule's radius), or `None`.
 fn rounded_grown(shape: &Shape, margin: f32) -> Option<Shape> {
@@ -38,9 +39,14 @@ fn rounded_grown(shape: &Shape, margin: f32) -> Option<Shape> {
 
 /// The manifold of a grown shape brought back to the true surfaces: the grown surface of A
 /// lies `added` further along the normal (of B, `added` back), so the midpoint moved by half of
-/// it, and each depth shrinks by `added` (negative: still apart); a point on a grown box's rim
-/// (a corner of the grown face) is pulled in across the normal to the true box, or the lever
-/// arms would be `added` too long.
+/// it, and each depth shrinks by `added` (negative: still apart). A grown box (`rim`) is not a
+/// rounded one: a point on its grown edge or corner stands `(|n·x| + |n·y| + |n·z|) added`
+/// out along the normal from the true edge or corner it grew from (up to `√3 added`), so its
+/// depth shrinks by that, measured ([`grown_box_excess`], less [`RIM_EXCESS_SLACK`]); read as
+/// `added`, a cube landing
+/// on an edge saw 41 % of the margin as contact and came to rest that far above the floor
+/// (the fourth probe: up to 3.9 mm). The point is then pulled in across the normal to the
+/// true box, or the lever arms would be `added` too long.
 fn from_grown(
     m: ContactManifold,
     added: f32,
@@ -51,7 +57,10 @@ fn from_grown(
     let mut out = ContactManifold::new(m.normal);
     for p in m.points() {
         let mut point = p.point + shift;
+        let mut excess = added;
         if let Some((c, pose)) = rim {
+            let beyond = grown_box_excess(p, m.normal, (c, pose), grown_a) - added;
+            excess += (beyond - RIM_EXCESS_SLACK * added).max(0.0);
             let local = pose.inverse_transform_point(point);
             let inside = local.clamp(-c.half_extents, c.half_extents);
             let pulled = pose.transform_point(inside);
@@ -61,11 +70,28 @@ fn from_grown(
         }
         out.push(ContactPoint {
             point,
-            depth: p.depth - added,
+            depth: p.depth - excess,
             ..*p
         });
     }
     out
+}
+
+/// How far out along its outward normal the grown box's surface point of `p` stands from the
+/// true box: `added` on a face met square on, more on a grown edge or corner. The grown
+/// surface point is half the depth from the midpoint `p.point` (towards B when the box is A);
+/// the true box's point it grew from is its clamp into the true box.
+fn grown_box_excess(
+    p: &ContactPoint,
+    normal: Vec3,
+    (c, pose): (&Cuboid, &Isometry),
+    grown_a: bool,
+) -> f32 {
+    let outward = if grown_a { normal } else { -normal };
+    let surface = p.point + outward * (0.5 * p.depth);
+    let local = pose.inverse_transform_point(surface);
+    let grew_from = pose.transform_point(local.clamp(-c.half_extents, c.half_extents));
+    (surface - grew_from).dot(outward)
 }
 
 /// The contact of `a` and `b` with a speculative `margin` (see the module doc), or `None` when
@@ -176,6 +202,14 @@ fn grown_box_contact(
     Some(capped)
 }
 
+/// The share of the margin by which a grown box's point may stand out beyond its face's
+/// reading and still be read as the face (see [`from_grown`]): a face tilted by less than
+/// about 0.6° (`cos θ + sin θ − 1` below it) keeps the face's reading exactly, and a point on
+/// a grown edge or corner reads its true gap within this share of the margin. Measured to
+/// the full excess, the rounding of points metres up and the tilts of a resting stack came
+/// into every reading: the 20-box stack's drift went from 0.59 to 2.2 cm in 10 s.
+const RIM_EXCESS_SLACK: f32 = 0.01;
+
 /// How much deeper than the true shapes a grown box's contact may read before its points are
 /// capped (m).
 const MAX_GROWN_BOX_ERROR: f32 = 1e-5;
@@ -216,7 +250,6 @@ fn raised_half_space(shape: &Shape, pose: &Isometry, margin: f32) -> Option<Isom
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::Vec3;
 
     #[test]
     fn a_speculative_contact_never_reads_deeper_than_the_true_shapes_by_1e_4_whatever_the_margin() {
@@ -382,6 +415,51 @@ mod tests {
         for p in c.points() {
             assert!((p.depth + 0.015).abs() < 1e-5);
             assert!((p.point.z - (0.5 + 0.0075)).abs() < 1e-5, "{}", p.point);
+        }
+    }
+
+    /// A cube standing on an edge (45°) or a corner, `gap` above the ground, a box and a
+    /// second cube: the speculative reading is the true gap at every point, whichever side
+    /// is grown, within the slack. Read as the face's `margin`, the edge's gap was short by
+    /// 41 % of the margin and a cube came to rest that far above the floor.
+    #[test]
+    fn a_cube_on_an_edge_or_a_corner_reads_its_true_gap_within_a_hundredth_of_the_margin() {
+        let cube = Shape::cuboid(Vec3::splat(0.3));
+        let edge = glam::Quat::from_rotation_y(std::f32::consts::FRAC_PI_4);
+        let corner = glam::Quat::from_rotation_arc(Vec3::ONE.normalize(), -Vec3::Z);
+        let grounds = [
+            (Shape::half_space(Vec3::Z), Isometry::default()),
+            (
+                Shape::cuboid(Vec3::new(5.0, 5.0, 0.5)),
+                Isometry::from_translation(Vec3::new(0.0, 0.0, -0.5)),
+            ),
+            (
+                Shape::cuboid(Vec3::splat(0.3)),
+                Isometry::from_translation(Vec3::new(0.05, -0.02, -0.3)),
+            ),
+        ];
+        for rotation in [edge, corner] {
+            let lowest = (0..8)
+                .map(|k| {
+                    let s = |bit: usize| if k & bit == 0 { -0.3 } else { 0.3 };
+                    (rotation * Vec3::new(s(1), s(2), s(4))).z
+                })
+                .fold(f32::MAX, f32::min);
+            for gap in [0.0005, 0.002, 0.01] {
+                let at = Isometry::new(Vec3::new(0.0, 0.0, gap - lowest), rotation);
+                for (ground, pose) in &grounds {
+                    for margin in [0.02, 0.05] {
+                        let up = speculative_contact(ground, pose, &cube, &at, margin).unwrap();
+                        let down = speculative_contact(&cube, &at, ground, pose, margin).unwrap();
+                        for m in [up, down] {
+                            let read = m.points().iter().map(|p| -p.depth).fold(f32::MAX, f32::min);
+                            let short = gap - read;
+                            let slack = RIM_EXCESS_SLACK * margin + 1e-5;
+                            assert!((-1e-5..slack).contains(&short), "gap {gap}: read {read}");
+                        }
+                    }
+                }
+            }
         }
     }
 }
