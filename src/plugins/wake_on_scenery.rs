@@ -1,11 +1,12 @@
 //! Waking sleepers whose support changed. A sleeping body's own writes wake it
 //! (`wake_on_writes`); this wakes the sleepers touching a static body game code moved, turned,
-//! reshaped, stripped of its collider, made a sensor (or solid again), or gave new layers,
-//! friction or restitution, the sleepers jointed to such a static, and a sleeper that lost its
-//! collider or became a sensor (its island wakes with it). Without it, a box asleep on a floor the game moved down by a metre
-//! hung in the air, as it did on a floor whose collider was removed or that became a sensor:
-//! the pair of a sleeper and a static body is dormant (`collision_messages`), never tested
-//! again until one of them wakes.
+//! reshaped, stripped of its collider or of its `Static` marker (made a body that falls), made
+//! a sensor (or solid again), or gave new layers, friction or restitution, the sleepers
+//! jointed to such a static, and a sleeper that lost its collider or became a sensor (its
+//! island wakes with it). Without it, a box asleep on a floor the game moved down by a metre
+//! hung in the air, as it did on a floor whose collider was removed or that became a sensor
+//! (and, two steps long, on a floor made dynamic): the pair of a sleeper and a static body is
+//! dormant (`collision_messages`), never tested again until one of them wakes.
 //!
 //! The statics written to are found among the *unsettled* ones only (`settle`: a write takes a
 //! static's marker off before this runs), so a level of a million untouched statics costs no
@@ -39,7 +40,11 @@ pub(crate) type SceneryWritten = (
 pub(crate) fn wake_on_scenery_changes(
     written: Query<Entity, SceneryWritten>,
     made_sensors: Query<Entity, Added<Sensor>>,
-    (mut uncollided, mut unsensed): (RemovedComponents<Collider>, RemovedComponents<Sensor>),
+    (mut uncollided, mut unsensed, mut unfixed): (
+        RemovedComponents<Collider>,
+        RemovedComponents<Sensor>,
+        RemovedComponents<Static>,
+    ),
     touching: Option<Res<TouchingPairs>>,
     joints: Query<&Joint, ActiveJoint>,
     mut sleepers: Query<&mut SleepState, With<Sleeping>>,
@@ -48,7 +53,12 @@ pub(crate) fn wake_on_scenery_changes(
 ) {
     changed.clear();
     changed.extend(written.iter().chain(made_sensors.iter()));
-    changed.extend(uncollided.read().chain(unsensed.read()));
+    changed.extend(
+        uncollided
+            .read()
+            .chain(unsensed.read())
+            .chain(unfixed.read()),
+    );
     if changed.is_empty() {
         return;
     }

@@ -1,6 +1,6 @@
-//! What a game does to what sleepers rest on: a static floor moved, tilted, stripped of its
-//! collider or made a sensor, and a sleeper in a stack stripped of its collider, wake the
-//! sleepers it held (`src/plugins/wake_on_scenery.rs`).
+//! What a game does to what sleepers rest on: a static floor moved, tilted, made dynamic,
+//! stripped of its collider or made a sensor, and a sleeper in a stack stripped of its
+//! collider, wake the sleepers it held (`src/plugins/wake_on_scenery.rs`).
 
 use super::*;
 
@@ -85,4 +85,24 @@ fn the_middle_box_of_a_sleeping_stack_losing_its_collider_lets_the_top_one_fall_
     let top = z(&app, boxes[2]);
     assert!((top - 1.5).abs() < 0.01, "top box at z = {top}");
     assert!(z(&app, boxes[1]) < -1.0, "the middle one falls through");
+}
+
+/// The slab under a sleeping box made a dynamic body by the game (its `Static` taken off, a
+/// `Velocity` and a `Mass` given): both fall, the box on it. Before (a user-style probe), the
+/// box slept on in the air for two steps while the slab fell away, and met it again 28 cm
+/// later, at 5.5 m/s.
+#[test]
+fn a_box_asleep_on_a_slab_made_dynamic_falls_with_it_within_1_mm_for_1_s() {
+    let (mut app, slab, b) = box_asleep_on_a_slab(0.5);
+    app.world_mut()
+        .entity_mut(slab)
+        .remove::<Static>()
+        .insert((Velocity::default(), Mass(100.0)));
+    let rest = z(&app, b) - z(&app, slab);
+    for step in 1..=60 {
+        urto::step(app.world_mut(), 1).unwrap();
+        let gap = z(&app, b) - z(&app, slab) - rest;
+        assert!(gap.abs() < 1e-3, "step {step}: gap {gap}");
+    }
+    assert!(z(&app, slab) < -4.0, "the slab fell");
 }
