@@ -357,6 +357,29 @@ impl Shape {
             Self::TriMesh(m) => m.bounding_radius(),
         }
     }
+
+    /// Radius of the largest origin-centred ball inside the shape (a lower bound for a cone;
+    /// 0 for a half-space, whose boundary holds the origin, and for a triangle mesh, whose
+    /// inside is not known). What a body's turning cannot move: continuous collision reads a
+    /// thin body (a plank, a bat, a stick) turning by more than its thickness a substep as
+    /// fast, whatever its speed.
+    pub fn inner_radius(&self) -> f32 {
+        match self {
+            Self::Sphere(s) => s.radius,
+            Self::Cuboid(c) => c.half_extents.min_element(),
+            Self::HalfSpace(_) | Self::TriMesh(_) => 0.0,
+            Self::Capsule(c) => c.radius,
+            Self::Cylinder(c) => c.radius.min(c.half_height),
+            // The base at `half_height`, the side `r h / √(r² + 4h²)` from the centre.
+            Self::Cone(c) => {
+                let (r, h) = (c.radius, c.half_height);
+                let side = r * h / (r * r + 4.0 * h * h).sqrt();
+                if side.is_finite() { side.min(h) } else { 0.0 }
+            }
+            Self::Ellipsoid(e) => e.radii.min_element(),
+            Self::ConvexHull(h) => h.inner_radius(),
+        }
+    }
 }
 
 /// The two numbers of a capsule, cylinder or cone: a radius and a half length, each finite and
@@ -452,5 +475,53 @@ mod tests {
                 assert!((aabb.min.dot(axis) - lo).abs() < 1e-5, "{k}: {aabb:?} {lo}");
             }
         }
+    }
+
+    /// Every convex shape's inner radius against its support function `h(d) = max x·d`
+    /// sampled over the axes, a hull's face normals and 4,000 directions: never above `min h` (the ball is inside), and within 1 %
+    /// of it (the largest such ball; the cone's side is exact as well).
+    #[test]
+    fn inner_radii_are_the_least_support_distance_within_1_percent() {
+        use crate::geometry::convex::support::ConvexPart;
+        let hull = Shape::convex_hull(&[
+            Vec3::new(0.5, 0.2, 0.1),
+            Vec3::new(-0.4, 0.3, 0.2),
+            Vec3::new(0.1, -0.5, 0.15),
+            Vec3::new(0.0, 0.1, -0.3),
+            Vec3::new(-0.1, -0.2, 0.4),
+        ])
+        .unwrap();
+        let shapes = [
+            Shape::sphere(0.3),
+            Shape::cuboid(Vec3::new(0.5, 0.1, 0.3)),
+            Shape::capsule(0.5, 0.02),
+            Shape::cylinder(0.05, 0.4),
+            Shape::cone(0.5, 0.2),
+            Shape::cone(0.1, 0.6),
+            Shape::ellipsoid(Vec3::new(0.3, 0.08, 0.2)),
+            hull,
+        ];
+        let mut rng = crate::test_rng::TestRng::new(5);
+        for shape in &shapes {
+            let part = ConvexPart::of_shape(shape, Isometry::IDENTITY).unwrap();
+            let mut axes: Vec<Vec3> = [Vec3::X, Vec3::Y, Vec3::Z]
+                .into_iter()
+                .flat_map(|a| [a, -a])
+                .collect();
+            if let Shape::ConvexHull(h) = shape {
+                axes.extend(h.faces().iter().map(|f| f.normal));
+            }
+            let random = (0..4000).map(|_| rng.vec3(-1.0, 1.0).normalize_or(Vec3::Z));
+            let least = axes
+                .into_iter()
+                .chain(random)
+                .map(|d| part.support(d).dot(d) + part.rounding)
+                .fold(f32::INFINITY, f32::min);
+            let inner = shape.inner_radius();
+            assert!(inner <= least + 1e-6, "{shape:?}: {inner} > {least}");
+            assert!(inner >= 0.99 * least, "{shape:?}: {inner} < {least}");
+        }
+        assert_eq!(Shape::half_space(Vec3::Z).inner_radius(), 0.0);
+        assert_eq!(Shape::cone(0.0, 0.0).inner_radius(), 0.0);
     }
 }
