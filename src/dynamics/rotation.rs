@@ -13,11 +13,11 @@
 //! How each [`Integrator`] treats rotation:
 //! - with the gyroscopic term, the **Euler methods and velocity Verlet** split the step into
 //!   torque kicks (`L += τ dt`) and the torque-free flow of [`FreeBody`](super::free_rotation)
-//!   (McLachlan's splitting: exact angular momentum, bounded energy error): drift then kick
-//!   (explicit), kick then drift (symplectic), half kick, drift, half kick (Verlet). The plain
-//!   explicit update of `ω × Iω` gains energy until the body spins about its axis of least
-//!   inertia, and the implicit one (Catto, "Numerical Methods", GDC 2015) loses momentum: both
-//!   fail a free tumbling box;
+//!   (a splitting about a symmetric body: exact angular momentum, bounded energy error): drift
+//!   then kick (explicit), kick then drift (symplectic), half kick, drift, half kick (Verlet).
+//!   The plain explicit update of `ω × Iω` gains energy until the body spins about its axis of
+//!   least inertia, and the implicit one (Catto, "Numerical Methods", GDC 2015) loses
+//!   momentum: both fail a free tumbling box;
 //! - without it (or with an axis locked or of infinite inertia) the Euler methods update `ω` by
 //!   the torque alone and turn by the old (explicit) or new (symplectic) one, and velocity
 //!   Verlet takes the explicit midpoint rule on `(q, ω)`;

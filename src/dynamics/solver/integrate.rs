@@ -28,7 +28,7 @@ pub(super) fn integrate_velocities(bodies: &mut SolverBodies, h: f32) {
 /// `max_speed`), and `dq` turned by `h ω` (the linearised quaternion update, renormalised, as
 /// Box2D; at most `max_rotation` per substep, for every body). A gyroscopic body turning
 /// noticeably instead follows the free rigid body's exact flow for `h` ([`FreeBody`]:
-/// McLachlan's splitting, momentum exact), which also updates `ω`.
+/// a splitting about a symmetric body, momentum exact), which also updates `ω`.
 pub(super) fn integrate_positions(
     bodies: &mut SolverBodies,
     h: f32,
