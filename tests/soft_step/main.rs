@@ -9,6 +9,7 @@ mod bounces_and_springs;
 mod games;
 mod platforms;
 mod rolling;
+mod thin_bodies;
 
 use bevy_app::App;
 use bevy_ecs::prelude::*;

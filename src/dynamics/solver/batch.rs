@@ -160,6 +160,34 @@ impl ContactBatches {
         }
     }
 
+    /// Takes the rows of the constraints `rebuilt` names (their bodies turned within the step,
+    /// `turned_rows.rs`) into their lanes; friction per patch keeps the step's rows.
+    pub fn refresh_rows(
+        &mut self,
+        constraints: &[ContactConstraint],
+        rebuilt: impl Fn(usize) -> bool,
+    ) {
+        for (batch, members) in self.batches.iter().zip(&self.members) {
+            for (lane, index) in members.iter().enumerate() {
+                let Some(index) = index.filter(|&i| rebuilt(i as usize)) else {
+                    continue;
+                };
+                let points = constraints[index as usize].points();
+                let wide = &mut self.points[batch.range(batch.first)];
+                for (wide, point) in wide.iter_mut().zip(points) {
+                    wide.normal_row.set_lane(lane, &point.normal_row);
+                }
+                if let FrictionRows::PerPoint(from) = batch.rows {
+                    let wide = &mut self.frictions[batch.range(from)];
+                    for (wide, point) in wide.iter_mut().zip(points) {
+                        wide.rows[0].set_lane(lane, &point.tangent_rows[0]);
+                        wide.rows[1].set_lane(lane, &point.tangent_rows[1]);
+                    }
+                }
+            }
+        }
+    }
+
     /// Applies the accumulated impulses ([`ContactConstraint::warm_start`] per lane).
     pub fn warm_start(&self, states: &mut [BodyState]) {
         for batch in &self.batches {

@@ -13,7 +13,7 @@
 
 use super::contact::{ConstraintPoint, PointRow, RowPart, on_moving};
 use super::contact_pair::SLIDING_FROM;
-use super::lanes::{LANES, Lanes, PairVelocities, Vec3x4};
+use super::lanes::{LANES, Lanes, PairVelocities, Vec3x4, set_lane};
 use super::patch_friction::PatchFriction;
 use crate::geometry::MAX_MANIFOLD_POINTS;
 use glam::Vec3;
@@ -47,6 +47,13 @@ pub(super) struct PointRowX4 {
 }
 
 impl PointRowX4 {
+    /// Puts `row` in lane `lane` (a row rebuilt during a step, `turned_rows.rs`).
+    pub fn set_lane(&mut self, lane: usize, row: &PointRow) {
+        self.turn[0].set_lane(lane, row.turn[0]);
+        self.turn[1].set_lane(lane, row.turn[1]);
+        set_lane(&mut self.mass, lane, row.mass);
+    }
+
     fn gather(rows: [&PointRow; LANES]) -> Self {
         let side = |part: fn(&PointRow) -> Vec3| Vec3x4::gather(rows.map(part));
         Self {

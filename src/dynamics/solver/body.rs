@@ -136,6 +136,9 @@ pub struct SolverBodies {
     pub centers: Vec<Vec3>,
     /// Orientations at the step's start.
     pub orientations: Vec<Quat>,
+    /// The slots of the bodies that turn with the gyroscopic term ([`BodyParams::gyroscopic`]),
+    /// whose inertia turns with them (`turned_rows.rs`).
+    pub gyroscopic: Vec<u32>,
 }
 
 /// Whether the three principal moments are equal (a ball, a cube): then `ω × Iω = 0` and the
@@ -154,12 +157,17 @@ fn isotropic(inverse_moments: Vec3) -> bool {
 /// may differ in the sign of its zero), at a third of
 /// the instructions (every awake body's gather computes it once a step).
 fn world_inverse_inertia(b: &BodyInput) -> Mat3 {
-    let r = Mat3::from_quat(b.orientation * b.inertia_frame);
-    let d = b.inverse_principal_inertia;
-    let rd = Mat3::from_cols(r.x_axis * d.x, r.y_axis * d.y, r.z_axis * d.z);
-    let m = rd * r.transpose();
+    let m = free_inverse_inertia(b.orientation, b.inertia_frame, b.inverse_principal_inertia);
     let f = b.free_axes;
     Mat3::from_cols(m.x_axis * f * f.x, m.y_axis * f * f.y, m.z_axis * f * f.z)
+}
+
+/// The world inverse inertia `R D Rᵀ` of a body free to turn about every axis, at
+/// `orientation`, its principal axes at `frame` in its frame with inverse moments `d`.
+pub(super) fn free_inverse_inertia(orientation: Quat, frame: Quat, d: Vec3) -> Mat3 {
+    let r = Mat3::from_quat(orientation * frame);
+    let rd = Mat3::from_cols(r.x_axis * d.x, r.y_axis * d.y, r.z_axis * d.z);
+    rd * r.transpose()
 }
 
 impl SolverBodies {
@@ -169,6 +177,7 @@ impl SolverBodies {
         self.params.clear();
         self.centers.clear();
         self.orientations.clear();
+        self.gyroscopic.clear();
     }
 
     /// Number of bodies.
@@ -231,6 +240,9 @@ impl SolverBodies {
                 && !isotropic(b.inverse_principal_inertia))
             .then_some((b.inertia_frame, b.inverse_principal_inertia)),
         });
+        if self.params[slot as usize].gyroscopic.is_some() {
+            self.gyroscopic.push(slot);
+        }
         self.centers.push(b.center);
         self.orientations.push(b.orientation);
         slot

@@ -439,6 +439,34 @@ impl ContactConstraint {
         });
     }
 
+    /// The rows again with the bodies' inverse inertias as `params` hold them now (a body
+    /// that turned within the step, `turned_rows.rs`): the anchors, directions and impulses
+    /// stay. Friction per patch keeps the step's rows.
+    pub fn refresh_rows(&mut self, params: &[BodyParams]) {
+        let (pa, pb) = (&params[self.a as usize], &params[self.b as usize]);
+        let w = self.inverse_mass[0] + self.inverse_mass[1];
+        let uniform = same_on_every_axis(w);
+        let along = |d: Vec3| (d, if uniform { w.x } else { w.dot(d * d) });
+        let (normal, sides) = (along(self.normal), self.tangents.map(along));
+        let per_point = self.patch.is_none();
+        for cp in &mut self.points[..self.count as usize] {
+            let (ra, rb) = (cp.anchor_a, cp.anchor_b);
+            cp.normal_row = RowPart::new(pa, pb, ra, rb, normal).into();
+            if per_point {
+                cp.tangent_rows = [
+                    RowPart::new(pa, pb, ra, rb, sides[0]).into(),
+                    RowPart::new(pa, pb, ra, rb, sides[1]).into(),
+                ];
+            }
+        }
+        if self.rolling.arm > 0.0 {
+            let impulse = self.rolling.impulse;
+            let inertia = [pa.inverse_inertia, pb.inverse_inertia];
+            self.rolling = RollingRows::new(self.rolling.arm, self.tangents, inertia);
+            self.rolling.impulse = impulse;
+        }
+    }
+
     /// The used points.
     pub fn points(&self) -> &[ConstraintPoint] {
         &self.points[..self.count as usize]

@@ -59,6 +59,13 @@ impl Vec3x4 {
         }
     }
 
+    /// Puts `v` in lane `i` (a row rebuilt during a step, `turned_rows.rs`).
+    pub fn set_lane(&mut self, i: usize, v: Vec3) {
+        set_lane(&mut self.x, i, v.x);
+        set_lane(&mut self.y, i, v.y);
+        set_lane(&mut self.z, i, v.z);
+    }
+
     /// The vector of lane `i`.
     pub fn lane(&self, i: usize) -> Vec3 {
         Vec3::new(
@@ -186,6 +193,13 @@ impl Quatx4 {
         }
         .rotate(r)
     }
+}
+
+/// Puts `x` in lane `i` of `lanes`.
+pub fn set_lane(lanes: &mut Lanes, i: usize, x: f32) {
+    let mut all = lanes.to_array();
+    all[i] = x;
+    *lanes = Lanes::new(all);
 }
 
 /// The items at `indices` one per lane (`None` past them), and the first: `None` for no

@@ -82,6 +82,7 @@ pub mod point_rows;
 pub mod rolling;
 pub mod row;
 pub mod softness;
+mod turned_rows;
 pub mod warm_start;
 
 #[cfg(test)]
@@ -108,6 +109,7 @@ use glam::Vec3;
 use integrate::{capped, integrate_positions, integrate_velocities};
 use joint_list::JointList;
 use ordered_batches::OrderedBatches;
+use turned_rows::TurnedRows;
 
 /// How many times the speed and spin bounds a joint's carried impulses may change a body's
 /// velocity by: a sound joint's impulse reverses at most a body's whole velocity (from `+v` to
@@ -264,6 +266,8 @@ pub struct Solver {
     joints: JointList,
     /// The last step's substep (s).
     substep: f32,
+    /// The rows of bodies that turn within the step, rebuilt as they turn.
+    turned_rows: TurnedRows,
 }
 
 impl Solver {
@@ -323,6 +327,7 @@ impl Solver {
         let inv_h = 1.0 / h;
         self.substep = h;
         self.prepare(bodies, contacts, (h, dt));
+        self.turned_rows.begin(bodies);
         self.prepare_joints(bodies, joints, inv_h);
         let joint_soft = Softness::new(s.joint_hertz, s.joint_damping_ratio, h);
         self.stabilise_springs(bodies, springs, h);
@@ -345,6 +350,8 @@ impl Solver {
             self.solve_contacts(bodies, inv_h, true, (flip, share));
             integrate_positions(bodies, h, s.max_rotation_per_substep, s.max_linear_speed);
             self.joints.refresh(&bodies.states);
+            let (constraints, batches) = (&mut self.constraints, &mut self.batches);
+            self.turned_rows.refresh(bodies, constraints, batches);
             for pass in 0..s.relax_iterations.max(s.joint_relax_iterations) {
                 if pass < s.joint_relax_iterations {
                     self.solve_joints(bodies, joint_soft, h, false);
