@@ -133,6 +133,14 @@ impl JointExtra {
         })
     }
 
+    /// The lock's inverse effective mass again, from `masses` as they are now (a body that
+    /// turned within the step, `turned_rows.rs`).
+    pub(super) fn take_masses(&mut self, masses: &PairMasses) {
+        if matches!(self.kind, JointKind::Fixed | JointKind::Prismatic { .. }) {
+            self.lock_inverse_mass = AngularRows::world().inverse_mass(masses);
+        }
+    }
+
     /// Takes the rows where bodies `sa`, `sb` are now, with the joint's `point` rows there;
     /// a limit row without an impulse `j` or a motor leaves its pivot pending.
     pub(super) fn refresh(

@@ -8,7 +8,7 @@
 //! would; the other joints are solved one at a time after the batches, in the order given
 //! (the ECS gives them by key).
 
-use super::body::{BodyState, SolverBodies};
+use super::body::{BodyParams, BodyState, SolverBodies};
 use super::joint::{HeldLoad, JointConstraint, JointImpulses, JointInput};
 use super::joint_batch::JointBatch;
 use super::joint_extra::{JointExtra, Pass};
@@ -217,6 +217,24 @@ impl JointList {
                 self.extras[x as usize].solve(&pass, states, &mut joint.impulses);
             }
             joint.solve_point(states, soft, use_bias);
+        }
+    }
+
+    /// Takes the inverse inertias `params` hold now into the joints solved one at a time
+    /// whose bodies `turned` says turned within the step (`turned_rows.rs`); [`Self::refresh`]
+    /// then builds their rows with them. The free ball joints solved four at a time keep the
+    /// step's: a ball joint's point rows gained no energy from it (the fourth probe's rods).
+    pub(super) fn take_turned_inertia(&mut self, params: &[BodyParams], turned: &[bool]) {
+        for &i in self.batching.one_by_one() {
+            let joint = &mut self.joints[i as usize];
+            let (a, b) = joint.slots();
+            if !(turned[a] || turned[b]) {
+                continue;
+            }
+            joint.masses.fill(params, a, b);
+            if let Some(x) = joint.extra {
+                self.extras[x as usize].take_masses(&joint.masses);
+            }
         }
     }
 

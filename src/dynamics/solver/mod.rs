@@ -349,9 +349,12 @@ impl Solver {
             self.solve_joints(bodies, joint_soft, h, true);
             self.solve_contacts(bodies, inv_h, true, (flip, share));
             integrate_positions(bodies, h, s.max_rotation_per_substep, s.max_linear_speed);
-            self.joints.refresh(&bodies.states);
             let (constraints, batches) = (&mut self.constraints, &mut self.batches);
-            self.turned_rows.refresh(bodies, constraints, batches);
+            if self.turned_rows.refresh(bodies, constraints, batches) {
+                let turned = self.turned_rows.turned();
+                self.joints.take_turned_inertia(&bodies.params, turned);
+            }
+            self.joints.refresh(&bodies.states);
             for pass in 0..s.relax_iterations.max(s.joint_relax_iterations) {
                 if pass < s.joint_relax_iterations {
                     self.solve_joints(bodies, joint_soft, h, false);

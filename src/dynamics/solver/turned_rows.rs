@@ -15,9 +15,11 @@
 //! After each substep's move, a gyroscopic body (free to turn, moments not all equal) whose
 //! turn since its rows were built, times its moments' ratio less one, exceeds
 //! [`STALE_ROW_BOUND`] takes its world inverse inertia where it is now, and the rows of its
-//! contacts are rebuilt (anchors, directions and accumulated impulses kept). A scene without
-//! such bodies pays one check of an empty list a substep; a cube or a ball never has one.
-//! Friction per patch and the joints keep the step's rows.
+//! contacts are rebuilt (anchors, directions and accumulated impulses kept), as are the
+//! rows of its joints solved one at a time (a thin capsule on a hinge, spun at 30 rad/s,
+//! gained up to 2,000 times its energy). A scene without such bodies pays one check of an
+//! empty list a substep; a cube or a ball never has one. Friction per patch and the free
+//! ball joints solved four at a time keep the step's rows.
 
 use super::ContactConstraint;
 use super::batch::ContactBatches;
@@ -52,15 +54,16 @@ impl TurnedRows {
         }
     }
 
-    /// Rebuilds the rows of the bodies that turned past [`STALE_ROW_BOUND`] (module docs).
+    /// Rebuilds the rows of the bodies that turned past [`STALE_ROW_BOUND`] (module docs);
+    /// true when some did ([`Self::turned`] says which).
     pub fn refresh(
         &mut self,
         bodies: &mut SolverBodies,
         constraints: &mut [ContactConstraint],
         batches: &mut ContactBatches,
-    ) {
+    ) -> bool {
         if self.bodies.is_empty() {
-            return;
+            return false;
         }
         self.turned.clear();
         self.turned.resize(bodies.len(), false);
@@ -80,7 +83,7 @@ impl TurnedRows {
             any = true;
         }
         if !any {
-            return;
+            return false;
         }
         self.rebuilt.clear();
         for c in constraints.iter_mut() {
@@ -92,5 +95,11 @@ impl TurnedRows {
         }
         let rebuilt = &self.rebuilt;
         batches.refresh_rows(constraints, |k| rebuilt[k]);
+        true
+    }
+
+    /// Per body slot: whether the last [`Self::refresh`] took its inertia anew.
+    pub fn turned(&self) -> &[bool] {
+        &self.turned
     }
 }
