@@ -466,29 +466,10 @@ fn a_translation_locked_bullet_bounces_off_a_tilted_wall_without_leaving_its_axi
 #[test]
 fn thin_bodies_spinning_at_150_rad_s_never_pass_a_1cm_wall() {
     let mut rng = Rng::new(29);
-    let shapes = [
-        Collider::cuboid(0.5, 0.5, 0.005),
-        Collider::capsule(0.5, 0.01),
-        Collider::cuboid(0.5, 0.01, 0.01),
-    ];
-    for shape in &shapes {
+    for shape in &common::thin_bodies() {
         for speed in [5.0, 20.0] {
             for throw in 0..40 {
-                let mut app = common::app();
-                app.insert_resource(Gravity::new(Vec3::ZERO).unwrap());
-                wall(&mut app, false);
-                let start = Vec3::new(3.6 - speed / 60.0 * rng.unit(), rng.range(-0.5, 0.5), 0.0);
-                let body = app
-                    .world_mut()
-                    .spawn((
-                        shape.clone(),
-                        Position(start),
-                        Rotation(rng.rotation()),
-                        Velocity(Vec3::X * speed),
-                        AngularVelocity(rng.direction() * 150.0),
-                        Density(500.0),
-                    ))
-                    .id();
+                let (mut app, body) = common::thrown_spinning(shape, (speed, 150.0), &mut rng);
                 urto::step(app.world_mut(), 60).unwrap();
                 let x = app.world().get::<Position>(body).unwrap().0.x;
                 assert!(x < 5.0, "{shape:?} at {speed} m/s, throw {throw}: x = {x}");

@@ -184,3 +184,45 @@ pub fn legacy_app_with(dt: f32, substeps: u32) -> App {
     );
     app
 }
+
+/// The thin bodies of the spinning-throw tests, all 1 m across: a plate 1 cm thick, a
+/// capsule and a stick 2 cm thick.
+pub fn thin_bodies() -> [Collider; 3] {
+    [
+        Collider::cuboid(0.5, 0.5, 0.005),
+        Collider::capsule(0.5, 0.01),
+        Collider::cuboid(0.5, 0.01, 0.01),
+    ]
+}
+
+/// An app without gravity in which `shape` (density 500) flies along +x at `speed` from
+/// about x = 3.6 (a random share of a step's travel back, up to 0.5 m off the axis) at a wall
+/// 1 cm thick across x = 5 (restitution 0.5), turned at random and spinning at `spin` rad/s
+/// about a random axis; the app and the body.
+pub fn thrown_spinning(
+    shape: &Collider,
+    (speed, spin): (f32, f32),
+    rng: &mut rng::Rng,
+) -> (App, bevy_ecs::entity::Entity) {
+    let mut app = app();
+    app.insert_resource(Gravity::new(Vec3::ZERO).unwrap());
+    app.world_mut().spawn((
+        Collider::cuboid(0.005, 10.0, 10.0),
+        Position::new(5.0, 0.0, 0.0),
+        Static,
+        Restitution(0.5),
+    ));
+    let start = Vec3::new(3.6 - speed / 60.0 * rng.unit(), rng.range(-0.5, 0.5), 0.0);
+    let body = app
+        .world_mut()
+        .spawn((
+            shape.clone(),
+            Position(start),
+            Rotation(rng.rotation()),
+            Velocity(Vec3::X * speed),
+            AngularVelocity(rng.direction() * spin),
+            Density(500.0),
+        ))
+        .id();
+    (app, body)
+}
