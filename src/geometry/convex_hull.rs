@@ -192,21 +192,6 @@ impl ConvexHull {
     pub fn bounding_radius(&self) -> f32 {
         self.bounding_radius
     }
-
-    /// Radius of the largest origin-centred ball inside the hull: its nearest face plane (0
-    /// when the origin is outside the hull).
-    pub fn inner_radius(&self) -> f32 {
-        let nearest = self
-            .faces
-            .iter()
-            .map(|f| f.offset)
-            .fold(f32::INFINITY, f32::min);
-        if nearest.is_finite() {
-            nearest.max(0.0)
-        } else {
-            0.0
-        }
-    }
 }
 
 /// The index in `0..n` with the largest `key` (the first on a tie, 0 if none or all NaN).

@@ -377,7 +377,19 @@ impl Shape {
                 if side.is_finite() { side.min(h) } else { 0.0 }
             }
             Self::Ellipsoid(e) => e.radii.min_element(),
-            Self::ConvexHull(h) => h.inner_radius(),
+            // The nearest face plane (0 when the origin is outside the hull).
+            Self::ConvexHull(h) => {
+                let nearest = h
+                    .faces()
+                    .iter()
+                    .map(|f| f.offset)
+                    .fold(f32::INFINITY, f32::min);
+                if nearest.is_finite() {
+                    nearest.max(0.0)
+                } else {
+                    0.0
+                }
+            }
         }
     }
 }
