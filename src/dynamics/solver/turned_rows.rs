@@ -9,7 +9,8 @@
 //! In 2D the inertia is a number and this never arises; in 3D a thin rod's moments differ by
 //! a thousand times. The fourth probe threw a capsule 1 m long and 2 cm thick, spinning at
 //! 30 rad/s, at a wall: the rows fixed for the step spun it about its length by hundreds of
-//! rad/s, and it left with up to 30 times the energy it came with (a stick 135 times).
+//! rad/s, and it left with up to 30 times the energy it came with (135 times before the
+//! stop's fix of the free flight, `free_rotation.rs`).
 //!
 //! # What
 //! After each substep's move, a gyroscopic body (free to turn, moments not all equal) whose
