@@ -25,7 +25,7 @@
 use super::hull_lanes::{SCANNED_VERTICES, SupportLanes};
 use super::predicates::orient3d;
 use super::shapes::MAX_SHAPE_EXTENT;
-use super::{MeshError, TriMesh};
+use super::{MeshError, TriMesh, length_or_zero};
 use crate::bounding::Aabb;
 use glam::{DVec3, Vec3, Vec4};
 use std::fmt;
@@ -48,6 +48,8 @@ pub struct ConvexHull {
     /// The longest vertex, taken once: the manifold cache asks for it on every lookup of a
     /// hull pair.
     bounding_radius: f32,
+    /// The nearest face plane (0 with the origin outside), taken once as the longest vertex.
+    inner_radius: f32,
 }
 
 /// One face of a hull: a convex polygon in the plane `normal · x == offset`.
@@ -191,6 +193,11 @@ impl ConvexHull {
     /// Radius of the smallest origin-centred ball holding the hull (its longest vertex).
     pub fn bounding_radius(&self) -> f32 {
         self.bounding_radius
+    }
+
+    /// Radius of the largest origin-centred ball inside the hull (asked for every substep).
+    pub fn inner_radius(&self) -> f32 {
+        self.inner_radius
     }
 }
 
@@ -555,6 +562,7 @@ impl<'a> Builder<'a> {
         let hull = ConvexHull {
             lanes: SupportLanes::new(&vertices),
             bounding_radius: vertices.iter().fold(0.0, |r, v| r.max(v.length())),
+            inner_radius: length_or_zero(faces.iter().fold(f32::INFINITY, |r, f| r.min(f.offset))),
             vertices,
             faces,
             face_indices,

@@ -9,7 +9,7 @@
 
 use crate::bounding::Aabb;
 use crate::geometry::convex::support::LINE_FEATURE_SINE;
-use crate::geometry::{ConvexHull, Isometry, MeshCollider};
+use crate::geometry::{ConvexHull, Isometry, MeshCollider, length_or_zero};
 use glam::{Quat, Vec3};
 use std::fmt;
 use std::sync::Arc;
@@ -373,23 +373,10 @@ impl Shape {
             // The base at `half_height`, the side `r h / √(r² + 4h²)` from the centre.
             Self::Cone(c) => {
                 let (r, h) = (c.radius, c.half_height);
-                let side = r * h / (r * r + 4.0 * h * h).sqrt();
-                if side.is_finite() { side.min(h) } else { 0.0 }
+                length_or_zero(r * h / (r * r + 4.0 * h * h).sqrt()).min(h)
             }
             Self::Ellipsoid(e) => e.radii.min_element(),
-            // The nearest face plane (0 when the origin is outside the hull).
-            Self::ConvexHull(h) => {
-                let nearest = h
-                    .faces()
-                    .iter()
-                    .map(|f| f.offset)
-                    .fold(f32::INFINITY, f32::min);
-                if nearest.is_finite() {
-                    nearest.max(0.0)
-                } else {
-                    0.0
-                }
-            }
+            Self::ConvexHull(h) => h.inner_radius(),
         }
     }
 }
@@ -490,8 +477,9 @@ mod tests {
     }
 
     /// Every convex shape's inner radius against its support function `h(d) = max x·d`
-    /// sampled over the axes, a hull's face normals and 4,000 directions: never above `min h` (the ball is inside), and within 1 %
-    /// of it (the largest such ball; the cone's side is exact as well).
+    /// sampled over the axes, a hull's face normals and 4,000 directions: never above `min h`
+    /// (the ball is inside), and within 1 % of it (the largest such ball; the cone's side is
+    /// exact as well).
     #[test]
     fn inner_radii_are_the_least_support_distance_within_1_percent() {
         use crate::geometry::convex::support::ConvexPart;

@@ -261,6 +261,52 @@ fn friction_directions_locked(n: Vec3, w: Vec3) -> [Vec3; 2] {
     }
 }
 
+/// A contact's row directions with their translational parts `d·W d` (`W` the pair's per-axis
+/// `1/m`: `1/m_a + 1/m_b` itself without locks, bit for bit what the solver computed before it
+/// had per-axis masses), as [`RowPart::new`] takes them.
+struct RowDirections {
+    normal: (Vec3, f32),
+    sides: [(Vec3, f32); 2],
+}
+
+impl RowDirections {
+    #[inline(always)]
+    fn new(n: Vec3, tangents: [Vec3; 2], w: Vec3) -> Self {
+        let uniform = same_on_every_axis(w);
+        let along = |d: Vec3| (d, if uniform { w.x } else { w.dot(d * d) });
+        Self {
+            normal: along(n),
+            sides: tangents.map(along),
+        }
+    }
+
+    /// A point's normal row at anchors `r` on bodies `p`.
+    #[inline(always)]
+    fn normal_row(&self, [pa, pb]: [&BodyParams; 2], [ra, rb]: [Vec3; 2]) -> PointRow {
+        RowPart::new(pa, pb, ra, rb, self.normal).into()
+    }
+
+    /// A point's two tangent rows with friction per point (zero rows without).
+    #[inline(always)]
+    fn tangent_rows(
+        &self,
+        [pa, pb]: [&BodyParams; 2],
+        [ra, rb]: [Vec3; 2],
+        per_point: bool,
+    ) -> [PointRow; 2] {
+        // Written out, not `sides.map(..)`: the map's closure was not inlined and read its
+        // side back through memory, stalled on the stores that wrote it.
+        if per_point {
+            [
+                RowPart::new(pa, pb, ra, rb, self.sides[0]).into(),
+                RowPart::new(pa, pb, ra, rb, self.sides[1]).into(),
+            ]
+        } else {
+            [PointRow::default(); 2]
+        }
+    }
+}
+
 /// Restitution within `0..=1`; a non-finite value (which would fling both bodies to infinity)
 /// is 0, and more than 1 (a bounce that gains energy) is 1.
 fn sane_restitution(e: f32) -> f32 {
@@ -365,8 +411,7 @@ impl ContactConstraint {
         } else {
             friction_directions_locked(n, w)
         };
-        let along = |d: Vec3| (d, if uniform { w.x } else { w.dot(d * d) });
-        let (normal, sides) = (along(n), tangents.map(along));
+        let directions = RowDirections::new(n, tangents, w);
         let count = (input.count as usize).min(MAX_MANIFOLD_POINTS);
         let per_point = model == FrictionModel::PerPoint;
         let still = [(pa, ia), (pb, ib)].map(|(p, i)| !p.dynamic && at_rest(&states[i]));
@@ -382,17 +427,8 @@ impl ContactConstraint {
                 anchor_a: ra,
                 anchor_b: rb,
                 base_separation: p.separation - (gap_arms[1] - gap_arms[0]).dot(n),
-                normal_row: RowPart::new(pa, pb, ra, rb, normal).into(),
-                // Written out, not `sides.map(..)`: the map's closure was not inlined and read
-                // its side back through memory, stalled on the stores that wrote it.
-                tangent_rows: if per_point {
-                    [
-                        RowPart::new(pa, pb, ra, rb, sides[0]).into(),
-                        RowPart::new(pa, pb, ra, rb, sides[1]).into(),
-                    ]
-                } else {
-                    [PointRow::default(); 2]
-                },
+                normal_row: directions.normal_row([pa, pb], [ra, rb]),
+                tangent_rows: directions.tangent_rows([pa, pb], [ra, rb], per_point),
                 tangent_drift: match &drift {
                     Some(drift) if per_point => drift.at(ra, rb, relative),
                     _ => [0.0; 2],
@@ -433,7 +469,7 @@ impl ContactConstraint {
                 [pa, pb],
                 &points[..count],
                 [centers[ia], centers[ib]],
-                (n, sides),
+                (n, directions.sides),
                 drift.as_ref(),
             )
         });
@@ -445,18 +481,13 @@ impl ContactConstraint {
     pub fn refresh_rows(&mut self, params: &[BodyParams]) {
         let (pa, pb) = (&params[self.a as usize], &params[self.b as usize]);
         let w = self.inverse_mass[0] + self.inverse_mass[1];
-        let uniform = same_on_every_axis(w);
-        let along = |d: Vec3| (d, if uniform { w.x } else { w.dot(d * d) });
-        let (normal, sides) = (along(self.normal), self.tangents.map(along));
+        let directions = RowDirections::new(self.normal, self.tangents, w);
         let per_point = self.patch.is_none();
         for cp in &mut self.points[..self.count as usize] {
-            let (ra, rb) = (cp.anchor_a, cp.anchor_b);
-            cp.normal_row = RowPart::new(pa, pb, ra, rb, normal).into();
+            let anchors = [cp.anchor_a, cp.anchor_b];
+            cp.normal_row = directions.normal_row([pa, pb], anchors);
             if per_point {
-                cp.tangent_rows = [
-                    RowPart::new(pa, pb, ra, rb, sides[0]).into(),
-                    RowPart::new(pa, pb, ra, rb, sides[1]).into(),
-                ];
+                cp.tangent_rows = directions.tangent_rows([pa, pb], anchors, per_point);
             }
         }
         if self.rolling.arm > 0.0 {

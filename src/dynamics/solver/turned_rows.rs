@@ -25,18 +25,30 @@
 use super::ContactConstraint;
 use super::batch::ContactBatches;
 use super::body::{SolverBodies, free_inverse_inertia};
-use glam::Quat;
+use glam::{Quat, Vec3};
 
 /// How far a body's rows may drift before they are rebuilt: its turn since they were built
 /// (rad) times its largest over its smallest moment, less one.
 const STALE_ROW_BOUND: f32 = 0.05;
 
+/// A body whose rows may go stale.
+#[derive(Debug, Clone, Copy)]
+struct TurningBody {
+    slot: u32,
+    /// Principal frame and inverse moments (`BodyParams::gyroscopic`).
+    inertia: (Quat, Vec3),
+    /// Its largest over its smallest moment, less one.
+    ratio: f32,
+    /// Where it was when its rows were built.
+    built: Quat,
+}
+
 /// The step's gyroscopic bodies and the orientations their rows were built at.
 #[derive(Debug, Default, Clone)]
 pub struct TurnedRows {
-    /// Body slot, its moments' ratio less one, and the orientation of its rows.
-    bodies: Vec<(u32, f32, Quat)>,
-    /// Per body slot: rebuilt in this substep.
+    /// The bodies whose rows may go stale.
+    bodies: Vec<TurningBody>,
+    /// Per body slot: rebuilt in this substep (sized at the step's start, reset body by body).
     turned: Vec<bool>,
     /// Per constraint: rebuilt in this substep.
     rebuilt: Vec<bool>,
@@ -46,12 +58,19 @@ impl TurnedRows {
     /// Lists the step's bodies whose rows may go stale (at the step's start).
     pub fn begin(&mut self, bodies: &SolverBodies) {
         self.bodies.clear();
-        for &i in &bodies.gyroscopic {
-            if let Some((_, d)) = bodies.params[i as usize].gyroscopic {
-                let ratio = d.max_element() / d.min_element() - 1.0;
-                self.bodies
-                    .push((i, ratio, bodies.orientations[i as usize]));
+        for &slot in &bodies.gyroscopic {
+            if let Some((frame, d)) = bodies.params[slot as usize].gyroscopic {
+                self.bodies.push(TurningBody {
+                    slot,
+                    inertia: (frame, d),
+                    ratio: d.max_element() / d.min_element() - 1.0,
+                    built: bodies.orientations[slot as usize],
+                });
             }
+        }
+        self.turned.clear();
+        if !self.bodies.is_empty() {
+            self.turned.resize(bodies.len(), false);
         }
     }
 
@@ -66,19 +85,16 @@ impl TurnedRows {
         if self.bodies.is_empty() {
             return false;
         }
-        self.turned.clear();
-        self.turned.resize(bodies.len(), false);
         let mut any = false;
-        for (i, ratio, built) in &mut self.bodies {
-            let slot = *i as usize;
+        for body in &mut self.bodies {
+            let slot = body.slot as usize;
+            self.turned[slot] = false;
             let now = bodies.states[slot].delta_rotation * bodies.orientations[slot];
-            if now.angle_between(*built) * *ratio <= STALE_ROW_BOUND {
+            if now.angle_between(body.built) * body.ratio <= STALE_ROW_BOUND {
                 continue;
             }
-            let Some((frame, d)) = bodies.params[slot].gyroscopic else {
-                continue;
-            };
-            *built = now;
+            body.built = now;
+            let (frame, d) = body.inertia;
             bodies.params[slot].inverse_inertia = free_inverse_inertia(now, frame, d);
             self.turned[slot] = true;
             any = true;

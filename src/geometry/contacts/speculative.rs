@@ -43,10 +43,9 @@ fn rounded_grown(shape: &Shape, margin: f32) -> Option<Shape> {
 /// rounded one: a point on its grown edge or corner stands `(|n·x| + |n·y| + |n·z|) added`
 /// out along the normal from the true edge or corner it grew from (up to `√3 added`), so its
 /// depth shrinks by that, measured ([`grown_box_excess`], less [`RIM_EXCESS_SLACK`]); read as
-/// `added`, a cube landing
-/// on an edge saw 41 % of the margin as contact and came to rest that far above the floor
-/// (the fourth probe: up to 3.9 mm). The point is then pulled in across the normal to the
-/// true box, or the lever arms would be `added` too long.
+/// `added`, a cube landing on an edge saw 41 % of the margin as contact and came to rest that
+/// far above the floor (the fourth probe: up to 3.9 mm). The point is then pulled in across
+/// the normal to the true box, or the lever arms would be `added` too long.
 fn from_grown(
     m: ContactManifold,
     added: f32,
@@ -207,7 +206,7 @@ fn grown_box_contact(
 /// about 0.6° (`cos θ + sin θ − 1` below it) keeps the face's reading exactly, and a point on
 /// a grown edge or corner reads its true gap within this share of the margin. Measured to
 /// the full excess, the rounding of points metres up and the tilts of a resting stack came
-/// into every reading: the 20-box stack's drift went from 0.59 to 2.2 cm in 10 s.
+/// into every reading: the 20-box stack's drift went from 0.81 to 2.2 cm in 10 s.
 const RIM_EXCESS_SLACK: f32 = 0.01;
 
 /// How much deeper than the true shapes a grown box's contact may read before its points are
