@@ -101,7 +101,9 @@ pub mod reexports {
 pub mod math {
     pub use glam::{Mat3, Quat, Vec2, Vec3, Vec3A, Vec4};
 }
-pub use settings::{ContactSettings, Gravity, Integration, PhysicsTimestep, SettingsError};
+pub use settings::{
+    ContactSettings, Gravity, Integration, LengthUnit, PhysicsTimestep, SettingsError,
+};
 
 /// What a game needs in scope.
 #[cfg(feature = "ecs")]

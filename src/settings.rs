@@ -3,6 +3,7 @@
 
 use crate::dynamics::Integrator;
 use crate::dynamics::response::SolverSettings;
+use crate::dynamics::solver::SoftStepSettings;
 #[cfg(feature = "ecs")]
 use bevy_ecs::prelude::*;
 use glam::Vec3;
@@ -29,6 +30,8 @@ pub enum SettingsError {
     BadGravity(Vec3),
     /// A coefficient outside its range.
     BadCoefficient(&'static str, f32),
+    /// A length unit not finite or outside [`LengthUnit::RANGE`].
+    BadLengthUnit(f32),
 }
 
 impl fmt::Display for SettingsError {
@@ -44,11 +47,72 @@ impl fmt::Display for SettingsError {
             Self::BadCatchUp(n) => write!(f, "catch-up cap must be >= 1 step, got {n}"),
             Self::BadGravity(g) => write!(f, "gravity must be finite, got {g}"),
             Self::BadCoefficient(name, v) => write!(f, "{name} out of range: {v}"),
+            Self::BadLengthUnit(u) => {
+                let (lo, hi) = LengthUnit::RANGE;
+                write!(
+                    f,
+                    "length unit must be finite, >= {lo} and <= {hi}, got {u}"
+                )
+            }
         }
     }
 }
 
 impl std::error::Error for SettingsError {}
+
+/// The typical size of the scene's bodies, in the game's length unit (rapier's `length_unit`,
+/// Box2D's `lengthUnitsPerMeter`, Avian's `PhysicsLengthUnit`). The thresholds that are lengths
+/// or speeds are set for bodies about a metre across and read multiplied by it: the sleep speed
+/// ([`SleepSettings::speed`], and with it the window a body must stay in), the soft-step
+/// solver's restitution threshold, push-out speed, speed bound and warm-start distance
+/// ([`SoftStepSettings`]), and the speculative margin's fixed distance. Everything else is already in proportion to the bodies (the
+/// contacts' stiffness is a frequency, the margins follow the motion). The lecture's legacy
+/// pipeline ([`ContactSettings::solver`]) keeps its metres.
+///
+/// Default 1. A scene of 1 cm dice and marbles in metres takes 0.01: with 1, a 1 cm ball
+/// rolling one diameter a second fell asleep after half a diameter, and no drop below 5 cm
+/// bounced (the threshold is 1 m/s); a game measuring in centimetres takes 100.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "ecs", derive(Resource))]
+pub struct LengthUnit(f32);
+
+impl Default for LengthUnit {
+    fn default() -> Self {
+        Self(1.0)
+    }
+}
+
+impl LengthUnit {
+    /// The sizes accepted: a micrometre to a thousand kilometres in metres (beyond, the scaled
+    /// speed bound would near `f32`'s range).
+    pub const RANGE: (f32, f32) = (1e-6, 1e6);
+
+    /// Bodies about `size` across, in the game's unit.
+    pub fn new(size: f32) -> Result<Self, SettingsError> {
+        let (lo, hi) = Self::RANGE;
+        if (lo..=hi).contains(&size) {
+            Ok(Self(size))
+        } else {
+            Err(SettingsError::BadLengthUnit(size))
+        }
+    }
+
+    /// The size.
+    pub fn get(self) -> f32 {
+        self.0
+    }
+
+    /// The soft-step solver's settings with their lengths and speeds in this unit.
+    pub fn solver_settings(self, s: SoftStepSettings) -> SoftStepSettings {
+        SoftStepSettings {
+            max_push_out: s.max_push_out * self.0,
+            restitution_threshold: s.restitution_threshold * self.0,
+            warm_start_distance: s.warm_start_distance * self.0,
+            max_linear_speed: s.max_linear_speed * self.0,
+            ..s
+        }
+    }
+}
 
 /// The fixed step: `dt` seconds split into `substeps` equal substeps, and at most
 /// `max_steps_per_frame` steps run per frame in an `App` ("the frame rate is sacred").
@@ -212,7 +276,7 @@ impl Default for ContactSettings {
 pub struct SleepSettings {
     /// Whether bodies may fall asleep.
     pub enabled: bool,
-    /// The sleep speed (m/s): a still body stays within `speed × time` of where its current
+    /// The sleep speed (m/s for metre-sized bodies; read times the [`LengthUnit`]): a still body stays within `speed × time` of where its current
     /// window began (a net displacement: its average velocity below `speed`), its surface as it
     /// turns too, and moves slower than `4 × speed` at every step (Jolt's sleep test with a cap;
     /// see [`crate::dynamics::stillness`]). Also the approach speed at which a contact wakes a

@@ -14,7 +14,7 @@ use crate::schedule::{
     BroadPhaseSystems, PhysicsSchedule, PhysicsSet, SubstepSchedule, SubstepSet,
 };
 use crate::settings::SleepSettings;
-use crate::settings::{ContactSettings, Integration, PhysicsTimestep};
+use crate::settings::{ContactSettings, Integration, LengthUnit, PhysicsTimestep};
 use crate::stats::PhysicsStats;
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
@@ -42,6 +42,7 @@ impl Plugin for PhysicsCorePlugin {
         app.insert_required(move || ts)
             .init_required::<Integration>()
             .init_required::<ContactSettings>()
+            .init_required::<LengthUnit>()
             .init_required::<PhysicsStats>()
             .insert_resource(CoreInstalled);
         // What one stage writes and another reads belongs to neither: any stage can be

@@ -20,7 +20,7 @@ use crate::plugins::required_resources::RequireResource;
 use crate::plugins::sleep::{ContactSide, Waker, wakes};
 use crate::plugins::soft_step::legacy_solver;
 use crate::schedule::{SubstepSchedule, SubstepSet};
-use crate::settings::{ContactSettings, PhysicsTimestep, SleepSettings};
+use crate::settings::{ContactSettings, LengthUnit, PhysicsTimestep, SleepSettings};
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
 use bevy_ecs::entity::EntityHashMap;
@@ -98,6 +98,7 @@ fn resolve_contacts(
     mut buffers: ResMut<ResponseBuffers>,
     mut stats: ResMut<PhysicsStats>,
     mut waker: Waker,
+    length: Option<Res<LengthUnit>>,
 ) {
     if contacts.pairs.is_empty() {
         buffers.warm.clear();
@@ -115,7 +116,8 @@ fn resolve_contacts(
     let mu_of = |e: Entity| friction.get(e).map_or(settings.default_friction, |f| f.0);
     b.waking.clear();
     if let Some(sleep) = sleep.filter(|s| s.enabled) {
-        b.find_waking(&contacts.pairs, &bodies, sleep.speed);
+        let unit = length.map_or(1.0, |u| u.get());
+        b.find_waking(&contacts.pairs, &bodies, sleep.speed * unit);
     }
     let mut rank = 0u16;
     for (i, c) in contacts.pairs.iter().enumerate() {

@@ -43,7 +43,7 @@ use crate::plugins::wake_on_joints::wake_on_joint_changes;
 use crate::plugins::wake_on_scenery::wake_on_scenery_changes;
 use crate::plugins::wake_on_writes::wake_on_game_changes;
 use crate::schedule::{PhysicsSchedule, PhysicsSet};
-use crate::settings::{Gravity, PhysicsTimestep, SleepSettings};
+use crate::settings::{Gravity, LengthUnit, PhysicsTimestep, SleepSettings};
 use crate::stats::PhysicsStats;
 use bevy_app::prelude::*;
 use bevy_ecs::entity::EntityHashMap;
@@ -295,9 +295,15 @@ fn fall_asleep(
     mut scratch: Local<IslandScratch>,
     mut stats: ResMut<PhysicsStats>,
     mut commands: Commands,
+    length: Option<Res<LengthUnit>>,
 ) {
     let s = &mut *scratch;
     let gravity = gravity.map_or(Vec3::ZERO, |g| g.acceleration());
+    // The sleep speed is set for metre-sized bodies.
+    let settings = SleepSettings {
+        speed: settings.speed * length.map_or(1.0, |u| u.get()),
+        ..*settings
+    };
     count_stillness(&mut bodies, &remade, &settings, (timestep.dt(), gravity), s);
     stats.set_counter("sleep/awake_bodies", s.awake.len() as f64);
     stats.set_counter("sleep/sleeping_islands", islands.members.len() as f64);

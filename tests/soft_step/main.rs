@@ -7,6 +7,7 @@ mod common;
 
 mod bounces_and_springs;
 mod games;
+mod length_unit;
 mod platforms;
 mod rolling;
 mod thin_bodies;

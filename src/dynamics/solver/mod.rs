@@ -103,7 +103,7 @@ pub use softness::Softness;
 pub use warm_start::WarmStartCache;
 
 use crate::dynamics::forces::{ForceModel, Spring, SpringEnd};
-use crate::settings::{MAX_SUBSTEPS, SettingsError};
+use crate::settings::{LengthUnit, MAX_SUBSTEPS, SettingsError};
 use anchor_drift::drift_share;
 use glam::Vec3;
 use integrate::{capped, integrate_positions, integrate_velocities};
@@ -147,7 +147,9 @@ pub struct SoftStepSettings {
     pub static_contact_hertz: f32,
     /// Damping ratio of the contact springs.
     pub damping_ratio: f32,
-    /// Fastest push out of penetration (m/s).
+    /// Fastest push out of penetration (m/s). This, the restitution threshold, the warm-start
+    /// distance and the speed bound are read times the solver's [`LengthUnit`]
+    /// ([`Solver::set_length_unit`]; 1 unless the game sets one).
     pub max_push_out: f32,
     /// Approach speeds below this do not bounce (m/s).
     pub restitution_threshold: f32,
@@ -248,6 +250,10 @@ impl SoftStepSettings {
 pub struct Solver {
     /// The tunables.
     pub settings: SoftStepSettings,
+    /// The size of the scene's bodies, which the settings' lengths and speeds are read in.
+    length_unit: LengthUnit,
+    /// The settings this step runs with: usable, and in the length unit.
+    stepping: SoftStepSettings,
     constraints: Vec<ContactConstraint>,
     /// The constraints in batches that keep the key order's result.
     batching: OrderedBatches,
@@ -277,6 +283,11 @@ impl Solver {
             settings,
             ..Default::default()
         }
+    }
+
+    /// Reads the settings' lengths and speeds in `unit` from the next step on.
+    pub fn set_length_unit(&mut self, unit: LengthUnit) {
+        self.length_unit = unit;
     }
 
     /// The constraints of the last step, with their impulses (for contact reports and debug
@@ -315,8 +326,9 @@ impl Solver {
     ) {
         // The settings are public: unusable ones (a NaN stiffness, u32::MAX substeps) step with
         // the defaults rather than hang or spread NaN.
-        let s = self.settings.usable();
-        self.settings = s;
+        self.settings = self.settings.usable();
+        let s = self.length_unit.solver_settings(self.settings);
+        self.stepping = s;
         // A step that returns early bounds nothing.
         self.bounded_joints = 0;
         let substeps = s.substeps.max(1);
@@ -380,7 +392,7 @@ impl Solver {
     /// could change a body's velocity by [`WARM_START_BOUND`] times the speed and spin bounds
     /// (see `JointList::bound_impulses`).
     fn prepare_joints(&mut self, bodies: &SolverBodies, joints: &[JointInput], inv_h: f32) {
-        let s = &self.settings;
+        let s = &self.stepping;
         let max_speed = WARM_START_BOUND * s.max_linear_speed;
         let max_spin = WARM_START_BOUND * s.max_rotation_per_substep * inv_h;
         self.bounded_joints = self.joints.prepare(bodies, joints, (max_speed, max_spin));
@@ -390,7 +402,7 @@ impl Solver {
     /// up: the step hands out no speed or spin above the bounds either (a spin above
     /// `max_rotation_per_substep / h` could not be followed by the next step anyway).
     fn cap_velocities(&self, bodies: &mut SolverBodies, inv_h: f32) {
-        let s = &self.settings;
+        let s = &self.stepping;
         let max_spin = s.max_rotation_per_substep * inv_h;
         for (state, p) in bodies.states.iter_mut().zip(&bodies.params) {
             if p.dynamic {
@@ -502,7 +514,7 @@ impl Solver {
         use_bias: bool,
         (flip, share): (bool, f32),
     ) {
-        let push = (inv_h, self.settings.max_push_out);
+        let push = (inv_h, self.stepping.max_push_out);
         let states = &mut bodies.states;
         self.batches.solve(states, push, use_bias, flip, share);
         for &i in self.batching.one_by_one() {
@@ -513,7 +525,7 @@ impl Solver {
     /// Builds this step's constraints (a step of `dt` in substeps of `h`) and seeds them from
     /// the cache.
     fn prepare(&mut self, bodies: &SolverBodies, contacts: &[ContactInput], (h, dt): (f32, f32)) {
-        let s = self.settings;
+        let s = self.stepping;
         let soft = Softness::new(s.contact_hertz, s.damping_ratio, h);
         let static_soft = Softness::new(s.static_contact_hertz, s.damping_ratio, h);
         // A dynamic body locked on every axis is as immovable as a static one, and its

@@ -31,7 +31,8 @@
 //! body's growth in the broad phase is refreshed when its velocity or gravity scale changes,
 //! and every body's when the margin settings, the step, gravity or the substep count do.
 //!
-//! The fixed distance is 2.5 mm per moving body: 5 mm between two moving bodies, 2.5 mm
+//! The fixed distance is 2.5 mm per moving body (for metre-sized bodies: it is read times the
+//! [`LengthUnit`]): 5 mm between two moving bodies, 2.5 mm
 //! between a moving one and a static one (Avian's 5 mm contact tolerance; rapier predicts
 //! 2 mm; Box2D and Jolt look 2 cm ahead). It only has to keep resting contacts found while the
 //! solver holds them a hair apart: the motion bound covers the rest.
@@ -41,7 +42,7 @@
 use crate::components::{AngularVelocity, BoundingVolume, GravityScale, Velocity};
 use crate::geometry::contacts::{motion_bound, raw_motion_bound};
 use crate::geometry::length_or_zero;
-use crate::settings::{Gravity, PhysicsTimestep};
+use crate::settings::{Gravity, LengthUnit, PhysicsTimestep};
 use bevy_ecs::prelude::*;
 use bevy_ecs::system::SystemParam;
 use glam::Vec3;
@@ -73,6 +74,7 @@ impl Default for SpeculativeMargin {
 #[derive(SystemParam)]
 pub(crate) struct LookaheadParams<'w> {
     margin: Option<Res<'w, SpeculativeMargin>>,
+    length: Option<Res<'w, LengthUnit>>,
     timestep: Option<Res<'w, PhysicsTimestep>>,
     gravity: Option<Res<'w, Gravity>>,
     solver: Option<Res<'w, super::SoftStepSolver>>,
@@ -86,8 +88,13 @@ impl LookaheadParams<'_> {
             .as_ref()
             // The count the solver will step with: unusable settings step with the defaults.
             .map_or(1, |s| s.solver.settings.usable().substeps);
+        let unit = self.length.as_deref().map_or(1.0, |u| u.get());
+        let margin = self.margin.as_deref().map(|m| SpeculativeMargin {
+            distance: m.distance * unit,
+            ..*m
+        });
         Lookahead::new(
-            self.margin.as_deref(),
+            margin.as_ref(),
             self.timestep.as_deref(),
             self.gravity.as_deref(),
         )

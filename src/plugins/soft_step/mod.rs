@@ -55,7 +55,9 @@ use crate::plugins::narrow_phase::Contacts;
 use crate::plugins::required_resources::RequireResource;
 use crate::plugins::sleep::{ContactSide, Waker, wakes};
 use crate::schedule::{SubstepSchedule, SubstepSet};
-use crate::settings::{ContactSettings, PhysicsTimestep, RotationSettings, SleepSettings};
+use crate::settings::{
+    ContactSettings, LengthUnit, PhysicsTimestep, RotationSettings, SleepSettings,
+};
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
@@ -196,9 +198,12 @@ fn solve_soft_step(
     mut waker: Waker,
     joints: JointParams,
     sleepers: Query<(), With<Sleeping>>,
+    length: Option<Res<LengthUnit>>,
 ) {
     let start = Instant::now();
     let s = &mut *soft;
+    let unit = length.map_or_else(LengthUnit::default, |u| *u);
+    s.solver.set_length_unit(unit);
     let gyroscopic = rotation.is_none_or(|r| r.gyroscopic);
     s.waking.clear();
     let jointed = joints.any();
@@ -212,7 +217,7 @@ fn solve_soft_step(
         wake_touched_sleepers(
             &mut movers.p0(),
             &contacts,
-            sleep.speed,
+            sleep.speed * unit.get(),
             &mut s.waking,
             &mut waker,
         );
