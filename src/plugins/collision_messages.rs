@@ -1,6 +1,9 @@
 //! Collision started / ended messages: each substep's touching pairs compared with the last
-//! substep's, and likewise the overlaps of [`Sensor`]s (which the solver never sees). A start
-//! carries the [`ContactData`] of the pair's strongest collider contact (`collision_data.rs`).
+//! substep's, and likewise the overlaps of [`Sensor`]s (which the solver never sees). Two
+//! bodies touch while any of their colliders touch or overlap through a sensor, so a body
+//! touching another through several parts, sensors among them, starts and ends one collision
+//! at a time. A start carries the [`ContactData`] of the pair's strongest collider contact
+//! (`collision_data.rs`), none when a sensor's overlap began it.
 //!
 //! Pairs of sleeping or static bodies are not tested (nothing moved), so they are not in the
 //! substep's contacts; they are kept aside, sorted, as the *dormant* pairs, and looked at again
@@ -129,11 +132,12 @@ use crate::plugins::narrow_phase::Dormancy;
 
 /// The pairs found in only one of two substeps' sorted lists (scratch, kept between substeps
 /// for its capacity): touching pairs that ended and that started (with their contact), and
-/// sensor overlaps that started; `gone` serves the sensors' ended overlaps after the contacts'.
+/// sensor overlaps that ended and started.
 #[derive(Default)]
 pub(crate) struct Changes {
     gone: Vec<Pair>,
     came: Vec<Touch>,
+    gone_sensing: Vec<Pair>,
     came_sensing: Vec<Pair>,
 }
 
@@ -143,6 +147,11 @@ type Touch = (Pair, u32);
 
 /// Compares this substep's touching pairs with the last one's; when a pair ends, a sleeping
 /// body in it wakes (what it rested on moved away or vanished).
+///
+/// Two bodies touch while any collider of one touches or, through a [`Sensor`], overlaps any
+/// of the other's: a body resting on the floor with a sensor part reaching into it starts one
+/// collision, not two, and ends it when the last of the two lets go (the start carries the
+/// contact when a collider contact begins it).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn report_collisions(
     contacts: Res<Contacts>,
@@ -183,12 +192,30 @@ pub(crate) fn report_collisions(
             previous.sort_unstable();
         }
     }
-    // The pairs of only one of the two sorted lists, in one merge pass.
     let Changes {
         gone,
         came,
+        gone_sensing,
         came_sensing,
     } = &mut *changes;
+    // The sensors' overlaps first: a contact that ends while the bodies still overlap through
+    // a sensor part ends nothing. Without the sensors' stage the last overlaps stay.
+    gone_sensing.clear();
+    came_sensing.clear();
+    sensed.clear();
+    if let Some(overlaps) = overlaps {
+        sensed.extend(overlaps.pairs.iter().map(|p| (p.a.min(p.b), p.a.max(p.b))));
+        let dormant_pair = |(a, b): Pair| is_dormant(a, &bodies) && is_dormant(b, &bodies);
+        let lists = (&mut *gone_sensing, &mut *came_sensing);
+        diff_sensing(&mut sensed, &touching.sensing, lists, dormant_pair);
+        std::mem::swap(&mut *sensed, &mut touching.sensing);
+    } else {
+        sensed.clone_from(&touching.sensing);
+    }
+    // The last substep's overlaps.
+    let sensed_before = &*sensed;
+    let sensing_now = |p: &Pair| touching.sensing.binary_search(p).is_ok();
+    // The pairs of only one of the two sorted lists, in one merge pass.
     gone.clear();
     came.clear();
     diff_sorted_by_key(&previous, &fresh, |p| *p, |t| t.0, came, gone);
@@ -200,7 +227,9 @@ pub(crate) fn report_collisions(
             newly_dormant = true;
             continue;
         }
-        ended.write(CollisionEnded { a, b });
+        if !sensing_now(&(a, b)) {
+            ended.write(CollisionEnded { a, b });
+        }
         for e in [a, b] {
             if let Ok(((_, true), state)) = bodies.get_mut(e) {
                 waker.wake(e, state.map(Mut::into_inner));
@@ -219,6 +248,10 @@ pub(crate) fn report_collisions(
             resumed = true;
             continue;
         }
+        if sensed_before.binary_search(&pair).is_ok() {
+            // Already touching through a sensor part.
+            continue;
+        }
         let data = |c: &ContactPair| ContactData::of_pair(c, pair.0, TOUCHING_TOLERANCE);
         started.write(CollisionStarted {
             a: pair.0,
@@ -231,18 +264,18 @@ pub(crate) fn report_collisions(
     }
     touching.active.clear();
     touching.active.extend(fresh.iter().map(|t| t.0));
-    if let Some(overlaps) = overlaps {
-        sensed.clear();
-        sensed.extend(overlaps.pairs.iter().map(|p| (p.a.min(p.b), p.a.max(p.b))));
-        let dormant_pair = |(a, b): Pair| is_dormant(a, &bodies) && is_dormant(b, &bodies);
-        report_sensors(
-            &mut sensed,
-            &mut touching.sensing,
-            (gone, came_sensing),
-            dormant_pair,
-            &mut started,
-            &mut ended,
-        );
+    // A sensor's overlap starts or ends a collision only if no collider contact holds the
+    // pair now (or, for a start, held it last substep).
+    let found = |list: &[Pair], p: &Pair| list.binary_search(p).is_ok();
+    let held = |p: &Pair| found(&touching.active, p) || found(&touching.dormant, p);
+    for &(a, b) in gone_sensing.iter().filter(|p| !held(p)) {
+        ended.write(CollisionEnded { a, b });
+    }
+    for &(a, b) in came_sensing.iter() {
+        if !(held(&(a, b)) || found(&previous, &(a, b))) {
+            let contact = None;
+            started.write(CollisionStarted { a, b, contact });
+        }
     }
     // Every pair touching now, tested this substep or at rest asleep.
     let all = touching.active.len() + touching.dormant.len();
@@ -276,42 +309,30 @@ fn touching_now(contacts: &Contacts, fresh: &mut Vec<Touch>) {
     });
 }
 
-/// The sensor overlaps' messages: `fresh` (this substep's pairs) against `sensing` (the last
-/// one's). A pair of two sleeping or static bodies is not tested, so it keeps overlapping (it
-/// neither starts nor ends); a sensor's overlap never wakes anything.
-fn report_sensors(
+/// The sensor overlaps' changes: `fresh` (this substep's pairs, sorted and deduplicated here)
+/// against `before` (the last one's). A pair of two sleeping or static bodies is not tested,
+/// so it keeps overlapping (it neither starts nor ends; it stays in `fresh`); a sensor's
+/// overlap never wakes anything.
+fn diff_sensing(
     fresh: &mut Vec<Pair>,
-    sensing: &mut Vec<Pair>,
+    before: &[Pair],
     (gone, came): (&mut Vec<Pair>, &mut Vec<Pair>),
     dormant: impl Fn(Pair) -> bool,
-    started: &mut MessageWriter<CollisionStarted>,
-    ended: &mut MessageWriter<CollisionEnded>,
 ) {
     fresh.sort_unstable();
     fresh.dedup();
-    gone.clear();
-    came.clear();
-    diff_sorted_by_key(sensing, fresh, |p| *p, |p| *p, came, gone);
-    let mut kept = false;
-    for &(a, b) in gone.iter() {
-        if dormant((a, b)) {
-            fresh.push((a, b));
-            kept = true;
-        } else {
-            ended.write(CollisionEnded { a, b });
+    diff_sorted_by_key(before, fresh, |p| *p, |p| *p, came, gone);
+    let tested = fresh.len();
+    gone.retain(|&p| {
+        let kept = dormant(p);
+        if kept {
+            fresh.push(p);
         }
-    }
-    for &(a, b) in came.iter() {
-        started.write(CollisionStarted {
-            a,
-            b,
-            contact: None,
-        });
-    }
-    if kept {
+        !kept
+    });
+    if fresh.len() > tested {
         fresh.sort_unstable();
     }
-    sensing.clone_from(fresh);
 }
 
 /// Triggers this substep's collision messages as entity events on the bodies that asked for
