@@ -5,6 +5,7 @@ mod common;
 
 use bevy_app::App;
 use bevy_ecs::prelude::*;
+use bevy_transform::components::Transform;
 use glam::{Quat, Vec3};
 use urto::bounding::Aabb;
 use urto::plugins::BroadPhasePairs;
@@ -224,6 +225,63 @@ fn a_part_with_its_own_velocity_is_quarantined() {
         .expect("quarantined");
     assert!(q.reason.contains("compound"), "{}", q.reason);
     assert!(app.world().get::<Quarantined>(chassis).is_none());
+}
+
+/// A level as Bevy scenes spawn it: a plain root with only a `Transform` (10, 0, 2), turned a
+/// quarter about z, a plain group under it at (0, 1, 0), and static balls under the group with
+/// only their `Transform`s. The plain entities take their poses from their `Transform`s, so
+/// each ball collides where it is drawn: a ball dropped on each rests on it within 1 cm. Before,
+/// the balls collided at their local positions near the origin and the root was quarantined.
+/// A dynamic body under the root is a part with a velocity, quarantined.
+#[test]
+fn colliders_under_plain_transform_parents_collide_where_they_are_drawn_within_1_cm() {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    let turn = Quat::from_rotation_z(std::f32::consts::FRAC_PI_2);
+    let world = app.world_mut();
+    let root = world
+        .spawn(Transform::from_xyz(10.0, 0.0, 2.0).with_rotation(turn))
+        .id();
+    let group = world
+        .spawn((Transform::from_xyz(0.0, 1.0, 0.0), ChildOf(root)))
+        .id();
+    let locals = [Vec3::new(0.0, 0.0, 0.0), Vec3::new(2.0, 0.0, 1.0)];
+    for at in locals {
+        world.spawn((
+            Collider::sphere(0.5),
+            Transform::from_translation(at),
+            ChildOf(group),
+        ));
+    }
+    let mover = world
+        .spawn((
+            Collider::sphere(0.2),
+            Transform::from_xyz(0.0, 0.0, 5.0),
+            Velocity::default(),
+            ChildOf(root),
+        ))
+        .id();
+    // Where the balls are drawn: the root's pose composed with the group's and their own.
+    let drawn = locals.map(|at| Vec3::new(10.0, 0.0, 2.0) + turn * (Vec3::Y + at));
+    let dropped = drawn.map(|at| {
+        let ball = (
+            Collider::sphere(0.5),
+            Position(at + Vec3::Z * 3.0),
+            Velocity::default(),
+        );
+        app.world_mut().spawn(ball).id()
+    });
+    urto::step(app.world_mut(), 120).unwrap();
+    for (ball, at) in dropped.iter().zip(drawn) {
+        let rest = app.world().get::<Position>(*ball).unwrap().0;
+        let on_top = at + Vec3::Z;
+        assert!(rest.distance(on_top) < 0.01, "{rest} on {on_top}");
+    }
+    for plain in [root, group] {
+        assert!(app.world().get::<Quarantined>(plain).is_none());
+    }
+    let q = app.world().get::<Quarantined>(mover).expect("quarantined");
+    assert!(q.reason.contains("Velocity"), "{}", q.reason);
 }
 
 /// A kinematic arm whose joint the game turns at 3 rad/s bats a ball at the speed of the point

@@ -17,11 +17,12 @@ use crate::components::*;
 use crate::geometry::Isometry;
 use crate::hierarchy::{refit_order, topmost_marked};
 use crate::plugins::broad_phase::IndexBodies;
-use crate::plugins::core::PrepareIndex;
+use crate::plugins::core::{PrepareIndex, PrepareStart};
+use crate::plugins::plain_parents::place_plain_parents;
 use crate::plugins::required_resources::RequireResource;
 use crate::plugins::restored_state::restore_removed_state;
 use crate::plugins::settle::Unsettled;
-use crate::plugins::validation::quarantine;
+use crate::plugins::validation::{quarantine, quarantine_unplaced_bodies};
 use crate::schedule::{BroadPhaseSystems, PhysicsSchedule, PhysicsSet, SubstepSchedule};
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
@@ -43,6 +44,13 @@ impl Plugin for HierarchyPlugin {
     fn build(&self, app: &mut App) {
         app.init_required::<HierarchyScratch>()
             .insert_resource(HierarchyInstalled)
+            .add_systems(
+                PhysicsSchedule,
+                place_plain_parents
+                    .run_if(any_with_component::<ChildOf>)
+                    .in_set(PrepareStart)
+                    .before(quarantine_unplaced_bodies),
+            )
             .add_systems(
                 SubstepSchedule,
                 (

@@ -24,6 +24,7 @@ pub mod interpolation;
 pub mod joints;
 pub mod mass_properties;
 pub mod narrow_phase;
+mod plain_parents;
 mod proxy_table;
 mod required_resources;
 pub mod response;

@@ -240,7 +240,7 @@ fn quarantine_parent_cycles(
 /// quarantined and the log says why, instead of silently never colliding. The filters are
 /// archetype-level: a world without such bodies pays nothing per body.
 #[allow(clippy::type_complexity)]
-fn quarantine_unplaced_bodies(
+pub(crate) fn quarantine_unplaced_bodies(
     unplaced: Query<
         Entity,
         (
