@@ -11,7 +11,9 @@
 //!   pose (a teleport: velocities are kept, a sleeping body wakes). urto remembers what it wrote
 //!   last ([`TransformWritten`]), so its own writes — and the interpolation's — are not mistaken
 //!   for the game's, as Avian's `transform_to_position` does by comparison.
-//! - **At spawn**, an explicitly set `Position` or `Rotation` wins; a body spawned with only a
+//! - **At spawn**, an explicitly set `Position` or `Rotation` wins, and is copied into the
+//!   `Transform` at once (a body spawned with a `Position` was drawn at the origin until the
+//!   first step ran, up to three frames at 200 frames a second); a body spawned with only a
 //!   `Transform` (the usual Bevy way) starts where that `Transform` puts it.
 //!
 //! Bodies without a `Transform` cost nothing, and a world with none does not run the systems.
@@ -90,7 +92,8 @@ impl Plugin for TransformSyncPlugin {
                     .run_if(any_with_component::<Transform>)
                     .in_set(PhysicsSet::Debug),
             ),
-        );
+        )
+        .add_observer(draw_spawned_pose);
     }
 }
 
@@ -158,6 +161,23 @@ fn sync_transforms(mut bodies: Query<Drawn, Moved>, mut commands: Commands) {
         {
             commands.entity(e).insert(first);
         }
+    }
+}
+
+/// A body spawned with a `Position` or `Rotation` of its own is drawn there from its first
+/// frame: its `Transform` takes that pose when either is added (one write per spawn, no
+/// per-frame pass).
+fn draw_spawned_pose(
+    add: On<Add<(Position, Transform)>>,
+    mut bodies: Query<(&Position, &Rotation, &mut Transform)>,
+) {
+    let Ok((p, r, mut t)) = bodies.get_mut(add.entity) else {
+        return;
+    };
+    let posed = p.0 != Vec3::ZERO || r.0 != Quat::IDENTITY;
+    if posed && (t.translation != p.0 || t.rotation != r.0) {
+        t.translation = p.0;
+        t.rotation = r.0;
     }
 }
 
@@ -229,6 +249,25 @@ mod tests {
             w.get::<Transform>(by_position).unwrap().translation,
             Vec3::new(-4.0, 0.0, 2.0)
         );
+    }
+
+    /// Drawn where it is from its first frame, before any step: the `Transform` of a body
+    /// spawned with a `Position` and `Rotation` holds them at once (it held the origin until
+    /// the first step); one spawned with only a `Transform` keeps it.
+    #[test]
+    fn a_body_spawned_with_a_position_is_drawn_there_before_any_step() {
+        let mut app = app();
+        let turned = Quat::from_rotation_y(0.3);
+        let at = Vec3::new(0.0, 5.0, 1.0);
+        let pose = (Position(at), Rotation(turned), Transform::default());
+        let posed = app.world_mut().spawn((Collider::sphere(0.5), pose)).id();
+        let drawn = Transform::from_xyz(2.0, 0.0, 0.0);
+        let by_transform = app.world_mut().spawn((Collider::sphere(0.5), drawn)).id();
+        let w = app.world();
+        let t = w.get::<Transform>(posed).unwrap();
+        assert_eq!((t.translation, t.rotation), (at, turned));
+        assert_eq!(*w.get::<Transform>(by_transform).unwrap(), drawn);
+        assert_eq!(w.get::<Position>(by_transform).unwrap().0, Vec3::ZERO);
     }
 
     #[test]
