@@ -125,6 +125,11 @@ impl TouchingPairs {
     pub(crate) fn dormant(&self) -> &[Pair] {
         &self.dormant
     }
+
+    /// The pairs overlapping through a sensor (each `(a, b)` with `a < b`).
+    pub(crate) fn sensing(&self) -> &[Pair] {
+        &self.sensing
+    }
 }
 
 /// Whether the bodies of a pair are both static or asleep.

@@ -2,8 +2,10 @@
 //! (`wake_on_writes`); this wakes the sleepers touching a static body game code moved, turned,
 //! reshaped, stripped of its collider or of its `Static` marker (made a body that falls), made
 //! a sensor (or solid again), or gave new layers, friction or restitution, the sleepers
-//! jointed to such a static, and a sleeper that lost its collider or became a sensor (its
-//! island wakes with it). Without it, a box asleep on a floor the game moved down by a metre
+//! jointed to such a static, the sleepers overlapping such a static sensor (the overlap of a
+//! sleeper and a static is not tested either: a zone moved off a sleeping box ended nothing,
+//! and a zone made solid around one left it asleep inside), and a sleeper that lost its
+//! collider or became a sensor (its island wakes with it). Without it, a box asleep on a floor the game moved down by a metre
 //! hung in the air, as it did on a floor whose collider was removed or that became a sensor
 //! (and, two steps long, on a floor made dynamic): the pair of a sleeper and a static body is
 //! dormant (`collision_messages`), never tested again until one of them wakes.
@@ -84,7 +86,9 @@ pub(crate) fn wake_on_scenery_changes(
     let Some(touching) = touching else {
         return;
     };
-    for &(a, b) in touching.dormant() {
+    // A sleeper in a static sensor that moved, took new layers or became solid: woken, so
+    // that the overlap is tested again (it ends, or the solid pushes the sleeper out).
+    for &(a, b) in touching.dormant().iter().chain(touching.sensing()) {
         if changed.contains(&a) {
             wake(b, &mut waker);
         }

@@ -188,3 +188,53 @@ fn a_body_touching_through_a_solid_and_a_sensor_part_starts_and_ends_one_collisi
         "the first start carries the solid part's contact"
     );
 }
+
+/// A box asleep on a floor inside a static zone: the zone moved 10 m away or given layers that
+/// keep it from the box ends the overlap within 3 steps, and the zone made solid wakes the box
+/// (which it now overlaps). The overlap of a sleeper and a static was never tested again:
+/// none of the three was heard while the box slept (a fifth user-style probe).
+#[test]
+fn a_static_zone_moved_off_a_sleeper_or_made_solid_is_heard_within_3_steps() {
+    for change in ["moved", "layers", "solid"] {
+        let mut app = common::app();
+        app.insert_resource(Gravity::EARTH_Z_UP);
+        app.world_mut().spawn((
+            Collider::cuboid(20.0, 5.0, 0.5),
+            Position::new(0.0, 0.0, -0.5),
+            Static,
+        ));
+        let zone = app
+            .world_mut()
+            .spawn((
+                Collider::cuboid(1.0, 1.0, 1.0),
+                Position::new(0.0, 0.0, 1.0),
+                Static,
+                Sensor,
+            ))
+            .id();
+        let body = (
+            Collider::cuboid(0.3, 0.3, 0.3),
+            Position::new(0.0, 0.0, 0.3),
+        );
+        let b = app.world_mut().spawn((body, Velocity::default())).id();
+        urto::step(app.world_mut(), 120).unwrap();
+        assert!(app.world().get::<Sleeping>(b).is_some(), "{change}: asleep");
+        let mut heard = Heard::new(&app);
+        let mut zone_mut = app.world_mut().entity_mut(zone);
+        match change {
+            "moved" => drop(zone_mut.insert(Position::new(10.0, 0.0, 1.0))),
+            "layers" => drop(zone_mut.insert(CollisionLayers::new(LayerMask(2), LayerMask(2)))),
+            _ => drop(zone_mut.remove::<Sensor>()),
+        }
+        let mut ended = Vec::new();
+        for _ in 0..3 {
+            urto::step(app.world_mut(), 1).unwrap();
+            ended.extend(heard.read(&app)[1].clone());
+        }
+        if change == "solid" {
+            assert!(app.world().get::<Sleeping>(b).is_none(), "solid: awake");
+        } else {
+            assert_eq!(ended, [ordered(zone, b)], "{change}");
+        }
+    }
+}
