@@ -10,11 +10,21 @@
 //! (and, two steps long, on a floor made dynamic): the pair of a sleeper and a static body is
 //! dormant (`collision_messages`), never tested again until one of them wakes.
 //!
+//! A static spawned or moved *onto* a sleeper has no pair with it to follow, so the sleepers
+//! its new volume overlaps wake too (a root static's collider; a compound's parts are placed
+//! after this runs): a trigger zone placed over resting loot reports it, a wall spawned
+//! through a sleeping box pushes it out. rapier reports a sensor's new overlap without waking
+//! the body; here the body is awake for the half second it takes to fall asleep again.
+//!
 //! The statics written to are found among the *unsettled* ones only (`settle`: a write takes a
 //! static's marker off before this runs), so a level of a million untouched statics costs no
-//! scan; the dormant pairs are read only in a step in which something changed.
+//! scan; the dormant pairs are read only in a step in which something changed, and the
+//! sleepers' volumes only in a step in which a static was spawned or moved (one test against
+//! the new volumes' union each, then against those volumes if inside it).
 
+use crate::bounding::Aabb;
 use crate::components::*;
+use crate::geometry::Isometry;
 use crate::plugins::collision_messages::TouchingPairs;
 use crate::plugins::joints::ActiveJoint;
 use crate::plugins::settle::Unsettled;
@@ -36,6 +46,11 @@ pub(crate) type SceneryWritten = (
     )>,
 );
 
+/// A static collider outside any hierarchy, with its pose (a compound's parts are placed only
+/// after this runs).
+type FlatStatic<'a> = (&'a Collider, &'a Position, &'a Rotation);
+type FlatStaticFilter = (With<Static>, Without<ChildOf>, Without<Children>);
+
 /// Wakes the sleepers touching a changed static or a changed sleeper, and the changed
 /// sleepers themselves (module docs).
 #[allow(clippy::too_many_arguments)]
@@ -50,8 +65,10 @@ pub(crate) fn wake_on_scenery_changes(
     touching: Option<Res<TouchingPairs>>,
     joints: Query<&Joint, ActiveJoint>,
     mut sleepers: Query<&mut SleepState, With<Sleeping>>,
+    placed: Query<FlatStatic, FlatStaticFilter>,
+    sleeping_volumes: Query<(Entity, &BoundingVolume), With<Sleeping>>,
     mut waker: Waker,
-    mut changed: Local<EntityHashSet>,
+    (mut changed, mut new_volumes): (Local<EntityHashSet>, Local<Vec<Aabb>>),
 ) {
     changed.clear();
     changed.extend(written.iter().chain(made_sensors.iter()));
@@ -71,6 +88,26 @@ pub(crate) fn wake_on_scenery_changes(
     };
     for &e in changed.iter() {
         wake(e, &mut waker);
+    }
+    // A static spawned or moved onto a sleeper (a trigger zone placed over resting loot, a wall
+    // spawned through a sleeping box) has no pair with it yet: the sleepers its new volume
+    // overlaps wake.
+    if !sleeping_volumes.is_empty() {
+        new_volumes.clear();
+        new_volumes.extend(
+            changed
+                .iter()
+                .filter_map(|&e| placed.get(e).ok())
+                .map(|(c, p, r)| c.shape.world_aabb(&Isometry::new(p.0, r.0))),
+        );
+        if let Some(reach) = new_volumes.iter().copied().reduce(|a, b| a.union(&b)) {
+            for (e, bv) in &sleeping_volumes {
+                let under = |v: &Aabb| v.intersects(&bv.0);
+                if under(&reach) && new_volumes.iter().any(under) {
+                    wake(e, &mut waker);
+                }
+            }
+        }
     }
     // A ball asleep on a rope from a static hook hung on where the hook had been moved or
     // despawned (a user-style probe).

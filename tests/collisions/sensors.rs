@@ -238,3 +238,61 @@ fn a_static_zone_moved_off_a_sleeper_or_made_solid_is_heard_within_3_steps() {
         }
     }
 }
+
+/// A box asleep on a floor: a static zone spawned around it, or moved onto it from 10 m away,
+/// starts an overlap within 3 steps, and a static wall spawned through it wakes it. None was
+/// seen while the box slept: the new static had no pair with it.
+#[test]
+fn a_static_zone_spawned_or_moved_onto_a_sleeper_is_heard_within_3_steps() {
+    for change in ["spawned", "moved onto", "wall"] {
+        let mut app = common::app();
+        app.insert_resource(Gravity::EARTH_Z_UP);
+        app.world_mut().spawn((
+            Collider::cuboid(20.0, 5.0, 0.5),
+            Position::new(0.0, 0.0, -0.5),
+            Static,
+        ));
+        let away = app
+            .world_mut()
+            .spawn((
+                Collider::cuboid(1.0, 1.0, 1.0),
+                Position::new(10.0, 0.0, 1.0),
+                Static,
+                Sensor,
+            ))
+            .id();
+        let body = (
+            Collider::cuboid(0.3, 0.3, 0.3),
+            Position::new(0.0, 0.0, 0.3),
+        );
+        let b = app.world_mut().spawn((body, Velocity::default())).id();
+        urto::step(app.world_mut(), 120).unwrap();
+        assert!(app.world().get::<Sleeping>(b).is_some(), "{change}: asleep");
+        let mut heard = Heard::new(&app);
+        let around = Position::new(0.0, 0.0, 1.0);
+        let zone = match change {
+            "spawned" => {
+                let zone = (Collider::cuboid(1.0, 1.0, 1.0), around, Static, Sensor);
+                app.world_mut().spawn(zone).id()
+            }
+            "moved onto" => {
+                app.world_mut().entity_mut(away).insert(around);
+                away
+            }
+            _ => {
+                let wall = (Collider::cuboid(0.1, 2.0, 2.0), around, Static);
+                app.world_mut().spawn(wall).id()
+            }
+        };
+        let mut started = Vec::new();
+        for _ in 0..3 {
+            urto::step(app.world_mut(), 1).unwrap();
+            started.extend(heard.read(&app)[0].clone());
+        }
+        if change == "wall" {
+            assert!(app.world().get::<Sleeping>(b).is_none(), "wall: awake");
+        } else {
+            assert_eq!(started, [ordered(zone, b)], "{change}");
+        }
+    }
+}
