@@ -29,6 +29,7 @@
 mod angular;
 mod impulse;
 mod joint;
+mod kinematic_target;
 mod mass;
 mod point_sum;
 mod sleeping;
@@ -38,6 +39,7 @@ pub use impulse::{GravityScale, Impulse};
 pub use joint::{
     Joint, JointBroken, JointDisabled, JointEnd, JointKind, JointLimit, JointLoad, JointMotor,
 };
+pub use kinematic_target::KinematicTarget;
 pub use mass::{ComputedMass, DEFAULT_DENSITY, Density, Mass};
 pub(crate) use sleeping::SleepTransitions;
 pub use sleeping::{SleepState, Sleeping, SleepingDisabled, SleepingIslands};

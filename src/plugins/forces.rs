@@ -5,8 +5,9 @@
 //! integrates; a [`GravityScale`] adds the force `(s − 1) m g`.
 
 use crate::components::*;
+use crate::plugins::validation::quarantine;
 use crate::schedule::{PhysicsSchedule, PhysicsSet};
-use crate::settings::Gravity;
+use crate::settings::{Gravity, PhysicsTimestep};
 use crate::stats::{PhysicsStats, Stage};
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
@@ -55,6 +56,7 @@ impl Plugin for ForcesPlugin {
                     .run_if(resource_exists::<Gravity>)
                     .run_if(any_with_component::<GravityScale>),
                 apply_impulses.run_if(any_with_component::<Impulse>),
+                follow_kinematic_targets.run_if(any_with_component::<KinematicTarget>),
             )
                 .chain()
                 .in_set(PhysicsSet::Forces),
@@ -232,4 +234,38 @@ fn apply_impulses(
             *impulse = Impulse::default();
         }
     });
+}
+
+type Targeted<'a> = (
+    Entity,
+    &'a KinematicTarget,
+    (&'a Position, Option<&'a Rotation>),
+    &'a mut Velocity,
+    Option<&'a mut AngularVelocity>,
+    &'a ComputedMass,
+);
+
+/// Sets each kinematic body's velocity and spin to reach its [`KinematicTarget`] by the end of
+/// the step (a body without an `AngularVelocity` only translates); a target that cannot be
+/// followed quarantines its body.
+fn follow_kinematic_targets(
+    mut bodies: Query<Targeted, Without<Quarantined>>,
+    timestep: Res<PhysicsTimestep>,
+    mut commands: Commands,
+) {
+    for (e, target, (p, r), mut v, w, mass) in &mut bodies {
+        if mass.inverse() != 0.0 {
+            continue;
+        }
+        let Some((velocity, spin)) = target.motion_from((p.0, Rotation::of(r)), timestep.dt())
+        else {
+            let reason = format!("its KinematicTarget cannot be followed: {target:?}");
+            quarantine(&mut commands, e, reason);
+            continue;
+        };
+        v.set_if_neq(Velocity(velocity));
+        if let Some(mut w) = w {
+            w.set_if_neq(AngularVelocity(spin));
+        }
+    }
 }

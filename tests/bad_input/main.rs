@@ -7,7 +7,7 @@ mod common;
 mod removed_volume;
 mod scene_fuzz;
 
-use glam::Vec3;
+use glam::{Quat, Vec3};
 use urto::geometry::Shape;
 use urto::prelude::*;
 
@@ -50,6 +50,45 @@ fn nan_and_infinite_state_is_quarantined_and_neighbours_stay_finite() {
         p.is_finite() && p.z > 0.3,
         "the good ball was disturbed: {p}"
     );
+}
+
+/// A kinematic platform whose `KinematicTarget` is NaN, infinite, unreachable in a step
+/// (1e38 m away) or turned by a quaternion of length 2 is quarantined; a ball resting on a
+/// good platform beside them stays finite and seated within 1 mm.
+#[test]
+fn kinematic_targets_that_cannot_be_followed_are_quarantined() {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    let platform = |app: &mut bevy_app::App, x: f32, target: KinematicTarget| {
+        let slab = Collider::cuboid(1.0, 1.0, 0.25);
+        let at = Position::new(x, 0.0, -0.25);
+        let kinematic = (Velocity::default(), Mass::INFINITE);
+        app.world_mut().spawn((slab, at, kinematic, target)).id()
+    };
+    let good = platform(
+        &mut app,
+        0.0,
+        KinematicTarget::new(Vec3::new(0.0, 0.0, -0.25)),
+    );
+    let ball = common::ball(&mut app, Vec3::new(0.0, 0.0, 0.5));
+    let doubled = Quat::from_xyzw(0.0, 0.0, 0.0, 2.0);
+    let bad = [
+        KinematicTarget::new(Vec3::NAN),
+        KinematicTarget::new(Vec3::splat(f32::INFINITY)),
+        KinematicTarget::new(Vec3::splat(1e38)),
+        KinematicTarget::new(Vec3::ZERO).with_rotation(doubled),
+    ]
+    .into_iter()
+    .zip(1..)
+    .map(|(target, i)| platform(&mut app, 5.0 * i as f32, target))
+    .collect::<Vec<_>>();
+    urto::step(app.world_mut(), 60).unwrap();
+    for e in bad {
+        assert!(quarantined(&app, e));
+    }
+    assert!(!quarantined(&app, good));
+    let p = app.world().get::<Position>(ball).unwrap().0;
+    assert!(p.distance(Vec3::new(0.0, 0.0, 0.5)) < 1e-3, "ball at {p}");
 }
 
 #[test]
