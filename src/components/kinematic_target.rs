@@ -52,3 +52,26 @@ impl KinematicTarget {
         (velocity.is_finite() && spin.is_finite()).then_some((velocity, spin))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A turn of 0.1 rad about z in a 1/60 s step is a spin of 6 rad/s about z (within 1e-4),
+    /// whichever sign its quaternion has; the same rotation written as `-q` is no turn.
+    #[test]
+    fn a_target_turned_0_1_rad_spins_6_rad_s_either_sign_and_minus_q_is_no_turn() {
+        let from = (Vec3::ZERO, Quat::from_rotation_x(0.3));
+        let dt = 1.0 / 60.0;
+        let turned = Quat::from_rotation_z(0.1) * from.1;
+        for q in [turned, -turned] {
+            let target = KinematicTarget::new(Vec3::X).with_rotation(q);
+            let (v, w) = target.motion_from(from, dt).unwrap();
+            assert!((v - Vec3::X * 60.0).length() < 1e-3, "{v}");
+            assert!((w - Vec3::Z * 6.0).length() < 1e-4, "{w}");
+        }
+        let still = KinematicTarget::new(Vec3::ZERO).with_rotation(-from.1);
+        let (_, w) = still.motion_from(from, dt).unwrap();
+        assert!(w.length() < 1e-4, "{w}");
+    }
+}
