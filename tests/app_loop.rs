@@ -48,13 +48,23 @@ fn app_update_steps_physics_by_elapsed_time() {
     );
 }
 
+/// A frame of a second (250 ms once Bevy's own `max_delta` caps it) runs 3 steps, the cap, and
+/// leaves the game's clock alone: `Time<Virtual>` advances the 250 ms (it advanced 60 ms when
+/// urto capped its `max_delta` instead, slowing every `Update` system after a hitch).
 #[test]
-fn a_slow_frame_runs_at_most_the_catch_up_cap() {
+fn a_slow_frame_runs_at_most_the_catch_up_cap_and_the_game_clock_keeps_its_time() {
     let mut app = app(Duration::from_secs(1));
     app.world_mut().spawn(Velocity::default());
     app.update(); // the first frame has no elapsed time
     app.update();
     assert_eq!(app.world().resource::<PhysicsStats>().step, 3);
+    let game = app
+        .world()
+        .resource::<bevy_time::Time<bevy_time::Virtual>>();
+    assert_eq!(game.elapsed(), Duration::from_millis(250));
+    // The next frame runs 3 more, no backlog carried.
+    app.update();
+    assert_eq!(app.world().resource::<PhysicsStats>().step, 6);
 }
 
 #[test]

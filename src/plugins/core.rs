@@ -19,7 +19,7 @@ use crate::stats::PhysicsStats;
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::SingleThreadedExecutor;
-use bevy_time::{Fixed, Time, Virtual};
+use bevy_time::{Fixed, Time};
 use std::fmt;
 use std::time::Duration;
 
@@ -119,7 +119,9 @@ impl Plugin for PhysicsCorePlugin {
         );
         app.add_schedule(substep);
 
-        app.add_systems(FixedPostUpdate, run_physics_in_fixed_update)
+        app.init_resource::<StepsThisFrame>()
+            .add_systems(FixedFirst, cap_catch_up)
+            .add_systems(FixedPostUpdate, run_physics_in_fixed_update)
             .add_systems(PreUpdate, set_fixed_clock);
     }
 
@@ -130,13 +132,32 @@ impl Plugin for PhysicsCorePlugin {
     }
 }
 
-/// In an App, Bevy's fixed clock is the accumulator: give it our dt and cap the catch-up.
+/// In an App, Bevy's fixed clock is the accumulator: give it our dt.
 fn set_clocks(world: &mut World, ts: &PhysicsTimestep) {
     if let Some(mut fixed) = world.get_resource_mut::<Time<Fixed>>() {
         fixed.set_timestep(Duration::from_secs_f32(ts.dt()));
     }
-    if let Some(mut virt) = world.get_resource_mut::<Time<Virtual>>() {
-        virt.set_max_delta(Duration::from_secs_f32(ts.dt()) * ts.max_steps_per_frame());
+}
+
+/// The fixed steps run in this frame so far.
+#[derive(Resource, Default)]
+struct StepsThisFrame(u32);
+
+/// At most [`PhysicsTimestep::max_steps_per_frame`] steps a frame: at the start of the last
+/// step the cap allows, the time still owed to the fixed clock is dropped, so Bevy's fixed
+/// loop ends after it. The game's own clock is left alone: urto used to cap `Time<Virtual>`'s
+/// `max_delta` at the cap instead, which slowed every `Update` system too (a 250 ms hitch
+/// advanced the game's time by 67 ms; a user-style probe).
+fn cap_catch_up(
+    mut steps: ResMut<StepsThisFrame>,
+    timestep: Option<Res<PhysicsTimestep>>,
+    mut fixed: ResMut<Time<Fixed>>,
+) {
+    steps.0 += 1;
+    let cap = timestep.map_or(u32::MAX, |ts| ts.max_steps_per_frame());
+    if steps.0 >= cap {
+        let owed = fixed.overstep();
+        fixed.discard_overstep(owed);
     }
 }
 
@@ -161,6 +182,9 @@ fn set_fixed_clock(world: &mut World, mut warned: Local<bool>) {
         .map(|ts| *ts);
     if let Some(ts) = changed {
         set_clocks(world, &ts);
+    }
+    if let Some(mut steps) = world.get_resource_mut::<StepsThisFrame>() {
+        steps.0 = 0;
     }
 }
 
