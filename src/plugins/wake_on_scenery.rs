@@ -5,10 +5,11 @@
 //! jointed to such a static, the sleepers overlapping such a static sensor (the overlap of a
 //! sleeper and a static is not tested either: a zone moved off a sleeping box ended nothing,
 //! and a zone made solid around one left it asleep inside), and a sleeper that lost its
-//! collider or became a sensor (its island wakes with it). Without it, a box asleep on a floor the game moved down by a metre
-//! hung in the air, as it did on a floor whose collider was removed or that became a sensor
-//! (and, two steps long, on a floor made dynamic): the pair of a sleeper and a static body is
-//! dormant (`collision_messages`), never tested again until one of them wakes.
+//! collider or became a sensor (its island wakes with it). Without it, a box asleep on a floor
+//! the game moved down by a metre hung in the air, as it did on a floor whose collider was
+//! removed or that became a sensor (and, two steps long, on a floor made dynamic): the pair of
+//! a sleeper and a static body is dormant (`collision_messages`), never tested again until one
+//! of them wakes.
 //!
 //! A static spawned or moved *onto* a sleeper has no pair with it to follow, so the sleepers
 //! its new volume overlaps wake too (a root static's collider; a compound's parts are placed

@@ -189,6 +189,44 @@ fn a_body_touching_through_a_solid_and_a_sensor_part_starts_and_ends_one_collisi
     );
 }
 
+/// A static zone 2 m across centred 1 m above a floor at `zone_x`, and a box of 0.6 m
+/// asleep on the floor at the origin; the app, the zone and the box.
+fn box_asleep_by_a_zone(zone_x: f32) -> (bevy_app::App, Entity, Entity) {
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    let world = app.world_mut();
+    let floor = (
+        Collider::cuboid(20.0, 5.0, 0.5),
+        Position::new(0.0, 0.0, -0.5),
+    );
+    world.spawn((floor, Static));
+    let zone = (
+        Collider::cuboid(1.0, 1.0, 1.0),
+        Position::new(zone_x, 0.0, 1.0),
+    );
+    let zone = world.spawn((zone, Static, Sensor)).id();
+    let body = (
+        Collider::cuboid(0.3, 0.3, 0.3),
+        Position::new(0.0, 0.0, 0.3),
+    );
+    let b = world.spawn((body, Velocity::default())).id();
+    urto::step(app.world_mut(), 120).unwrap();
+    assert!(app.world().get::<Sleeping>(b).is_some(), "the box sleeps");
+    (app, zone, b)
+}
+
+/// Steps 3 times; the pairs that started and that ended.
+fn heard_in_3_steps(app: &mut bevy_app::App, heard: &mut Heard) -> [Vec<(Entity, Entity)>; 2] {
+    let mut all = [Vec::new(), Vec::new()];
+    for _ in 0..3 {
+        urto::step(app.world_mut(), 1).unwrap();
+        for (to, from) in all.iter_mut().zip(heard.read(app)) {
+            to.extend(from);
+        }
+    }
+    all
+}
+
 /// A box asleep on a floor inside a static zone: the zone moved 10 m away or given layers that
 /// keep it from the box ends the overlap within 3 steps, and the zone made solid wakes the box
 /// (which it now overlaps). The overlap of a sleeper and a static was never tested again:
@@ -196,29 +234,7 @@ fn a_body_touching_through_a_solid_and_a_sensor_part_starts_and_ends_one_collisi
 #[test]
 fn a_static_zone_moved_off_a_sleeper_or_made_solid_is_heard_within_3_steps() {
     for change in ["moved", "layers", "solid"] {
-        let mut app = common::app();
-        app.insert_resource(Gravity::EARTH_Z_UP);
-        app.world_mut().spawn((
-            Collider::cuboid(20.0, 5.0, 0.5),
-            Position::new(0.0, 0.0, -0.5),
-            Static,
-        ));
-        let zone = app
-            .world_mut()
-            .spawn((
-                Collider::cuboid(1.0, 1.0, 1.0),
-                Position::new(0.0, 0.0, 1.0),
-                Static,
-                Sensor,
-            ))
-            .id();
-        let body = (
-            Collider::cuboid(0.3, 0.3, 0.3),
-            Position::new(0.0, 0.0, 0.3),
-        );
-        let b = app.world_mut().spawn((body, Velocity::default())).id();
-        urto::step(app.world_mut(), 120).unwrap();
-        assert!(app.world().get::<Sleeping>(b).is_some(), "{change}: asleep");
+        let (mut app, zone, b) = box_asleep_by_a_zone(0.0);
         let mut heard = Heard::new(&app);
         let mut zone_mut = app.world_mut().entity_mut(zone);
         match change {
@@ -226,11 +242,7 @@ fn a_static_zone_moved_off_a_sleeper_or_made_solid_is_heard_within_3_steps() {
             "layers" => drop(zone_mut.insert(CollisionLayers::new(LayerMask(2), LayerMask(2)))),
             _ => drop(zone_mut.remove::<Sensor>()),
         }
-        let mut ended = Vec::new();
-        for _ in 0..3 {
-            urto::step(app.world_mut(), 1).unwrap();
-            ended.extend(heard.read(&app)[1].clone());
-        }
+        let [_, ended] = heard_in_3_steps(&mut app, &mut heard);
         if change == "solid" {
             assert!(app.world().get::<Sleeping>(b).is_none(), "solid: awake");
         } else {
@@ -245,29 +257,7 @@ fn a_static_zone_moved_off_a_sleeper_or_made_solid_is_heard_within_3_steps() {
 #[test]
 fn a_static_zone_spawned_or_moved_onto_a_sleeper_is_heard_within_3_steps() {
     for change in ["spawned", "moved onto", "wall"] {
-        let mut app = common::app();
-        app.insert_resource(Gravity::EARTH_Z_UP);
-        app.world_mut().spawn((
-            Collider::cuboid(20.0, 5.0, 0.5),
-            Position::new(0.0, 0.0, -0.5),
-            Static,
-        ));
-        let away = app
-            .world_mut()
-            .spawn((
-                Collider::cuboid(1.0, 1.0, 1.0),
-                Position::new(10.0, 0.0, 1.0),
-                Static,
-                Sensor,
-            ))
-            .id();
-        let body = (
-            Collider::cuboid(0.3, 0.3, 0.3),
-            Position::new(0.0, 0.0, 0.3),
-        );
-        let b = app.world_mut().spawn((body, Velocity::default())).id();
-        urto::step(app.world_mut(), 120).unwrap();
-        assert!(app.world().get::<Sleeping>(b).is_some(), "{change}: asleep");
+        let (mut app, away, b) = box_asleep_by_a_zone(10.0);
         let mut heard = Heard::new(&app);
         let around = Position::new(0.0, 0.0, 1.0);
         let zone = match change {
@@ -284,11 +274,7 @@ fn a_static_zone_spawned_or_moved_onto_a_sleeper_is_heard_within_3_steps() {
                 app.world_mut().spawn(wall).id()
             }
         };
-        let mut started = Vec::new();
-        for _ in 0..3 {
-            urto::step(app.world_mut(), 1).unwrap();
-            started.extend(heard.read(&app)[0].clone());
-        }
+        let [started, _] = heard_in_3_steps(&mut app, &mut heard);
         if change == "wall" {
             assert!(app.world().get::<Sleeping>(b).is_none(), "wall: awake");
         } else {

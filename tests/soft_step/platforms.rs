@@ -18,22 +18,24 @@ fn spawn_platform(world: &mut World, half: f32) -> Entity {
         .id()
 }
 
+/// A 6 m × 6 m kinematic platform at rest with a unit box seated on it `x` m from its centre,
+/// settled for a second; the app, the platform and the box.
+fn box_seated_on_a_platform(x: f32) -> (App, Entity, Entity) {
+    let mut app = soft_step_app();
+    let world = app.world_mut();
+    let platform = spawn_platform(world, 3.0);
+    let body = (Collider::cuboid(0.5, 0.5, 0.5), Position::new(x, 0.0, 0.52));
+    let body = world.spawn((body, Velocity::default())).id();
+    urto::step(app.world_mut(), 60).unwrap();
+    (app, platform, body)
+}
+
 /// A 6 m × 6 m kinematic platform with a unit box on it, settled for a second; the platform
 /// then moves at `velocity(step)` for 600 steps. The box's largest speed relative to the
 /// platform within the plane, after the first second of motion, and how far it ends from
 /// where it sat on the platform.
 fn ride(velocity: impl Fn(u32) -> Vec3) -> (f32, f32) {
-    let mut app = soft_step_app();
-    let world = app.world_mut();
-    let platform = spawn_platform(world, 3.0);
-    let body = world
-        .spawn((
-            Collider::cuboid(0.5, 0.5, 0.5),
-            Position::new(0.0, 0.0, 0.52),
-            Velocity::default(),
-        ))
-        .id();
-    urto::step(app.world_mut(), 60).unwrap();
+    let (mut app, platform, body) = box_seated_on_a_platform(0.0);
     let offset =
         |app: &App| (get::<Position>(app, body).0 - get::<Position>(app, platform).0).truncate();
     let seated = offset(&app);
@@ -203,17 +205,7 @@ fn a_ball_rolling_on_a_turntable_orbits_its_axis_at_two_sevenths_its_rate_within
 /// with the target).
 #[test]
 fn a_platform_lowered_and_turned_by_its_kinematic_target_carries_a_box_within_1_cm() {
-    let mut app = soft_step_app();
-    let world = app.world_mut();
-    let platform = spawn_platform(world, 3.0);
-    let body = world
-        .spawn((
-            Collider::cuboid(0.5, 0.5, 0.5),
-            Position::new(1.0, 0.0, 0.52),
-            Velocity::default(),
-        ))
-        .id();
-    urto::step(app.world_mut(), 60).unwrap();
+    let (mut app, platform, body) = box_seated_on_a_platform(1.0);
     let seat = |app: &App| {
         let turned = get::<Rotation>(app, platform).0.inverse();
         turned * (get::<Position>(app, body).0 - get::<Position>(app, platform).0)
