@@ -67,6 +67,22 @@ fn a_slow_frame_runs_at_most_the_catch_up_cap_and_the_game_clock_keeps_its_time(
     assert_eq!(app.world().resource::<PhysicsStats>().step, 6);
 }
 
+/// Frames of 70 ms at 50 Hz with a cap of 3 steps: each frame owes 3.5 steps, runs 3 and
+/// drops whole steps only, so the half step left over joins the next frame's: after 10
+/// frames (the first has no elapsed time), 9 × 3 steps ran and half a step is owed.
+#[test]
+fn the_catch_up_cap_drops_whole_steps_and_keeps_the_fraction_within_1_us() {
+    let mut app = app(Duration::from_millis(70));
+    app.world_mut().spawn(Velocity::default());
+    for _ in 0..10 {
+        app.update();
+    }
+    assert_eq!(app.world().resource::<PhysicsStats>().step, 27);
+    let fixed = app.world().resource::<bevy_time::Time<bevy_time::Fixed>>();
+    let owed = fixed.overstep().as_secs_f64();
+    assert!((owed - 0.01).abs() < 1e-6, "owed {owed} s");
+}
+
 #[test]
 fn a_hand_written_update_loop_without_finish_steps_at_exactly_the_configured_60_hz() {
     // The README's loop: plugins added, then app.update() in a loop, never app.finish().

@@ -144,8 +144,8 @@ fn set_clocks(world: &mut World, ts: &PhysicsTimestep) {
 struct StepsThisFrame(u32);
 
 /// At most [`PhysicsTimestep::max_steps_per_frame`] steps a frame: at the start of the last
-/// step the cap allows, the time still owed to the fixed clock is dropped, so Bevy's fixed
-/// loop ends after it. The game's own clock is left alone: urto used to cap `Time<Virtual>`'s
+/// step the cap allows, the whole steps still owed to the fixed clock are dropped, so Bevy's
+/// fixed loop ends after it. The game's own clock is left alone: urto used to cap `Time<Virtual>`'s
 /// `max_delta` at the cap instead, which slowed every `Update` system too (a 250 ms hitch
 /// advanced the game's time by 67 ms; a user-style probe).
 fn cap_catch_up(
@@ -156,8 +156,14 @@ fn cap_catch_up(
     steps.0 += 1;
     let cap = timestep.map_or(u32::MAX, |ts| ts.max_steps_per_frame());
     if steps.0 >= cap {
-        let owed = fixed.overstep();
-        fixed.discard_overstep(owed);
+        // Whole steps only: the fraction of a step left over is the next frame's, as it is
+        // below the cap (and the interpolation's blend reads it).
+        let (owed, step) = (
+            fixed.overstep().as_nanos(),
+            fixed.timestep().as_nanos().max(1),
+        );
+        let whole = owed - owed % step;
+        fixed.discard_overstep(Duration::from_nanos(whole as u64));
     }
 }
 
