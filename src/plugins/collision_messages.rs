@@ -270,11 +270,13 @@ pub(crate) fn report_collisions(
     touching.active.clear();
     touching.active.extend(fresh.iter().map(|t| t.0));
     // A sensor's overlap starts or ends a collision only if no collider contact holds the
-    // pair now (or, for a start, held it last substep).
+    // pair now or held it last substep (a contact that ended with it has ended the pair).
     let found = |list: &[Pair], p: &Pair| list.binary_search(p).is_ok();
     let held = |p: &Pair| found(&touching.active, p) || found(&touching.dormant, p);
-    for &(a, b) in gone_sensing.iter().filter(|p| !held(p)) {
-        ended.write(CollisionEnded { a, b });
+    for &(a, b) in gone_sensing.iter() {
+        if !(held(&(a, b)) || found(&previous, &(a, b))) {
+            ended.write(CollisionEnded { a, b });
+        }
     }
     for &(a, b) in came_sensing.iter() {
         if !(held(&(a, b)) || found(&previous, &(a, b))) {

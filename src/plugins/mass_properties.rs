@@ -46,8 +46,13 @@ struct MassBuffers {
     path: Vec<Entity>,
     visited: EntityHashSet,
     stack: Vec<(Entity, Isometry)>,
-    parts: Vec<(Isometry, MassProperties)>,
+    parts: PlacedParts,
+    /// The [`Sensor`] parts met, which weigh only when the body has no other collider.
+    sensor_parts: PlacedParts,
 }
+
+/// Colliders' unit-density mass properties, each placed in its body's frame.
+type PlacedParts = Vec<(Isometry, MassProperties)>;
 
 /// Sleeping roots are left out: a write to one wakes it first.
 type ChangedRoot = (
@@ -60,6 +65,7 @@ type ChangedRoot = (
         Changed<Density>,
         Added<Inertia>,
         Changed<Children>,
+        Added<Sensor>,
     )>,
 );
 type ChangedPart = (
@@ -71,6 +77,7 @@ type ChangedPart = (
         Changed<Children>,
         Changed<Position>,
         Changed<Rotation>,
+        Added<Sensor>,
     )>,
 );
 type ChangedRoots<'w, 's> = Query<'w, 's, Entity, (ChangedRoot, With<Inertia>)>;
@@ -91,6 +98,7 @@ type PartData<'a> = (
     Option<&'a Children>,
     &'a Position,
     Option<&'a Rotation>,
+    Has<Sensor>,
 );
 
 /// Recomputes the computed mass and inertia of bodies whose collider, mass, density or parts
@@ -103,7 +111,7 @@ fn compute_mass_properties(
     mut unset_mass: RemovedComponents<Mass>,
     mut unset_density: RemovedComponents<Density>,
     mut released: RemovedComponents<Quarantined>,
-    mut stripped: RemovedComponents<Collider>,
+    (mut stripped, mut unsensed): (RemovedComponents<Collider>, RemovedComponents<Sensor>),
     parents: Query<&ChildOf>,
     parts: Query<PartData>,
     mut buffers: ResMut<MassBuffers>,
@@ -117,9 +125,10 @@ fn compute_mass_properties(
     b.dirty.extend(unset.chain(released.read()));
     // A collider removed from a body or a part changes its root's mass (a despawned part's
     // parent sees its `Children` change; a despawned body needs nothing).
-    if !changed_parts.is_empty() || !stripped.is_empty() {
+    if !changed_parts.is_empty() || !stripped.is_empty() || !unsensed.is_empty() {
         b.roots.clear();
-        for part in changed_parts.iter().chain(stripped.read()) {
+        let removed = stripped.read().chain(unsensed.read());
+        for part in changed_parts.iter().chain(removed) {
             let root = root_of(part, &parents, &mut b.roots, &mut b.path);
             b.dirty.push(root);
         }
@@ -139,7 +148,8 @@ fn compute_mass_properties(
             if mass.is_some_and(|m| !m.is_valid()) {
                 continue;
             }
-            gather_compound(root, &parts, &mut b.stack, &mut b.visited, &mut b.parts);
+            let out = (&mut b.parts, &mut b.sensor_parts);
+            gather_compound(root, &parts, &mut b.stack, &mut b.visited, out);
             let unit = MassProperties::compound(b.parts.drain(..));
             let (derived, density_report) =
                 ComputedMass::derive(mass.copied(), density.copied(), unit.mass);
@@ -178,34 +188,42 @@ fn root_of(
     root
 }
 
-/// Every collider at or below `root`, placed in `root`'s frame, at unit density.
+/// Every collider at or below `root`, placed in `root`'s frame, at unit density, into `out`.
+/// [`Sensor`]s weigh nothing, as in Avian, Godot and Unity (rapier weighs them): a pickup
+/// radius or a detection zone attached to a character would otherwise outweigh it and move its
+/// centre of mass. A body made of sensors alone weighs them, so that it still has a mass.
 fn gather_compound(
     root: Entity,
     parts: &Query<PartData>,
     stack: &mut Vec<(Entity, Isometry)>,
     visited: &mut EntityHashSet,
-    out: &mut Vec<(Isometry, MassProperties)>,
+    (out, sensors): (&mut PlacedParts, &mut PlacedParts),
 ) {
     stack.clear();
     visited.clear();
     out.clear();
+    sensors.clear();
     stack.push((root, Isometry::default()));
     while let Some((e, pose)) = stack.pop() {
         if !visited.insert(e) {
             continue;
         }
-        let Ok((collider, children, ..)) = parts.get(e) else {
+        let Ok((collider, children, _, _, sensor)) = parts.get(e) else {
             continue;
         };
         // A part with an impossible shape is quarantined; its numbers reach no inertia.
         if let Some(c) = collider.filter(|c| c.shape.validate().is_ok()) {
-            out.push((pose, c.shape.mass_properties(1.0)));
+            let to = if sensor { &mut *sensors } else { &mut *out };
+            to.push((pose, c.shape.mass_properties(1.0)));
         }
         for &child in children.into_iter().flatten() {
-            if let Ok((_, _, p, r)) = parts.get(child) {
+            if let Ok((_, _, p, r, _)) = parts.get(child) {
                 stack.push((child, pose * crate::components::pose(p, r)));
             }
         }
+    }
+    if out.is_empty() {
+        out.append(sensors);
     }
 }
 
