@@ -91,6 +91,30 @@ fn kinematic_targets_that_cannot_be_followed_are_quarantined() {
     assert!(p.distance(Vec3::new(0.0, 0.0, 0.5)) < 1e-3, "ball at {p}");
 }
 
+/// A plain parent (only a `Transform`) whose translation is NaN, holding a collider: the
+/// parent takes that NaN as its pose and is quarantined, and a ball falling past its child
+/// stays finite and lands.
+#[test]
+fn a_plain_parent_with_a_nan_transform_is_quarantined() {
+    use bevy_transform::components::Transform;
+    let mut app = common::app();
+    app.insert_resource(Gravity::EARTH_Z_UP);
+    app.world_mut()
+        .spawn((Collider::half_space(Vec3::Z), Static));
+    let root = app
+        .world_mut()
+        .spawn(Transform::from_xyz(f32::NAN, 0.0, 1.0))
+        .id();
+    let part = (Collider::sphere(0.5), Transform::from_xyz(0.0, 0.0, 1.0));
+    app.world_mut()
+        .spawn((part, bevy_ecs::hierarchy::ChildOf(root)));
+    let ball = common::ball(&mut app, Vec3::new(0.0, 0.0, 3.0));
+    urto::step(app.world_mut(), 120).unwrap();
+    assert!(quarantined(&app, root));
+    let p = app.world().get::<Position>(ball).unwrap().0;
+    assert!(p.is_finite() && (p.z - 0.5).abs() < 0.01, "ball at {p}");
+}
+
 #[test]
 fn zero_negative_subnormal_and_nan_masses_are_quarantined() {
     let mut app = common::app();
