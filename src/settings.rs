@@ -61,13 +61,13 @@ impl fmt::Display for SettingsError {
 impl std::error::Error for SettingsError {}
 
 /// The typical size of the scene's bodies, in the game's length unit (rapier's `length_unit`,
-/// Box2D's `lengthUnitsPerMeter`, Avian's `PhysicsLengthUnit`). The thresholds that are lengths
-/// or speeds are set for bodies about a metre across and read multiplied by it: the sleep speed
-/// ([`SleepSettings::speed`], and with it the window a body must stay in), the soft-step
-/// solver's restitution threshold, push-out speed, speed bound and warm-start distance
-/// ([`SoftStepSettings`]), and the speculative margin's fixed distance. Everything else is already in proportion to the bodies (the
-/// contacts' stiffness is a frequency, the margins follow the motion). The lecture's legacy
-/// pipeline ([`ContactSettings::solver`]) keeps its metres.
+/// Box2D's `lengthUnitsPerMeter`, Avian's `PhysicsLengthUnit`). The thresholds that are lengths or
+/// speeds are set for bodies about a metre across and read multiplied by it: the sleep speed
+/// ([`SleepSettings::speed`], and with it the window a body must stay in), the soft-step solver's
+/// restitution threshold, push-out speed, speed bound and warm-start distance
+/// ([`SoftStepSettings`]), and the speculative margin's fixed distance. Everything else is already
+/// in proportion to the bodies (the contacts' stiffness is a frequency, the margins follow the
+/// motion). The lecture's legacy pipeline ([`ContactSettings::solver`]) keeps its metres.
 ///
 /// Default 1. A scene of 1 cm dice and marbles in metres takes 0.01: with 1, a 1 cm ball
 /// rolling one diameter a second fell asleep after half a diameter, and no drop below 5 cm
@@ -276,11 +276,11 @@ impl Default for ContactSettings {
 pub struct SleepSettings {
     /// Whether bodies may fall asleep.
     pub enabled: bool,
-    /// The sleep speed (m/s for metre-sized bodies; read times the [`LengthUnit`]): a still body stays within `speed × time` of where its current
-    /// window began (a net displacement: its average velocity below `speed`), its surface as it
-    /// turns too, and moves slower than `4 × speed` at every step (Jolt's sleep test with a cap;
-    /// see [`crate::dynamics::stillness`]). Also the approach speed at which a contact wakes a
-    /// sleeper.
+    /// The sleep speed (m/s for metre-sized bodies; read times the [`LengthUnit`]): a still body
+    /// stays within `speed × time` of where its current window began (a net displacement: its
+    /// average velocity below `speed`), its surface as it turns too, and moves slower than `4 ×
+    /// speed` at every step (Jolt's sleep test with a cap; see [`crate::dynamics::stillness`]).
+    /// Also the approach speed at which a contact wakes a sleeper.
     pub speed: f32,
     /// How long a body must stay still before it sleeps (s; more than 0).
     pub time: f32,

@@ -32,12 +32,11 @@
 //! and every body's when the margin settings, the step, gravity or the substep count do.
 //!
 //! The fixed distance is 2.5 mm per moving body (for metre-sized bodies: it is read times the
-//! [`LengthUnit`]): 5 mm between two moving bodies, 2.5 mm
-//! between a moving one and a static one (Avian's 5 mm contact tolerance; rapier predicts
-//! 2 mm; Box2D and Jolt look 2 cm ahead). It only has to keep resting contacts found while the
-//! solver holds them a hair apart: the motion bound covers the rest.
-//! At 2 cm per body the 1 cm gaps between the boxes of a row became 190 contacts more in a
-//! 210-box pyramid (590 against 400), a quarter of its awake step.
+//! [`LengthUnit`]): 5 mm between two moving bodies, 2.5 mm between a moving one and a static one
+//! (Avian's 5 mm contact tolerance; rapier predicts 2 mm; Box2D and Jolt look 2 cm ahead). It only
+//! has to keep resting contacts found while the solver holds them a hair apart: the motion bound
+//! covers the rest. At 2 cm per body the 1 cm gaps between the boxes of a row became 190 contacts
+//! more in a 210-box pyramid (590 against 400), a quarter of its awake step.
 
 use crate::components::{AngularVelocity, BoundingVolume, GravityScale, Velocity};
 use crate::geometry::contacts::{motion_bound, raw_motion_bound};
