@@ -4,6 +4,7 @@
 //! `Position` every frame teleported it: contacts saw it standing still, and a box riding it
 //! down at 1.2 m/s fell behind and bounced 0.45 m (a user-style probe).
 
+use crate::geometry::is_unit_rotation;
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
 
@@ -39,8 +40,7 @@ impl KinematicTarget {
     /// `dt` seconds (the shorter way round); `None` for a target that is not finite or a
     /// rotation that is not a unit quaternion.
     pub fn motion_from(&self, (position, rotation): (Vec3, Quat), dt: f32) -> Option<(Vec3, Vec3)> {
-        let unit = (self.rotation.length() - 1.0).abs() < 1e-3;
-        if !(self.position.is_finite() && self.rotation.is_finite() && unit) {
+        if !(self.position.is_finite() && is_unit_rotation(self.rotation)) {
             return None;
         }
         let mut turn = self.rotation.normalize() * rotation.inverse();

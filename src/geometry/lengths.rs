@@ -9,6 +9,13 @@ pub fn length_or_zero(x: f32) -> f32 {
     if x.is_finite() { x.max(0.0) } else { 0.0 }
 }
 
+/// Whether `q` is a rotation the engine can use: finite, and a unit quaternion within 1e-3 (a
+/// body's rotation, a joint's frame, a kinematic target's).
+#[inline]
+pub fn is_unit_rotation(q: glam::Quat) -> bool {
+    q.is_finite() && (q.length() - 1.0).abs() < 1e-3
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

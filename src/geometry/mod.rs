@@ -26,7 +26,7 @@ mod weld;
 pub use contact::{ContactManifold, ContactPoint, FeatureId, MAX_MANIFOLD_POINTS};
 pub use convex_hull::{ConvexHull, HullError, HullFace};
 pub use isometry::Isometry;
-pub use lengths::length_or_zero;
+pub use lengths::{is_unit_rotation, length_or_zero};
 pub use mass_properties::MassProperties;
 pub use mesh_collider::{MeshCollider, MeshColliderError};
 pub use mesh_intersects::BadPose;

@@ -9,6 +9,7 @@
 //! added or changed components are checked, so a scene at rest costs nothing here.
 
 use crate::components::*;
+use crate::geometry::is_unit_rotation;
 use crate::plugins::core::PrepareStart;
 use crate::plugins::settle::Unsettled;
 use crate::schedule::PhysicsSchedule;
@@ -283,7 +284,7 @@ fn why_invalid(
                 .map(|m| format!("mass must be > 0 (or Mass::INFINITE), got {}", m.0))
         })
         .or_else(|| {
-            r.filter(|r| !(r.0.is_finite() && (r.0.length() - 1.0).abs() < 1e-3))
+            r.filter(|r| !is_unit_rotation(r.0))
                 .map(|r| format!("rotation must be a unit quaternion, got {}", r.0))
         })
         .or_else(|| {

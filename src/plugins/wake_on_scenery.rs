@@ -25,7 +25,6 @@
 
 use crate::bounding::Aabb;
 use crate::components::*;
-use crate::geometry::Isometry;
 use crate::plugins::collision_messages::TouchingPairs;
 use crate::plugins::joints::ActiveJoint;
 use crate::plugins::settle::Unsettled;
@@ -99,7 +98,7 @@ pub(crate) fn wake_on_scenery_changes(
             changed
                 .iter()
                 .filter_map(|&e| placed.get(e).ok())
-                .map(|(c, p, r)| c.shape.world_aabb(&Isometry::new(p.0, r.0))),
+                .map(|(c, p, r)| c.shape.world_aabb(&pose(p, Some(r)))),
         );
         if let Some(reach) = new_volumes.iter().copied().reduce(|a, b| a.union(&b)) {
             for (e, bv) in &sleeping_volumes {

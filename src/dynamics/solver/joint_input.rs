@@ -2,6 +2,7 @@
 //! and the checks that refuse unusable values before they reach the solver
 //! ([`joint`](super::joint) prepares and solves it).
 
+use crate::geometry::is_unit_rotation;
 use glam::{Quat, Vec3};
 
 /// Where a joint holds a body: an anchor from its centre of mass and a basis whose x axis is
@@ -17,9 +18,7 @@ pub struct JointFrame {
 impl JointFrame {
     /// A finite anchor and a finite unit basis.
     pub fn is_usable(&self) -> bool {
-        self.anchor.is_finite()
-            && self.basis.is_finite()
-            && (self.basis.length() - 1.0).abs() < 1e-3
+        self.anchor.is_finite() && is_unit_rotation(self.basis)
     }
 }
 
